@@ -1,0 +1,22 @@
+# Installs the library, its headers under include/jelly/<module>/, and the CMake package files.
+include(CMakePackageConfigHelpers)
+foreach(module IN LISTS JELLY_MODULES)
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${module}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly/${module}
+          FILES_MATCHING PATTERN "*.hpp")
+endforeach()
+install(FILES ${JELLY_BUILD_INCLUDE_DIR}/jelly/version.hpp ${JELLY_BUILD_INCLUDE_DIR}/jelly/jelly.hpp
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly)
+install(TARGETS jelly EXPORT jellyTargets
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(EXPORT jellyTargets NAMESPACE jelly:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/jelly)
+configure_package_config_file(cmake/jellyConfig.cmake.in ${CMAKE_CURRENT_BINARY_DIR}/jellyConfig.cmake
+                              INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/jelly)
+write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/jellyConfigVersion.cmake
+                                 COMPATIBILITY SameMajorVersion)
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/jellyConfig.cmake
+              ${CMAKE_CURRENT_BINARY_DIR}/jellyConfigVersion.cmake
+              ${CMAKE_CURRENT_SOURCE_DIR}/cmake/FindCHOLMOD.cmake
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/jelly)

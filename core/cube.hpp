@@ -1,0 +1,36 @@
+#pragma once
+// The seed's jelly cube: an n x n x n particle lattice joined by structural, shear and bending
+// springs, each spring stored once.
+#include <array>
+
+#include <jelly/core/model.hpp>
+#include <jelly/core/state.hpp>
+
+namespace jelly {
+
+struct CubeSpec {
+  int n = 10;                                   // particles per edge, >= 2
+  Real edge_length = 4;                         // m, > 0
+  Vec3 origin{-20.0 / 9, 61.0 / 9, -20.0 / 9};  // position of particle (0, 0, 0)
+  Real particle_mass = 1;                       // kg, > 0
+  // Indexed by SpringType: structural, shear, bending.
+  std::array<SpringCoefficients, kSpringTypeCount> springs{
+      SpringCoefficients{1400, 50}, SpringCoefficients{1400, 50}, SpringCoefficients{1400, 50}};
+  Vec3 gravity{0, -9.8, 0};
+
+  // Throws InputError naming the first invalid field.
+  void validate() const;
+};
+
+// Particle (i, j, k) of the lattice has index (i * n + j) * n + k and sits at
+// origin + (i, j, k) * edge_length / (n - 1). Springs: structural to the +x, +y, +z neighbours;
+// shear along the 6 face and 4 body diagonals of each unit cell; bending to the axis neighbours
+// at distance 2. For n = 10: 2700 + 7776 + 2400 = 12,876 springs.
+Model build_cube(const CubeSpec& spec);
+
+inline int cube_index(int n, int i, int j, int k) { return (i * n + j) * n + k; }
+
+// The model at rest in its construction pose, at time 0.
+State rest_state(const Model& model);
+
+}  // namespace jelly

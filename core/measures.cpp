@@ -1,0 +1,48 @@
+#include <jelly/core/measures.hpp>
+
+namespace jelly {
+
+Real kinetic_energy(const Model& model, const VecX& v) {
+  Real e = 0;
+  for (int i = 0; i < model.num_particles(); ++i)
+    e += 0.5 * model.mass[i] * particle(v, i).squaredNorm();
+  return e;
+}
+
+Real elastic_energy(const Model& model, const VecX& x) {
+  const Springs& s = model.springs;
+  Real e = 0;
+  for (int k = 0; k < s.size(); ++k) {
+    const Real stretch = (particle(x, s.a[k]) - particle(x, s.b[k])).norm() - s.rest_length[k];
+    e += 0.5 * s.ks[k] * stretch * stretch;
+  }
+  return e;
+}
+
+Real gravitational_energy(const Model& model, const VecX& x) {
+  Real e = 0;
+  for (int i = 0; i < model.num_particles(); ++i)
+    e -= model.mass[i] * model.gravity.dot(particle(x, i));
+  return e;
+}
+
+Vec3 center_of_mass(const Model& model, const VecX& x) {
+  Vec3 sum = Vec3::Zero();
+  for (int i = 0; i < model.num_particles(); ++i) sum += model.mass[i] * particle(x, i);
+  return sum / model.mass.sum();
+}
+
+Vec3 linear_momentum(const Model& model, const VecX& v) {
+  Vec3 p = Vec3::Zero();
+  for (int i = 0; i < model.num_particles(); ++i) p += model.mass[i] * particle(v, i);
+  return p;
+}
+
+Vec3 angular_momentum(const Model& model, const VecX& x, const VecX& v) {
+  Vec3 l = Vec3::Zero();
+  for (int i = 0; i < model.num_particles(); ++i)
+    l += model.mass[i] * Vec3(particle(x, i)).cross(Vec3(particle(v, i)));
+  return l;
+}
+
+}  // namespace jelly

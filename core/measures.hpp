@@ -1,0 +1,30 @@
+#pragma once
+// Energies, momenta and centre of mass of a model in a state.
+#include <jelly/core/model.hpp>
+#include <jelly/core/state.hpp>
+
+namespace jelly {
+
+Real kinetic_energy(const Model& model, const VecX& v);        // sum m |v|^2 / 2
+Real elastic_energy(const Model& model, const VecX& x);        // sum ks (|xa - xb| - l0)^2 / 2
+Real gravitational_energy(const Model& model, const VecX& x);  // -sum m g . x
+Vec3 center_of_mass(const Model& model, const VecX& x);        // sum m x / sum m
+Vec3 linear_momentum(const Model& model, const VecX& v);       // sum m v
+Vec3 angular_momentum(const Model& model, const VecX& x, const VecX& v);  // sum m x cross v
+
+inline Real kinetic_energy(const Model& m, const State& s) { return kinetic_energy(m, s.v); }
+inline Real elastic_energy(const Model& m, const State& s) { return elastic_energy(m, s.x); }
+inline Real gravitational_energy(const Model& m, const State& s) {
+  return gravitational_energy(m, s.x);
+}
+inline Vec3 center_of_mass(const Model& m, const State& s) { return center_of_mass(m, s.x); }
+inline Vec3 linear_momentum(const Model& m, const State& s) { return linear_momentum(m, s.v); }
+inline Vec3 angular_momentum(const Model& m, const State& s) {
+  return angular_momentum(m, s.x, s.v);
+}
+// Kinetic + elastic + gravitational.
+inline Real total_energy(const Model& m, const State& s) {
+  return kinetic_energy(m, s.v) + elastic_energy(m, s.x) + gravitational_energy(m, s.x);
+}
+
+}  // namespace jelly

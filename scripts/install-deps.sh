@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs, with apt, the Debian packages jelly needs that are missing. Idempotent: a machine
+# that already has everything is left untouched and nothing is downloaded.
+set -euo pipefail
+
+packages=(
+  build-essential cmake make pkg-config git
+  libeigen3-dev libsuitesparse-dev libopenblas-dev libsundials-dev libhdf5-dev hdf5-tools
+  libceres-dev libgtest-dev libgmock-dev googletest libbenchmark-dev nlohmann-json3-dev libcli11-dev
+  python3-h5py python3-matplotlib python3-numpy ffmpeg clang-format
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"

@@ -1,0 +1,36 @@
+#include <jelly/solvers/divergence_guard.hpp>
+
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+void DivergenceGuard::validate() const {
+  require(max_speed > 0, "divergence.max_speed", max_speed, "a speed > 0 m/s");
+  require(max_distance > 0, "divergence.max_distance", max_distance, "a distance > 0 m");
+}
+
+std::optional<std::string> DivergenceGuard::check(const State& s) const {
+  const int n = static_cast<int>(s.x.size() / 3);
+  const Real speed2 = max_speed * max_speed;
+  const Real dist2 = max_distance * max_distance;
+  for (int i = 0; i < n; ++i) {
+    const auto x = particle(s.x, i);
+    const auto v = particle(s.v, i);
+    if (!x.allFinite() || !v.allFinite()) {
+      return "particle " + std::to_string(i) + " has a non-finite position or velocity";
+    }
+    if (v.squaredNorm() > speed2) {
+      return "particle " + std::to_string(i) + " moves at " + to_text(v.norm()) +
+             " m/s, above the limit of " + to_text(max_speed) + " m/s";
+    }
+    if (x.squaredNorm() > dist2) {
+      return "particle " + std::to_string(i) + " is " + to_text(x.norm()) +
+             " m from the origin, beyond the limit of " + to_text(max_distance) + " m";
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace jelly

@@ -1,0 +1,25 @@
+#include <jelly/solvers/dynamics.hpp>
+
+#include <jelly/core/forces.hpp>
+
+namespace jelly {
+
+void Dynamics::forces(const VecX& x, const VecX& v, VecX& f) const {
+  ++evaluations_;
+  compute_forces(*model_, x, v, f);
+  contacts_->add_forces(v, f);
+}
+
+void Dynamics::acceleration(const VecX& x, const VecX& v, VecX& a) const {
+  forces(x, v, a);
+  const Real* m = model_->mass.data();
+  Real* pa = a.data();
+  for (int i = 0; i < model_->num_particles(); ++i) {
+    const Real inv = 1.0 / m[i];
+    pa[3 * i] *= inv;
+    pa[3 * i + 1] *= inv;
+    pa[3 * i + 2] *= inv;
+  }
+}
+
+}  // namespace jelly

@@ -1,0 +1,29 @@
+#pragma once
+// The right-hand side every integrator sees: the model's forces (gravity, springs, dampers) plus
+// the contact forces active during the current step, and the accelerations M^-1 f.
+#include <jelly/core/model.hpp>
+#include <jelly/terrain/contact.hpp>
+
+namespace jelly {
+
+class Dynamics {
+ public:
+  Dynamics(const Model& model, const ContactSolver& contacts)
+      : model_(&model), contacts_(&contacts) {}
+
+  // f(x, v): size 3N, no allocation.
+  void forces(const VecX& x, const VecX& v, VecX& f) const;
+  // a = M^-1 f(x, v).
+  void acceleration(const VecX& x, const VecX& v, VecX& a) const;
+
+  const Model& model() const { return *model_; }
+  const ContactSolver& contacts() const { return *contacts_; }
+  long force_evaluations() const { return evaluations_; }
+
+ private:
+  const Model* model_;
+  const ContactSolver* contacts_;
+  mutable long evaluations_ = 0;
+};
+
+}  // namespace jelly

@@ -1,0 +1,21 @@
+#include <jelly/solvers/integrator.hpp>
+
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
+  require(std::isfinite(h) && h > 0, "dt", h, "a finite time step > 0");
+  const Eigen::Index n = dynamics.model().num_dofs();
+  require(state.x.size() == n && state.v.size() == n, "state.size", state.x.size(),
+          "3 x the number of particles (" + std::to_string(n) + ")");
+  StepResult result = do_step(dynamics, state, h);
+  if (result.ok) ++steps_;
+  return result;
+}
+
+Statistics Integrator::statistics() const { return {{"steps", static_cast<double>(steps_)}}; }
+
+}  // namespace jelly

@@ -1,0 +1,52 @@
+#pragma once
+// The integrator interface: a non-virtual step() that checks its input and keeps counts, over a
+// small protected hook each method implements.
+#include <map>
+#include <string>
+#include <string_view>
+
+#include <jelly/core/state.hpp>
+#include <jelly/solvers/dynamics.hpp>
+
+namespace jelly {
+
+// Named counters and timings an integrator reports (summary, HDF5 attributes).
+using Statistics = std::map<std::string, double>;
+
+// A recoverable numerical failure is a returned status, not an exception.
+struct StepResult {
+  bool ok = true;
+  std::string message;
+  static StepResult success() { return {}; }
+  static StepResult failure(std::string why) { return {false, std::move(why)}; }
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+
+  // Advances state (t, x, v) by h under `dynamics`. Throws InputError unless h is finite and
+  // > 0 and the state's sizes match the model.
+  StepResult step(const Dynamics& dynamics, State& state, Real h);
+
+  virtual std::string_view name() const = 0;
+  virtual int order() const = 0;
+  virtual bool is_implicit() const { return false; }
+  // Counters of this integrator (steps, and whatever the method adds).
+  virtual Statistics statistics() const;
+
+  long steps() const { return steps_; }
+
+ protected:
+  virtual StepResult do_step(const Dynamics& dynamics, State& state, Real h) = 0;
+
+ private:
+  long steps_ = 0;
+};
+
+// Resizes v to n entries only when its size differs (no allocation in steady state).
+inline void ensure_size(VecX& v, Eigen::Index n) {
+  if (v.size() != n) v.setZero(n);
+}
+
+}  // namespace jelly

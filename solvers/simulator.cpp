@@ -1,0 +1,99 @@
+#include <jelly/solvers/simulator.hpp>
+
+#include <chrono>
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+void SimulatorOptions::validate() const {
+  require(std::isfinite(dt) && dt > 0, "integrator.dt", dt, "a finite time step > 0 s");
+  require(std::isfinite(output_interval) && output_interval >= 0, "output_interval",
+          output_interval, "a finite interval >= 0 s (0 = every step)");
+  divergence.validate();
+}
+
+Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integrator,
+                     SimulatorOptions options)
+    : model_(std::move(model)),
+      state_(std::move(state)),
+      integrator_(std::move(integrator)),
+      options_(options) {
+  model_.validate();
+  options_.validate();
+  require(integrator_ != nullptr, "integrator", "null", "an integrator");
+  require(state_.x.size() == model_.num_dofs() && state_.v.size() == model_.num_dofs(),
+          "state.x.size", state_.x.size(), "3 x the number of particles");
+  require(std::isfinite(state_.t), "state.t", state_.t, "a finite time");
+  next_output_ = state_.t;
+}
+
+void Simulator::add_terrain(std::unique_ptr<Terrain> terrain) {
+  require(terrain != nullptr, "terrain", "null", "a terrain");
+  terrains_.push_back(std::move(terrain));
+}
+
+void Simulator::add_observer(Observer& observer) { observers_.push_back(&observer); }
+
+void Simulator::set_state(State state) {
+  require(state.x.size() == model_.num_dofs() && state.v.size() == model_.num_dofs(),
+          "state.x.size", state.x.size(), "3 x the number of particles");
+  state_ = std::move(state);
+  contacts_.clear();
+  next_output_ = state_.t;
+  frames_ = 0;
+}
+
+StepResult Simulator::step() {
+  const Dynamics dynamics(model_, contacts_);
+  before_.x = state_.x;
+  before_.v = state_.v;
+  StepResult result = integrator_->step(dynamics, state_, options_.dt);
+  force_evaluations_ += dynamics.force_evaluations();
+  if (!result.ok) return result;
+  contacts_.resolve(model_, terrains_, before_, state_, options_.dt);
+  ++total_steps_;
+  return result;
+}
+
+void Simulator::emit_frame() {
+  for (Observer* o : observers_) o->on_frame(*this);
+  ++frames_;
+  if (options_.output_interval > 0) {
+    while (next_output_ <= state_.t + 1e-9 * options_.dt) next_output_ += options_.output_interval;
+  }
+}
+
+RunReport Simulator::run_until(Real t_end) {
+  require(std::isfinite(t_end), "t_end", t_end, "a finite time");
+  const auto start = std::chrono::steady_clock::now();
+  const long evaluations_before = force_evaluations_;
+  RunReport report;
+  if (frames_ == 0) emit_frame();
+  const Real dt = options_.dt;
+  while (state_.t < t_end - 0.5 * dt) {
+    const StepResult result = step();
+    if (!result.ok) {
+      report.status = RunStatus::kSolverFailed;
+      report.reason = result.message;
+      break;
+    }
+    ++report.steps;
+    if (auto why = options_.divergence.check(state_)) {
+      report.status = RunStatus::kDiverged;
+      report.reason = *why;
+      break;
+    }
+    if (options_.output_interval == 0 || state_.t >= next_output_ - 1e-9 * dt) emit_frame();
+  }
+  report.t = state_.t;
+  report.force_evaluations = force_evaluations_ - evaluations_before;
+  report.statistics = integrator_->statistics();
+  report.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (Observer* o : observers_) o->on_finish(*this, report);
+  return report;
+}
+
+}  // namespace jelly

@@ -1,0 +1,81 @@
+#pragma once
+// Steps a model among terrains with an integrator: contact after every step, observers at a
+// chosen output interval, and a divergence guard that stops the run with a report.
+#include <memory>
+#include <vector>
+
+#include <jelly/core/model.hpp>
+#include <jelly/core/state.hpp>
+#include <jelly/solvers/divergence_guard.hpp>
+#include <jelly/solvers/integrator.hpp>
+#include <jelly/solvers/run_report.hpp>
+#include <jelly/terrain/contact.hpp>
+
+namespace jelly {
+
+class Simulator;
+
+// Called with the simulator at the first output time and then every output interval.
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  virtual void on_frame(const Simulator& simulator) = 0;
+  virtual void on_finish(const Simulator& /*simulator*/, const RunReport& /*report*/) {}
+};
+
+struct SimulatorOptions {
+  Real dt = 0.001;           // s, > 0
+  Real output_interval = 0;  // s between observer frames; 0 = every step
+  DivergenceGuard divergence;
+  void validate() const;
+};
+
+class Simulator {
+ public:
+  // Throws InputError for an invalid model, state size or option.
+  Simulator(Model model, State state, std::unique_ptr<Integrator> integrator,
+            SimulatorOptions options = {});
+
+  void add_terrain(std::unique_ptr<Terrain> terrain);
+  // The observer must outlive the runs it observes.
+  void add_observer(Observer& observer);
+
+  // One step of options().dt, then contact. Returns the integrator's failure, if any; does not
+  // check divergence (run_until does).
+  StepResult step();
+  // Steps until t_end (the last step lands within dt / 2 of it), calling observers, and stops
+  // early on divergence or integrator failure.
+  RunReport run_until(Real t_end);
+
+  const Model& model() const { return model_; }
+  // For changing coefficients between runs (fitting); the sparsity of springs must not change.
+  Model& mutable_model() { return model_; }
+  const State& state() const { return state_; }
+  // Replaces the state (a restart); forgets the active contacts.
+  void set_state(State state);
+  const Terrains& terrains() const { return terrains_; }
+  const Integrator& integrator() const { return *integrator_; }
+  Integrator& integrator() { return *integrator_; }
+  const SimulatorOptions& options() const { return options_; }
+  const ContactSolver& contacts() const { return contacts_; }
+  long total_steps() const { return total_steps_; }
+  long force_evaluations() const { return force_evaluations_; }
+
+ private:
+  void emit_frame();
+
+  Model model_;
+  State state_;
+  std::unique_ptr<Integrator> integrator_;
+  SimulatorOptions options_;
+  Terrains terrains_;
+  ContactSolver contacts_;
+  State before_;  // the state at the start of the current step
+  std::vector<Observer*> observers_;
+  long total_steps_ = 0;
+  long force_evaluations_ = 0;
+  long frames_ = 0;
+  Real next_output_ = 0;
+};
+
+}  // namespace jelly

@@ -1,0 +1,44 @@
+#pragma once
+// Contact between particles and terrains, the same for every integrator (docs/contact.md):
+//  1. after each integrator step, resolve() applies each terrain's contact model to the new
+//     state: velocity impulses (restitution, friction) and, for coulomb, projection out of the
+//     surface and the tangential displacement that friction removed during the step;
+//  2. during the next step, every force evaluation calls add_forces(), which applies the seed
+//     model's contact and friction forces to the particles that collided in step 1.
+#include <memory>
+#include <vector>
+
+#include <jelly/core/model.hpp>
+#include <jelly/core/state.hpp>
+#include <jelly/terrain/terrain.hpp>
+
+namespace jelly {
+
+using Terrains = std::vector<std::unique_ptr<Terrain>>;
+
+class ContactSolver {
+ public:
+  // Applies every terrain's contact response to `state` (time state.t) after a step of size h
+  // from the state `before`.
+  void resolve(const Model& model, const Terrains& terrains, const State& before, State& state,
+               Real h);
+  // Seed model: for each particle that collided at the last resolve() and whose force f pushes
+  // into the surface, cancels the inward normal force N and adds the friction -mu N v_t.
+  void add_forces(const VecX& v, VecX& f) const;
+
+  // Particle-terrain contacts found by the last resolve().
+  int contact_count() const { return contact_count_; }
+  // Forget the seed contacts (after a restart or a state set from outside).
+  void clear();
+
+ private:
+  struct SeedContact {
+    int particle;
+    Vec3 normal;
+    Real friction;
+  };
+  std::vector<SeedContact> seed_contacts_;
+  int contact_count_ = 0;
+};
+
+}  // namespace jelly

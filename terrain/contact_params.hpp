@@ -1,0 +1,37 @@
+#pragma once
+// How a terrain answers a particle that touches it: the contact model and its coefficients.
+#include <string>
+#include <string_view>
+
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+enum class ContactModel {
+  // Impulses on the relative velocity: restitution above a resting speed, Coulomb friction
+  // (static and kinetic, bounded by mu times the normal impulse), penetration projected out.
+  kCoulomb,
+  // The seed report's rules (sections 1.2 and 1.3): velocity reflection within epsilon, a contact
+  // force cancelling the inward force, and friction -mu N v_t proportional to the speed.
+  kSeed,
+};
+std::string_view contact_model_name(ContactModel model);
+// Throws InputError for a name other than "coulomb" or "seed".
+ContactModel contact_model_from_name(std::string_view name, std::string_view field);
+
+struct ContactParams {
+  ContactModel model = ContactModel::kCoulomb;
+  Real restitution = 0.8;      // in [0, 1]
+  Real friction = 0.5;         // kinetic mu (coulomb), the report's coefFriction (seed); >= 0
+  Real static_friction = 0.5;  // coulomb: sticking when |v_t| <= mu_s * dv_n; >= friction
+  Real epsilon = 0.01;         // seed: contact distance (m); > 0
+  // coulomb: a particle bounces only if it was already approaching the surface faster than this
+  // at the start of the step; an approach built up within one step (a resting particle pulled
+  // down by gravity and its springs) is absorbed, so that a resting jelly does not jitter.
+  Real resting_speed = 0.05;
+
+  // Throws InputError naming `prefix`.field for a value out of range.
+  void validate(const std::string& prefix) const;
+};
+
+}  // namespace jelly

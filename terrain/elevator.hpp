@@ -1,0 +1,43 @@
+#pragma once
+// The seed elevator: a horizontal rectangular platform (normal +y) moving vertically by an
+// ElevatorMotion. A particle outside its footprint, or deeper below it than its thickness,
+// does not touch it and falls past.
+#include <jelly/terrain/elevator_motion.hpp>
+#include <jelly/terrain/terrain.hpp>
+
+namespace jelly {
+
+struct ElevatorSpec {
+  Vec3 center{0, 1, 0};  // platform centre at t = 0
+  Real size_x = 5;       // footprint along x (m), > 0
+  Real size_z = 5;       // footprint along z (m), > 0
+  Real thickness = 1;    // how deep below the surface a particle still counts as touching (m)
+  Real mass = 1;         // kg, the platform mass of the seed collision formula
+  ElevatorMotion motion = ElevatorMotion::seed();
+  void validate() const;
+};
+
+class Elevator final : public Terrain {
+ public:
+  explicit Elevator(ElevatorSpec spec = {}, ContactParams contact = {});
+
+  std::string_view kind() const override { return "elevator"; }
+  Real signed_distance(const Vec3& p, Real t) const override { return p.y() - height(t); }
+  Vec3 normal(const Vec3& /*p*/, Real /*t*/) const override { return Vec3::UnitY(); }
+  Vec3 surface_velocity(const Vec3& /*p*/, Real t) const override {
+    return Vec3(0, spec_.motion.velocity(t), 0);
+  }
+  bool can_contact(const Vec3& p, Real t) const override;
+  Vec3 position(Real t) const override {
+    return Vec3(spec_.center.x(), height(t), spec_.center.z());
+  }
+  Real mass() const override { return spec_.mass; }
+
+  Real height(Real t) const { return spec_.center.y() + spec_.motion.offset(t); }
+  const ElevatorSpec& spec() const { return spec_; }
+
+ private:
+  ElevatorSpec spec_;
+};
+
+}  // namespace jelly

@@ -1,0 +1,43 @@
+#pragma once
+// The vertical motion of the elevator as a function of time: a cycle of constant-acceleration
+// phases, each optionally ending in a dead stop, repeated forever. The seed cycle is
+// +3 m/s^2 for 2 s, dead stop, -3 m/s^2 for 2 s, dead stop.
+#include <vector>
+
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+struct MotionPhase {
+  Real duration = 2;        // s, > 0
+  Real acceleration = 3;    // m/s^2 along +y
+  bool stop_at_end = true;  // velocity drops to 0 when the phase ends
+};
+
+class ElevatorMotion {
+ public:
+  // No phases: the platform stays still. Throws InputError for a phase of non-positive duration
+  // or a cycle that does not end at rest (it could not repeat).
+  explicit ElevatorMotion(std::vector<MotionPhase> phases = {});
+  static ElevatorMotion seed();
+
+  // Height offset from the start, velocity and acceleration along +y at time t >= 0.
+  Real offset(Real t) const;
+  Real velocity(Real t) const;
+  Real acceleration(Real t) const;
+
+  const std::vector<MotionPhase>& phases() const { return phases_; }
+  Real period() const { return period_; }
+
+ private:
+  struct Sample {
+    Real offset, velocity, acceleration;
+  };
+  Sample sample(Real t) const;
+
+  std::vector<MotionPhase> phases_;
+  Real period_ = 0;
+  Real cycle_offset_ = 0;  // displacement over one cycle
+};
+
+}  // namespace jelly

@@ -1,0 +1,82 @@
+#include <gtest/gtest.h>
+
+#include <jelly/core/cube.hpp>
+#include <jelly/core/errors.hpp>
+#include <jelly/solvers/registry.hpp>
+
+#include "support/systems.hpp"
+
+namespace jelly {
+namespace {
+
+TEST(Registry, SortedNamesAndUnknownName) {
+  const auto names = integrator_names();
+  EXPECT_TRUE(std::is_sorted(names.begin(), names.end()));
+  for (const char* expected : {"explicit_euler", "midpoint", "rk4", "symplectic_euler"}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+    EXPECT_EQ(make_integrator(expected)->name(), expected);
+  }
+  try {
+    make_integrator("rk5");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown integrator 'rk5'. Known: "), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Simulator, RejectsBadTimeStep) {
+  const Model m = build_cube(testing::small_cube(2));
+  SimulatorOptions o;
+  o.dt = 0;
+  try {
+    Simulator(m, rest_state(m), make_integrator("rk4"), o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "integrator.dt = 0 is invalid: a finite time step > 0 s");
+  }
+  o.dt = -1e-3;
+  EXPECT_THROW(Simulator(m, rest_state(m), make_integrator("rk4"), o), InputError);
+}
+
+TEST(Simulator, ObserversAtTheOutputInterval) {
+  const Model m = build_cube(testing::small_cube(2));
+  Simulator sim = testing::make_sim(m, rest_state(m), "rk4", 0.001, 0.1);
+  std::vector<Real> times;
+  testing::Probe probe([&](const Simulator& s) { times.push_back(s.state().t); });
+  sim.add_observer(probe);
+  const RunReport r = sim.run_until(1.0);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.steps, 1000);
+  EXPECT_EQ(r.force_evaluations, 4000);
+  ASSERT_EQ(times.size(), 11u);
+  for (std::size_t k = 0; k < times.size(); ++k) EXPECT_NEAR(times[k], 0.1 * k, 1e-9);
+  // A second call continues without repeating the frame at its start.
+  ASSERT_TRUE(sim.run_until(1.2).ok());
+  EXPECT_EQ(times.size(), 13u);
+}
+
+// Explicit Euler far past its stability limit: the guard stops the run and says why.
+TEST(Simulator, DivergenceGuardStopsExplicitEuler) {
+  const Model m = build_cube(testing::small_cube(4));
+  State s = rest_state(m);
+  s.v[1] = 1.0;  // a small kick
+  Simulator sim = testing::make_sim(m, s, "explicit_euler", 0.05);
+  const RunReport r = sim.run_until(10.0);
+  EXPECT_EQ(r.status, RunStatus::kDiverged);
+  EXPECT_LT(r.t, 10.0);
+  EXPECT_GT(r.steps, 0);
+  EXPECT_FALSE(r.reason.empty());
+  EXPECT_NE(r.brief().find("diverged"), std::string::npos);
+}
+
+TEST(Simulator, StableRunIsNotFlagged) {
+  const Model m = build_cube(testing::small_cube(4));
+  State s = rest_state(m);
+  s.v[1] = 1.0;
+  Simulator sim = testing::make_sim(m, s, "rk4", 0.001);
+  EXPECT_TRUE(sim.run_until(1.0).ok());
+}
+
+}  // namespace
+}  // namespace jelly

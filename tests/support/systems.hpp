@@ -1,0 +1,91 @@
+#pragma once
+// Small systems with analytic answers, shared by the tests.
+#include <cmath>
+#include <memory>
+
+#include <Eigen/Geometry>
+
+#include <jelly/core/cube.hpp>
+#include <jelly/core/model.hpp>
+#include <jelly/core/state.hpp>
+#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/simulator.hpp>
+
+namespace jelly::testing {
+
+// Two particles of mass m on the x axis joined by one spring (ks, kd, rest length l0), no
+// gravity; the spring starts stretched by `stretch`, at rest.
+struct TwoParticleSpring {
+  Real m = 1, ks = 100, kd = 0, l0 = 1, stretch = 0.1;
+
+  Model model() const {
+    Model model;
+    model.mass = VecX::Constant(2, m);
+    model.rest_position = VecX::Zero(6);
+    model.rest_position[3] = l0;
+    model.springs.add(0, 1, l0, {ks, kd}, SpringType::kStructural);
+    model.gravity.setZero();
+    return model;
+  }
+  State initial() const {
+    State s;
+    s.x = VecX::Zero(6);
+    s.x[0] = -stretch / 2;
+    s.x[3] = l0 + stretch / 2;
+    s.v = VecX::Zero(6);
+    return s;
+  }
+  // Relative coordinate r = x1 - x0 with reduced mass mu = m / 2:
+  // mu r'' = -ks (r - l0) - kd r', r(0) = l0 + stretch, r'(0) = 0.
+  Real gamma() const { return kd / m; }  // kd / (2 mu)
+  Real omega0() const { return std::sqrt(2 * ks / m); }
+  Real omega_d() const { return std::sqrt(omega0() * omega0() - gamma() * gamma()); }
+  Real length(Real t) const {
+    const Real g = gamma(), w = omega_d();
+    return l0 + stretch * std::exp(-g * t) * (std::cos(w * t) + g / w * std::sin(w * t));
+  }
+  Real length_rate(Real t) const {
+    const Real g = gamma(), w = omega_d();
+    return -stretch * std::exp(-g * t) * (g * g / w + w) * std::sin(w * t);
+  }
+};
+
+// A small jelly cube (n per edge) of the seed's material, corner at `origin`.
+inline CubeSpec small_cube(int n = 4, Real edge = 1, Vec3 origin = Vec3(0, 0.5, 0)) {
+  CubeSpec spec;
+  spec.n = n;
+  spec.edge_length = edge;
+  spec.origin = origin;
+  return spec;
+}
+
+// Rotates a state's positions about the z axis by `degrees` around `pivot`.
+inline void rotate_about_z(State& s, Real degrees, const Vec3& pivot) {
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(degrees * M_PI / 180.0, Vec3::UnitZ()).toRotationMatrix();
+  for (int i = 0; i < s.x.size() / 3; ++i)
+    particle(s.x, i) = pivot + r * (particle(s.x, i) - pivot);
+}
+
+inline Simulator make_sim(const Model& model, const State& state, const std::string& integrator,
+                          Real dt, Real output_interval = 0) {
+  SimulatorOptions options;
+  options.dt = dt;
+  options.output_interval = output_interval;
+  return Simulator(model, state, make_integrator(integrator), options);
+}
+
+// An observer that records a function of the simulator at every frame.
+template <typename F>
+class Probe final : public Observer {
+ public:
+  explicit Probe(F f) : f_(std::move(f)) {}
+  void on_frame(const Simulator& sim) override { f_(sim); }
+
+ private:
+  F f_;
+};
+template <typename F>
+Probe(F) -> Probe<F>;
+
+}  // namespace jelly::testing
