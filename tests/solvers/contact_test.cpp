@@ -19,7 +19,7 @@ using testing::make_sim;
 // every registered integrator must pass the scene-level contact tests.
 class ContactEveryIntegrator : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Registry, ContactEveryIntegrator, ::testing::ValuesIn(integrator_names()),
-                         [](const auto& info) { return info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 // The time step for the small cubes below. Explicit Euler updates positions with the velocity
 // from before the contact impulses, and at dt >= 5e-4 the bottom layer of these cubes settles

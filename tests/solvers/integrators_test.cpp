@@ -18,7 +18,7 @@ using testing::TwoParticleSpring;
 // Every registered integrator is tested the moment it is registered.
 class EveryIntegrator : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Registry, EveryIntegrator, ::testing::ValuesIn(integrator_names()),
-                         [](const auto& info) { return info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 // Free fall of the whole cube at rest: springs stay at rest length, so x(t) = x0 + v0 t + g t^2/2.
 // Methods of order >= 2 are exact; both first-order Euler variants are off by exactly g t h / 2.
