@@ -101,7 +101,9 @@ std::string JsonFields::string(std::string_view key) {
 }
 
 std::string JsonFields::string_or(std::string_view key, const std::string& fallback) {
-  return has(key) ? string(key) : (known_.emplace_back(key), fallback);
+  if (has(key)) return string(key);
+  known_.emplace_back(key);
+  return fallback;
 }
 
 Vec3 JsonFields::vec3_or(std::string_view key, const Vec3& fallback) {
