@@ -8,6 +8,9 @@ IntegratorOptions parse_integrator_options(const Json& options, const std::strin
   // ---- Integrator option fields are read here, one line each, with the struct's defaults:
   //        out.newton_iterations = fields.integer_or("newton_iterations", out.newton_iterations);
   //      (the implicit Euler and ARKODE options go here when IntegratorOptions gains them).
+  //      Unknown keys stay errors (reject_unknown below). For range errors to name the JSON path
+  //      ("integrator.options.newton_iterations"), give IntegratorOptions::validate a prefix
+  //      parameter like ContactParams::validate and pass path + "." here and in Scene::validate.
   // ----
   fields.reject_unknown();
   out.validate();

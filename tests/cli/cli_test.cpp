@@ -19,6 +19,7 @@ namespace jelly {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 struct Result {
@@ -184,6 +185,34 @@ TEST(Cli, CommandLineParseErrorsExitTwo) {
   r = jelly("run " + kSmallSlope + " --dt");
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, StartsWith("error: --dt: 1 required H missing"));
+}
+
+// Runs `jelly ARGS` on a pseudo-terminal (util-linux `script`), stdout and stderr together.
+Result jelly_on_a_terminal(const std::string& args) {
+  const std::string out = temp_path(".tty");
+  const std::string command = "script -qec \"'" + std::string(JELLY_CLI) + "' " + args +
+                              "\" /dev/null >'" + out + "' 2>&1 </dev/null";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_file(out);
+  std::remove(out.c_str());
+  return r;
+}
+
+TEST(Cli, ProgressBarOnATerminalOnlyAndNotWithQuiet) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no `script`";
+  Result r = jelly_on_a_terminal("run " + kSmallSlope + " --duration 0.2");
+  ASSERT_EQ(r.code, 0) << r.out;
+  // The final redraw of the bar, then the summary.
+  EXPECT_THAT(r.out, HasSubstr("\r[########################] 100%  t = 0.200 / 0.200 s  "));
+  EXPECT_THAT(r.out, HasSubstr(" steps/s  ETA 0:00"));
+  EXPECT_THAT(r.out, HasSubstr("jelly run: completed at t = 0.2 s after 200 steps"));
+
+  r = jelly_on_a_terminal("run " + kSmallSlope + " --duration 0.2 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_THAT(r.out, Not(HasSubstr("steps/s  ETA")));
+  EXPECT_THAT(r.out, HasSubstr("jelly run: completed at t = 0.2 s after 200 steps"));
 }
 
 TEST(Cli, HelpExitsZero) {
