@@ -2,6 +2,7 @@
 BUILD ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
+JELLY = $(BUILD)/cli/jelly
 
 .PHONY: all deps configure build test demo bench format clean
 
@@ -18,6 +19,16 @@ build: configure
 
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+
+# 3 s of the seed slope with RK4 (a few seconds of wall time), then the plots when
+# scripts/plot.py is there.
+demo: build
+	@mkdir -p out
+	$(JELLY) run scenes/seed_slope.json --duration 3 -o out/demo.h5
+	@if [ -f scripts/plot.py ]; then /usr/bin/python3 scripts/plot.py out/demo.h5 -o out/demo.png; \
+	else echo "demo: scripts/plot.py is not in this tree: no plots"; fi
+	@echo "demo: written:"; for f in out/demo.h5 out/demo.xdmf out/demo.png; do \
+	  if [ -e $$f ]; then echo "  $(CURDIR)/$$f"; fi; done
 
 format:
 	clang-format -i $$(git ls-files '*.hpp' '*.cpp')

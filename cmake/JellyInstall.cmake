@@ -1,9 +1,13 @@
-# Installs the library, its headers under include/jelly/<module>/, and the CMake package files.
+# Installs the library, its headers under include/jelly/<module>/ (not the internal detail/
+# folders), the jelly program (cli/CMakeLists.txt), the scenes under share/jelly/scenes, and the
+# CMake package files.
 include(CMakePackageConfigHelpers)
 foreach(module IN LISTS JELLY_MODULES)
   install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${module}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly/${module}
-          FILES_MATCHING PATTERN "*.hpp")
+          FILES_MATCHING PATTERN "*.hpp" PATTERN "detail" EXCLUDE)
 endforeach()
+install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/scenes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/jelly/scenes
+        FILES_MATCHING PATTERN "*.json")
 install(FILES ${JELLY_BUILD_INCLUDE_DIR}/jelly/version.hpp ${JELLY_BUILD_INCLUDE_DIR}/jelly/jelly.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly)
 install(TARGETS jelly EXPORT jellyTargets

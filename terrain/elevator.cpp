@@ -6,13 +6,13 @@
 
 namespace jelly {
 
-void ElevatorSpec::validate() const {
-  require(center.allFinite(), "elevator.center", center.transpose(), "finite coordinates");
-  require(std::isfinite(size_x) && size_x > 0, "elevator.size_x", size_x, "a finite size > 0");
-  require(std::isfinite(size_z) && size_z > 0, "elevator.size_z", size_z, "a finite size > 0");
-  require(std::isfinite(thickness) && thickness > 0, "elevator.thickness", thickness,
+void ElevatorSpec::validate(const std::string& prefix) const {
+  require(center.allFinite(), prefix + "center", center.transpose(), "finite coordinates");
+  require(std::isfinite(size_x) && size_x > 0, prefix + "size_x", size_x, "a finite size > 0");
+  require(std::isfinite(size_z) && size_z > 0, prefix + "size_z", size_z, "a finite size > 0");
+  require(std::isfinite(thickness) && thickness > 0, prefix + "thickness", thickness,
           "a finite thickness > 0");
-  require(mass > 0, "elevator.mass", mass, "a mass > 0 (inf for an immovable platform)");
+  require(mass > 0, prefix + "mass", mass, "a mass > 0 (inf for an immovable platform)");
 }
 
 Elevator::Elevator(ElevatorSpec spec, ContactParams contact)

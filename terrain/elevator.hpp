@@ -2,6 +2,8 @@
 // The seed elevator: a horizontal rectangular platform (normal +y) moving vertically by an
 // ElevatorMotion. A particle outside its footprint, or deeper below it than its thickness,
 // does not touch it and falls past.
+#include <string>
+
 #include <jelly/terrain/elevator_motion.hpp>
 #include <jelly/terrain/terrain.hpp>
 
@@ -14,7 +16,8 @@ struct ElevatorSpec {
   Real thickness = 1;    // how deep below the surface a particle still counts as touching (m)
   Real mass = 1;         // kg, the platform mass of the seed collision formula
   ElevatorMotion motion = ElevatorMotion::seed();
-  void validate() const;
+  // Throws InputError naming `prefix`field (a scene passes its JSON path, "terrains[0].").
+  void validate(const std::string& prefix = "elevator.") const;
 };
 
 class Elevator final : public Terrain {

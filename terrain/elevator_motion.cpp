@@ -7,11 +7,12 @@
 
 namespace jelly {
 
-ElevatorMotion::ElevatorMotion(std::vector<MotionPhase> phases) : phases_(std::move(phases)) {
+ElevatorMotion::ElevatorMotion(std::vector<MotionPhase> phases, std::string_view field)
+    : phases_(std::move(phases)) {
   Real v = 0;
   for (std::size_t i = 0; i < phases_.size(); ++i) {
     const MotionPhase& p = phases_[i];
-    const std::string at = "motion[" + std::to_string(i) + "]";
+    const std::string at = std::string(field) + "[" + std::to_string(i) + "]";
     require(std::isfinite(p.duration) && p.duration > 0, at + ".duration", p.duration,
             "a finite duration > 0 s");
     require(std::isfinite(p.acceleration), at + ".acceleration", p.acceleration,
@@ -20,7 +21,7 @@ ElevatorMotion::ElevatorMotion(std::vector<MotionPhase> phases) : phases_(std::m
     v = p.stop_at_end ? 0 : v + p.acceleration * p.duration;
     period_ += p.duration;
   }
-  require(std::abs(v) < 1e-12, "motion", "a cycle ending at " + to_text(v) + " m/s",
+  require(std::abs(v) < 1e-12, field, "a cycle ending at " + to_text(v) + " m/s",
           "a cycle that ends at rest (end it with a dead stop or zero net acceleration)");
 }
 

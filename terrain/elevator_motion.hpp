@@ -2,6 +2,7 @@
 // The vertical motion of the elevator as a function of time: a cycle of constant-acceleration
 // phases, each optionally ending in a dead stop, repeated forever. The seed cycle is
 // +3 m/s^2 for 2 s, dead stop, -3 m/s^2 for 2 s, dead stop.
+#include <string_view>
 #include <vector>
 
 #include <jelly/core/types.hpp>
@@ -17,8 +18,9 @@ struct MotionPhase {
 class ElevatorMotion {
  public:
   // No phases: the platform stays still. Throws InputError for a phase of non-positive duration
-  // or a cycle that does not end at rest (it could not repeat).
-  explicit ElevatorMotion(std::vector<MotionPhase> phases = {});
+  // or a cycle that does not end at rest (it could not repeat); the message names `field`
+  // (a scene passes its JSON path, "terrains[0].motion").
+  explicit ElevatorMotion(std::vector<MotionPhase> phases = {}, std::string_view field = "motion");
   static ElevatorMotion seed();
 
   // Height offset from the start, velocity and acceleration along +y at time t >= 0.

@@ -1,0 +1,78 @@
+// jelly: simulate scenes (run), describe recordings (info), list what a scene can name (list).
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/version.hpp>
+
+#include "commands.hpp"
+#include "exit_codes.hpp"
+
+namespace {
+
+constexpr const char* kFooter =
+    "Exit codes: 0 ok, 2 bad input (scene, option or argument), 3 the run diverged or the solver "
+    "failed (the output file keeps what was written), 1 any other failure.";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace jelly::cli;
+  CLI::App app{"jelly " JELLY_VERSION_STRING ": mass-spring soft-body simulation", "jelly"};
+  app.footer(kFooter);
+  app.require_subcommand(1);
+  app.set_version_flag("--version", JELLY_VERSION_STRING);
+
+  RunArgs run_args;
+  CLI::App* run = app.add_subcommand("run", "Simulate a scene (JSON) and print a summary");
+  run->add_option("scene", run_args.scene, "Scene file (JSON), e.g. scenes/seed_slope.json")
+      ->required();
+  run->add_option("-o,--output", run_args.output,
+                  "Write the run to this HDF5 file (and an .xdmf beside it)");
+  run->add_option("--integrator", run_args.integrator,
+                  "Integrator name (see `jelly list`); overrides integrator.name");
+  run->add_option("--dt", run_args.dt, "Time step in s; overrides integrator.dt")->type_name("H");
+  run->add_option("--duration", run_args.duration, "Simulated time in s; overrides duration")
+      ->type_name("T");
+  run->add_option("--set", run_args.sets,
+                  "Override a scene field, e.g. --set springs.structural.ks=2400 or "
+                  "--set terrains[0].contact.restitution=0.5 (repeatable; the value is JSON, or "
+                  "else a string)")
+      ->type_name("PATH=VALUE")
+      ->allow_extra_args(false);  // one PATH=VALUE per --set; a scene after it stays positional
+  run->add_option("--restart", run_args.restart,
+                  "Start from the last checkpoint of this HDF5 file (same scene)");
+  run->add_flag("-q,--quiet", run_args.quiet, "No progress bar");
+
+  std::string info_path;
+  CLI::App* info = app.add_subcommand("info", "Describe an HDF5 file written by `jelly run -o`");
+  info->add_option("file", info_path, "HDF5 file")->required();
+
+  CLI::App* list = app.add_subcommand(
+      "list", "List the integrators, terrain kinds and contact models, one per line");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "error: %s\nRun 'jelly --help' or 'jelly run --help' for usage.\n",
+                 e.what());
+    return kExitBadInput;
+  }
+
+  try {
+    if (run->parsed()) return run_command(run_args);
+    if (info->parsed()) return info_command(info_path);
+    if (list->parsed()) return list_command();
+  } catch (const jelly::InputError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitInternalError;
+  }
+  return kExitBadInput;  // unreachable: require_subcommand(1)
+}

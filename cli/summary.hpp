@@ -1,0 +1,16 @@
+#pragma once
+// The summary `jelly run` prints at the end: status, steps, wall time, final centre of mass,
+// energies and the integrator's statistics.
+#include <cstdio>
+#include <string>
+
+#include <jelly/io/scene.hpp>
+#include <jelly/solvers/run_report.hpp>
+#include <jelly/solvers/simulator.hpp>
+
+namespace jelly::cli {
+
+void print_summary(std::FILE* out, const Scene& scene, const Simulator& sim,
+                   const RunReport& report, const std::string& output_path);
+
+}  // namespace jelly::cli

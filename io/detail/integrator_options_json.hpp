@@ -1,0 +1,16 @@
+#pragma once
+// The "integrator.options" object of a scene <-> IntegratorOptions. Internal to io/.
+#include <string>
+
+#include <jelly/io/detail/json_fields.hpp>
+#include <jelly/solvers/integrator_options.hpp>
+
+namespace jelly::detail {
+
+// Fills IntegratorOptions from the JSON object at `path` ("integrator.options"); an unknown key,
+// a wrong type or an invalid value is an InputError naming its path.
+IntegratorOptions parse_integrator_options(const Json& options, const std::string& path);
+// Every option written out, so that parse_integrator_options reads back equal options.
+Json integrator_options_to_json(const IntegratorOptions& options);
+
+}  // namespace jelly::detail

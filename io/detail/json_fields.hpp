@@ -1,0 +1,64 @@
+#pragma once
+// Strict reading of one JSON object: typed fields with defaults or required, every key the
+// caller reads is known, any other key is an InputError naming its JSON path. Internal to io/
+// (not installed): the public API passes JSON as text.
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <jelly/core/types.hpp>
+
+namespace jelly::detail {
+
+// Ordered, so that written scenes keep the order of the format (cube, springs, ...).
+using Json = nlohmann::ordered_json;
+
+// "a.b" + "c" -> "a.b.c"; "" + "c" -> "c".
+std::string json_child(const std::string& path, std::string_view key);
+// "terrains" + 0 -> "terrains[0]".
+std::string json_element(const std::string& path, std::size_t index);
+// A JSON value as it appears in messages: compact, long values cut short.
+std::string json_text(const Json& value);
+
+class JsonFields {
+ public:
+  // Throws InputError unless `object` is a JSON object; `path` is its JSON path ("" = root).
+  JsonFields(const Json& object, std::string path);
+
+  bool has(std::string_view key) const;
+  // The JSON path of a key of this object.
+  std::string path(std::string_view key) const;
+  const std::string& path() const { return path_; }
+
+  // Each getter marks `key` as known. The `_or` variants return `fallback` for a missing key;
+  // the others throw InputError "<path> is required".
+  Real number(std::string_view key);
+  Real number_or(std::string_view key, Real fallback);
+  int integer_or(std::string_view key, int fallback);
+  bool boolean_or(std::string_view key, bool fallback);
+  std::string string(std::string_view key);
+  std::string string_or(std::string_view key, const std::string& fallback);
+  Vec3 vec3_or(std::string_view key, const Vec3& fallback);
+  // A sub-object or array, or nullptr when the key is missing.
+  const Json* value(std::string_view key);
+
+  // Throws InputError for the first key no getter asked for, listing the allowed keys.
+  void reject_unknown() const;
+
+ private:
+  const Json* find(std::string_view key);
+  [[noreturn]] void missing(std::string_view key) const;
+
+  const Json& object_;
+  std::string path_;
+  std::vector<std::string> known_;
+};
+
+// Typed conversions of a single value at `path`; throw InputError naming path, value and type.
+Real json_number(const Json& value, const std::string& path);
+int json_integer(const Json& value, const std::string& path);
+Vec3 json_vec3(const Json& value, const std::string& path);
+
+}  // namespace jelly::detail

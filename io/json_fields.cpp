@@ -1,0 +1,129 @@
+#include <jelly/io/detail/json_fields.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly::detail {
+
+std::string json_child(const std::string& path, std::string_view key) {
+  return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+
+std::string json_element(const std::string& path, std::size_t index) {
+  return path + "[" + std::to_string(index) + "]";
+}
+
+std::string json_text(const Json& value) {
+  constexpr std::size_t kMaxLength = 80;
+  std::string text = value.dump();
+  if (text.size() > kMaxLength) text = text.substr(0, kMaxLength - 3) + "...";
+  return text;
+}
+
+Real json_number(const Json& value, const std::string& path) {
+  if (!value.is_number()) throw InputError(path, json_text(value), "a number");
+  return value.get<Real>();
+}
+
+int json_integer(const Json& value, const std::string& path) {
+  if (value.is_number_integer()) {
+    const auto i = value.get<long long>();
+    if (i >= std::numeric_limits<int>::min() && i <= std::numeric_limits<int>::max()) {
+      return static_cast<int>(i);
+    }
+  } else if (value.is_number_float()) {
+    const double d = value.get<double>();
+    if (std::floor(d) == d && std::abs(d) < 2e9) return static_cast<int>(d);
+  }
+  throw InputError(path, json_text(value), "an integer");
+}
+
+Vec3 json_vec3(const Json& value, const std::string& path) {
+  if (!value.is_array() || value.size() != 3 ||
+      !std::all_of(value.begin(), value.end(), [](const Json& c) { return c.is_number(); })) {
+    throw InputError(path, json_text(value), "an array of 3 numbers [x, y, z]");
+  }
+  return Vec3(value[0].get<Real>(), value[1].get<Real>(), value[2].get<Real>());
+}
+
+JsonFields::JsonFields(const Json& object, std::string path)
+    : object_(object), path_(std::move(path)) {
+  if (!object_.is_object()) {
+    throw InputError(path_.empty() ? "scene" : path_, json_text(object_), "a JSON object {...}");
+  }
+}
+
+bool JsonFields::has(std::string_view key) const { return object_.contains(std::string(key)); }
+
+std::string JsonFields::path(std::string_view key) const { return json_child(path_, key); }
+
+const Json* JsonFields::find(std::string_view key) {
+  known_.emplace_back(key);
+  const auto it = object_.find(std::string(key));
+  return it == object_.end() ? nullptr : &*it;
+}
+
+void JsonFields::missing(std::string_view key) const {
+  throw InputError(path(key) + " is missing: it is required");
+}
+
+Real JsonFields::number(std::string_view key) {
+  const Json* v = find(key);
+  if (v == nullptr) missing(key);
+  return json_number(*v, path(key));
+}
+
+Real JsonFields::number_or(std::string_view key, Real fallback) {
+  const Json* v = find(key);
+  return v == nullptr ? fallback : json_number(*v, path(key));
+}
+
+int JsonFields::integer_or(std::string_view key, int fallback) {
+  const Json* v = find(key);
+  return v == nullptr ? fallback : json_integer(*v, path(key));
+}
+
+bool JsonFields::boolean_or(std::string_view key, bool fallback) {
+  const Json* v = find(key);
+  if (v == nullptr) return fallback;
+  if (!v->is_boolean()) throw InputError(path(key), json_text(*v), "true or false");
+  return v->get<bool>();
+}
+
+std::string JsonFields::string(std::string_view key) {
+  const Json* v = find(key);
+  if (v == nullptr) missing(key);
+  if (!v->is_string()) throw InputError(path(key), json_text(*v), "a string");
+  return v->get<std::string>();
+}
+
+std::string JsonFields::string_or(std::string_view key, const std::string& fallback) {
+  if (has(key)) return string(key);
+  known_.emplace_back(key);
+  return fallback;
+}
+
+Vec3 JsonFields::vec3_or(std::string_view key, const Vec3& fallback) {
+  const Json* v = find(key);
+  return v == nullptr ? fallback : json_vec3(*v, path(key));
+}
+
+const Json* JsonFields::value(std::string_view key) { return find(key); }
+
+void JsonFields::reject_unknown() const {
+  for (auto it = object_.begin(); it != object_.end(); ++it) {
+    if (std::find(known_.begin(), known_.end(), it.key()) != known_.end()) continue;
+    std::string allowed;
+    for (const std::string& k : known_) {
+      if (allowed.find("\"" + k + "\"") != std::string::npos) continue;
+      allowed += (allowed.empty() ? "" : ", ") + ("\"" + k + "\"");
+    }
+    throw InputError(path(it.key()), json_text(it.value()),
+                     "unknown key; allowed here: " + (allowed.empty() ? "none" : allowed));
+  }
+}
+
+}  // namespace jelly::detail

@@ -1,0 +1,264 @@
+// The jelly program as users run it: exit codes 0, 2 and 3, "error: ..." messages naming the
+// JSON path, `jelly list`, and the HDF5 options of this build.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <jelly/io/scene.hpp>
+#include <jelly/solvers/registry.hpp>
+
+namespace jelly {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::StartsWith;
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A fresh path in the test's temporary directory.
+std::string temp_path(const std::string& suffix) {
+  std::string pattern = ::testing::TempDir() + "jelly_cli_XXXXXX";
+  const int fd = mkstemp(pattern.data());
+  if (fd >= 0) close(fd);
+  std::remove(pattern.c_str());
+  return pattern + suffix;
+}
+
+// Runs `jelly ARGS` with stdout and stderr captured (neither is a terminal).
+Result jelly(const std::string& args) {
+  const std::string out = temp_path(".out");
+  const std::string err = temp_path(".err");
+  const std::string command =
+      std::string("'") + JELLY_CLI + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_file(out);
+  r.err = read_file(err);
+  std::remove(out.c_str());
+  std::remove(err.c_str());
+  return r;
+}
+
+std::string scene(const std::string& name) { return std::string(JELLY_SCENES_DIR) + "/" + name; }
+
+// The seed slope on a 3x3x3 cube: fast.
+const std::string kSmallSlope = "'" + scene("seed_slope.json") + "' --set cube.n=3";
+
+std::string write_scene(const std::string& text) {
+  const std::string path = temp_path(".json");
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(Cli, ListNamesEveryIntegratorTerrainKindAndContactModel) {
+  const Result r = jelly("list");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  for (const std::string& name : integrator_names()) {
+    EXPECT_THAT(r.out, HasSubstr("integrator " + name + " ")) << name;
+  }
+  for (TerrainKind kind : terrain_kinds()) {
+    EXPECT_THAT(r.out, HasSubstr("\nterrain    " + std::string(terrain_kind_name(kind)) + " "));
+  }
+  EXPECT_THAT(r.out, HasSubstr("\ncontact    coulomb "));
+  EXPECT_THAT(r.out, HasSubstr("\ncontact    seed "));
+}
+
+TEST(Cli, AShortGoodRunExitsZeroWithASummary) {
+  const Result r = jelly("run " + kSmallSlope + " --duration 0.05 --integrator midpoint");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");  // stderr is not a terminal: no progress bar
+  EXPECT_THAT(r.out, StartsWith("jelly run: completed at t = 0.05 s after 50 steps"));
+  EXPECT_THAT(r.out, HasSubstr("integrator      midpoint, dt = 0.001 s"));
+  EXPECT_THAT(r.out, HasSubstr("centre of mass  ("));
+  EXPECT_THAT(r.out, HasSubstr("energy          kinetic "));
+  EXPECT_THAT(r.out, HasSubstr("statistics      steps = 50"));
+}
+
+TEST(Cli, ADivergentRunExitsThree) {
+  const Result r = jelly("run " + kSmallSlope + " --integrator explicit_euler --dt 0.05 --quiet");
+  EXPECT_EQ(r.code, 3) << r.out << r.err;
+  EXPECT_THAT(r.out, StartsWith("jelly run: diverged at t = "));
+  EXPECT_THAT(r.err, StartsWith("error: the run stopped early: diverged at t = "));
+}
+
+TEST(Cli, BadScenesExitTwoNamingTheJsonPath) {
+  const std::string bad_range = write_scene(R"({
+    "terrains": [{"kind": "plane", "contact": {"restitution": 1.5}}],
+    "integrator": {"name": "rk4"}, "duration": 1})");
+  Result r = jelly("run '" + bad_range + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: terrains[0].contact.restitution = 1.5 is invalid: a number in [0, 1]\n");
+  EXPECT_EQ(r.out, "");
+
+  const std::string unknown_key = write_scene(R"({
+    "springs": {"shear": {"ks": 10, "kb": 1}}, "integrator": {"name": "rk4"}, "duration": 1})");
+  r = jelly("run '" + unknown_key + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "error: springs.shear.kb = 1 is invalid: unknown key; allowed here: \"ks\", \"kd\"\n");
+
+  const std::string missing = write_scene(R"({"integrator": {"name": "rk4"}})");
+  r = jelly("run '" + missing + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: duration is missing: it is required\n");
+
+  const std::string not_json = write_scene("{\"duration\": ");
+  r = jelly("run '" + not_json + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: " + not_json + " is not valid JSON: parse error"));
+
+  r = jelly("run '" + scene("no_such_scene.json") + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: cannot read the scene file '"));
+}
+
+TEST(Cli, BadOptionsExitTwoNamingTheJsonPath) {
+  Result r = jelly("run " + kSmallSlope + " --dt abc");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: integrator.dt = \"abc\" is invalid: a number\n");
+
+  r = jelly("run " + kSmallSlope + " --dt -1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: integrator.dt = -1 is invalid: a finite time step > 0 s\n");
+
+  r = jelly("run " + kSmallSlope + " --duration 0");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: duration = 0 is invalid: a finite duration > 0 s\n");
+
+  r = jelly("run " + kSmallSlope + " --integrator rk5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: integrator.name = \"rk5\" is invalid: one of "));
+
+  r = jelly("run " + kSmallSlope + " --set terrains[0].contact.friction=-2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: terrains[0].contact.friction = -2 is invalid: a finite number >= 0\n");
+
+  r = jelly("run " + kSmallSlope + " --set terrains.1.kind=plane");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "error: --set 'terrains.1.kind=plane': terrains[1] does not exist (terrains has 1 "
+            "element)\n");
+
+  r = jelly("run " + kSmallSlope + " --set cube.n");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: --set 'cube.n': expected path=value"));
+}
+
+TEST(Cli, CommandLineParseErrorsExitTwo) {
+  Result r = jelly("run " + kSmallSlope + " --bogus");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: The following argument was not expected: --bogus\n"));
+
+  r = jelly("run");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: scene is required\n"));
+
+  r = jelly("");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: A subcommand is required\n"));
+
+  r = jelly("fly");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: "));
+
+  r = jelly("run " + kSmallSlope + " --dt");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: --dt: 1 required H missing"));
+}
+
+// Runs `jelly ARGS` on a pseudo-terminal (util-linux `script`), stdout and stderr together.
+Result jelly_on_a_terminal(const std::string& args) {
+  const std::string out = temp_path(".tty");
+  const std::string command = "script -qec \"'" + std::string(JELLY_CLI) + "' " + args +
+                              "\" /dev/null >'" + out + "' 2>&1 </dev/null";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_file(out);
+  std::remove(out.c_str());
+  return r;
+}
+
+TEST(Cli, ProgressBarOnATerminalOnlyAndNotWithQuiet) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no `script`";
+  Result r = jelly_on_a_terminal("run " + kSmallSlope + " --duration 0.2");
+  ASSERT_EQ(r.code, 0) << r.out;
+  // The final redraw of the bar, then the summary.
+  EXPECT_THAT(r.out, HasSubstr("\r[########################] 100%  t = 0.200 / 0.200 s  "));
+  EXPECT_THAT(r.out, HasSubstr(" steps/s  ETA 0:00"));
+  EXPECT_THAT(r.out, HasSubstr("jelly run: completed at t = 0.2 s after 200 steps"));
+
+  r = jelly_on_a_terminal("run " + kSmallSlope + " --duration 0.2 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_THAT(r.out, Not(HasSubstr("steps/s  ETA")));
+  EXPECT_THAT(r.out, HasSubstr("jelly run: completed at t = 0.2 s after 200 steps"));
+}
+
+TEST(Cli, HelpExitsZero) {
+  const Result r = jelly("run --help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_THAT(r.out, HasSubstr("--set PATH=VALUE"));
+  EXPECT_THAT(r.out, HasSubstr("Exit codes: 0 ok, 2 bad input"));
+}
+
+#if __has_include(<jelly/io/h5_recorder.hpp>) && __has_include(<jelly/io/checkpoint.hpp>) && \
+    __has_include(<jelly/io/recording.hpp>)
+
+TEST(Cli, RunWritesAFileThatInfoDescribes) {
+  const std::string file = temp_path(".h5");
+  Result r = jelly("run " + kSmallSlope + " --duration 0.1 -o '" + file + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = jelly("info '" + file + "'");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out, "");
+}
+
+TEST(Cli, ADivergentRunKeepsItsFile) {
+  const std::string file = temp_path(".h5");
+  Result r =
+      jelly("run " + kSmallSlope + " --integrator explicit_euler --dt 0.05 -q -o '" + file + "'");
+  EXPECT_EQ(r.code, 3) << r.err;
+  r = jelly("info '" + file + "'");
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
+#else
+
+TEST(Cli, HdfOptionsSayTheyAreNotAvailableInThisBuild) {
+  Result r = jelly("run " + kSmallSlope + " --duration 0.01 -o out.h5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: -o out.h5: HDF5 output is not available in this build"));
+  r = jelly("run " + kSmallSlope + " --restart run.h5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err,
+              StartsWith("error: --restart run.h5: reading checkpoints is not available in this"));
+  r = jelly("info run.h5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: info run.h5: reading HDF5 files is not available in this"));
+}
+
+#endif
+
+}  // namespace
+}  // namespace jelly

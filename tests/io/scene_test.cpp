@@ -1,0 +1,381 @@
+// Scene files: the seed scenes load to the seed facts, scenes round-trip through JSON, and every
+// kind of bad scene or --set override is an InputError with a precise message.
+#include <jelly/io/scene.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
+#include <jelly/solvers/registry.hpp>
+#include <jelly/terrain/plane.hpp>
+
+namespace jelly {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+std::string scene_path(const std::string& name) {
+  return std::string(JELLY_SCENES_DIR) + "/" + name;
+}
+
+// The InputError message of parsing `text` with `overrides`, or "" when it parses.
+std::string error_of(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  try {
+    parse_scene(text, overrides);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A valid scene with one terrain of each kind, to be broken by overrides in the tests.
+const char* const kGood = R"({
+  "terrains": [
+    {"kind": "slope", "contact": {"model": "seed"}},
+    {"kind": "elevator", "motion": [{"duration": 1, "acceleration": 2},
+                                    {"duration": 1, "acceleration": -2}]},
+    {"kind": "plane", "normal": [0, 1, 0]}
+  ],
+  "integrator": {"name": "rk4"},
+  "duration": 1
+})";
+
+void expect_same_scene(const Scene& a, const Scene& b) {
+  EXPECT_EQ(a.description, b.description);
+  EXPECT_EQ(a.cube.n, b.cube.n);
+  EXPECT_EQ(a.cube.edge_length, b.cube.edge_length);
+  EXPECT_EQ(a.cube.origin, b.cube.origin);
+  EXPECT_EQ(a.cube.particle_mass, b.cube.particle_mass);
+  for (int t = 0; t < kSpringTypeCount; ++t) {
+    EXPECT_EQ(a.cube.springs[t].ks, b.cube.springs[t].ks);
+    EXPECT_EQ(a.cube.springs[t].kd, b.cube.springs[t].kd);
+  }
+  EXPECT_EQ(a.cube.gravity, b.cube.gravity);
+  ASSERT_EQ(a.terrains.size(), b.terrains.size());
+  for (std::size_t i = 0; i < a.terrains.size(); ++i) {
+    const TerrainSpec& s = a.terrains[i];
+    const TerrainSpec& t = b.terrains[i];
+    EXPECT_EQ(s.kind, t.kind);
+    EXPECT_EQ(s.plane.point, t.plane.point);
+    EXPECT_EQ(s.plane.normal, t.plane.normal);
+    EXPECT_EQ(s.slope.angle_degrees, t.slope.angle_degrees);
+    EXPECT_EQ(s.slope.point, t.slope.point);
+    EXPECT_EQ(s.elevator.center, t.elevator.center);
+    EXPECT_EQ(s.elevator.size_x, t.elevator.size_x);
+    EXPECT_EQ(s.elevator.size_z, t.elevator.size_z);
+    EXPECT_EQ(s.elevator.thickness, t.elevator.thickness);
+    EXPECT_EQ(s.elevator.mass, t.elevator.mass);
+    ASSERT_EQ(s.elevator.motion.phases().size(), t.elevator.motion.phases().size());
+    for (std::size_t p = 0; p < s.elevator.motion.phases().size(); ++p) {
+      EXPECT_EQ(s.elevator.motion.phases()[p].duration, t.elevator.motion.phases()[p].duration);
+      EXPECT_EQ(s.elevator.motion.phases()[p].acceleration,
+                t.elevator.motion.phases()[p].acceleration);
+      EXPECT_EQ(s.elevator.motion.phases()[p].stop_at_end,
+                t.elevator.motion.phases()[p].stop_at_end);
+    }
+    EXPECT_EQ(s.contact.model, t.contact.model);
+    EXPECT_EQ(s.contact.restitution, t.contact.restitution);
+    EXPECT_EQ(s.contact.friction, t.contact.friction);
+    EXPECT_EQ(s.contact.static_friction, t.contact.static_friction);
+    EXPECT_EQ(s.contact.epsilon, t.contact.epsilon);
+    EXPECT_EQ(s.contact.resting_speed, t.contact.resting_speed);
+  }
+  EXPECT_EQ(a.integrator.name, b.integrator.name);
+  EXPECT_EQ(a.integrator.dt, b.integrator.dt);
+  EXPECT_EQ(a.duration, b.duration);
+  EXPECT_EQ(a.output_interval, b.output_interval);
+  EXPECT_EQ(a.divergence.max_speed, b.divergence.max_speed);
+  EXPECT_EQ(a.divergence.max_distance, b.divergence.max_distance);
+}
+
+TEST(SeedScenes, SlopeIsTheSeedSlope) {
+  const Scene scene = load_scene(scene_path("seed_slope.json"));
+  const CubeSpec seed;  // the seed cube is CubeSpec's default
+  EXPECT_EQ(scene.cube.n, 10);
+  EXPECT_EQ(scene.cube.edge_length, 4);
+  EXPECT_EQ(scene.cube.origin, Vec3(-20.0 / 9, 61.0 / 9, -20.0 / 9));
+  EXPECT_EQ(scene.cube.particle_mass, 1);
+  for (int t = 0; t < kSpringTypeCount; ++t) {
+    EXPECT_EQ(scene.cube.springs[t].ks, 1400);
+    EXPECT_EQ(scene.cube.springs[t].kd, 50);
+  }
+  EXPECT_EQ(scene.cube.gravity, Vec3(0, -9.8, 0));
+  EXPECT_EQ(scene.integrator.name, "rk4");
+  EXPECT_EQ(scene.integrator.dt, 0.001);
+  EXPECT_EQ(scene.output_interval, 1.0 / 60);
+
+  const Model model = build_cube(scene.cube);
+  EXPECT_EQ(model.springs.size(), 12876);
+  const Vec3 com = center_of_mass(model, model.rest_position);
+  EXPECT_NEAR(com.x(), -0.2222, 1e-4);
+  EXPECT_NEAR(com.y(), 8.7778, 1e-4);
+  EXPECT_NEAR(com.z(), -0.2222, 1e-4);
+
+  ASSERT_EQ(scene.terrains.size(), 1u);
+  const TerrainSpec& slope = scene.terrains[0];
+  EXPECT_EQ(slope.kind, TerrainKind::kSlope);
+  EXPECT_EQ(slope.contact.model, ContactModel::kSeed);
+  EXPECT_EQ(slope.contact.restitution, 0.8);
+  EXPECT_EQ(slope.contact.friction, 0.5);
+  EXPECT_EQ(slope.contact.epsilon, 0.01);
+  const auto terrain = make_terrain(slope);
+  const auto* plane = dynamic_cast<const Plane*>(terrain.get());
+  ASSERT_NE(plane, nullptr);
+  const Real a = 20 * M_PI / 180;
+  EXPECT_NEAR((plane->unit_normal() - Vec3(std::sin(a), std::cos(a), 0)).norm(), 0, 1e-15);
+  EXPECT_EQ(plane->point(), Vec3::Zero());
+}
+
+TEST(SeedScenes, ElevatorIsTheSeedElevator) {
+  const Scene scene = load_scene(scene_path("seed_elevator.json"));
+  EXPECT_EQ(build_cube(scene.cube).springs.size(), 12876);
+  ASSERT_EQ(scene.terrains.size(), 1u);
+  const TerrainSpec& t = scene.terrains[0];
+  EXPECT_EQ(t.kind, TerrainKind::kElevator);
+  EXPECT_EQ(t.elevator.center, Vec3(0, 1, 0));
+  EXPECT_EQ(t.elevator.size_x, 5);
+  EXPECT_EQ(t.elevator.size_z, 5);
+  EXPECT_EQ(t.elevator.mass, 1);
+  EXPECT_EQ(t.contact.model, ContactModel::kSeed);
+  EXPECT_EQ(t.contact.restitution, 0.8);
+  const ElevatorMotion seed = ElevatorMotion::seed();
+  ASSERT_EQ(t.elevator.motion.phases().size(), seed.phases().size());
+  for (Real time : {0.5, 1.9, 2.5, 3.7, 4.2, 9.9}) {
+    EXPECT_EQ(t.elevator.motion.offset(time), seed.offset(time)) << time;
+  }
+  const Simulator sim = make_simulator(scene);
+  ASSERT_EQ(sim.terrains().size(), 1u);
+  EXPECT_EQ(sim.terrains()[0]->kind(), "elevator");
+  EXPECT_EQ(sim.terrains()[0]->mass(), 1);
+}
+
+TEST(Scenes, EveryShippedSceneRoundTrips) {
+  for (const char* name : {"seed_slope.json", "seed_elevator.json", "drop_coulomb.json"}) {
+    SCOPED_TRACE(name);
+    const Scene first = load_scene(scene_path(name));
+    const std::string text = scene_to_json(first);
+    const Scene second = parse_scene(text);
+    expect_same_scene(first, second);
+    EXPECT_EQ(scene_to_json(second), text);
+  }
+}
+
+TEST(Scenes, RoundTripKeepsEveryNonDefaultField) {
+  Scene s = parse_scene(kGood);
+  s.description = "all fields";
+  s.cube.n = 3;
+  s.cube.edge_length = 1.5;
+  s.cube.origin = Vec3(0.1, 0.2, 0.3);
+  s.cube.particle_mass = 0.25;
+  s.cube.springs[2] = {700, 3};
+  s.cube.gravity = Vec3(0, 0, -1);
+  s.terrains[0].slope = {-15, Vec3(1, 0, 0)};
+  s.terrains[1].elevator.mass = std::numeric_limits<Real>::infinity();
+  s.terrains[1].elevator.thickness = 0.5;
+  s.terrains[2].plane = {Vec3(0, -1, 0), Vec3(0.1, 1, 0)};
+  s.terrains[2].contact.static_friction = 0.9;
+  s.terrains[2].contact.resting_speed = 0.02;
+  s.integrator = {"midpoint", 0.002, {}};
+  s.duration = 2.5;
+  s.output_interval = 0;
+  s.divergence = {100, 50};
+  const Scene back = parse_scene(scene_to_json(s));
+  expect_same_scene(s, back);
+}
+
+TEST(Scenes, MissingFieldsTakeTheSeedDefaults) {
+  const Scene s = parse_scene(
+      R"({"terrains": [{"kind": "plane"}], "integrator": {"name": "rk4"}, "duration": 2})");
+  expect_same_scene(s, [] {
+    Scene d;
+    d.integrator.name = "rk4";
+    d.duration = 2;
+    d.terrains.resize(1);
+    return d;
+  }());
+  EXPECT_EQ(s.terrains[0].contact.model, ContactModel::kCoulomb);
+  EXPECT_EQ(s.terrains[0].plane.normal, Vec3::UnitY());
+  EXPECT_EQ(s.integrator.dt, 0.001);
+}
+
+TEST(Scenes, CommentsAreAllowed) {
+  EXPECT_EQ(error_of("// a scene\n{\"integrator\": {\"name\": \"rk4\"}, /* s */ \"duration\": 1}"),
+            "");
+}
+
+TEST(BadScenes, UnknownKeysNameTheirPathAndTheAllowedKeys) {
+  EXPECT_EQ(error_of(kGood, {"terrains[0].contact.restitutoin=0.5"}),
+            "terrains[0].contact.restitutoin = 0.5 is invalid: unknown key; allowed here: "
+            "\"model\", \"restitution\", \"friction\", \"static_friction\", \"epsilon\", "
+            "\"resting_speed\"");
+  EXPECT_EQ(error_of(kGood, {"terrains.0.normal=[0,1,0]"}),
+            "terrains[0].normal = [0,1,0] is invalid: unknown key; allowed here: \"kind\", "
+            "\"angle_degrees\", \"point\", \"contact\"");
+  EXPECT_EQ(error_of(kGood, {"springs.stuctural.ks=1"}),
+            "springs.stuctural = {\"ks\":1} is invalid: unknown key; allowed here: "
+            "\"structural\", \"shear\", \"bending\"");
+  EXPECT_THAT(error_of(kGood, {"durration=3"}),
+              StartsWith("durration = 3 is invalid: unknown key; allowed here: \"description\", "
+                         "\"cube\", \"springs\", \"gravity\", \"terrains\", \"integrator\", "
+                         "\"duration\", \"output_interval\", \"divergence\""));
+  EXPECT_EQ(error_of(kGood, {"integrator.options.newton=2"}),
+            "integrator.options.newton = 2 is invalid: unknown key; allowed here: none");
+}
+
+TEST(BadScenes, WrongTypes) {
+  EXPECT_EQ(error_of(kGood, {"cube.n=ten"}), "cube.n = \"ten\" is invalid: an integer");
+  EXPECT_EQ(error_of(kGood, {"cube.n=2.5"}), "cube.n = 2.5 is invalid: an integer");
+  EXPECT_EQ(error_of(kGood, {"cube.origin=[1,2]"}),
+            "cube.origin = [1,2] is invalid: an array of 3 numbers [x, y, z]");
+  EXPECT_EQ(error_of(kGood, {"terrains[1].motion[0].stop_at_end=1"}),
+            "terrains[1].motion[0].stop_at_end = 1 is invalid: true or false");
+  EXPECT_EQ(error_of(kGood, {"terrains[1].mass=heavy"}),
+            "terrains[1].mass = \"heavy\" is invalid: a number or \"inf\"");
+  EXPECT_EQ(error_of(kGood, {"terrains[1].motion=up"}),
+            "terrains[1].motion = \"up\" is invalid: \"seed\" or a list of phases "
+            "[{\"duration\": 2, \"acceleration\": 3, \"stop_at_end\": true}, ...]");
+  EXPECT_EQ(error_of(kGood, {"integrator=rk4"}),
+            "integrator = \"rk4\" is invalid: a JSON object {...}");
+  EXPECT_EQ(error_of(kGood, {"terrains={}"}),
+            "terrains = {} is invalid: a list of terrains [{...}, ...]");
+  EXPECT_EQ(error_of("[1, 2]"), "scene = [1,2] is invalid: a JSON object {...}");
+}
+
+TEST(BadScenes, OutOfRangeValuesSayWhatIsAllowed) {
+  EXPECT_EQ(error_of(kGood, {"terrains[0].contact.restitution=1.5"}),
+            "terrains[0].contact.restitution = 1.5 is invalid: a number in [0, 1]");
+  EXPECT_EQ(error_of(kGood, {"terrains[2].contact.static_friction=0.1"}),
+            "terrains[2].contact.static_friction = 0.10000000000000001 is invalid: a finite "
+            "number >= friction (0.5)");
+  EXPECT_EQ(error_of(kGood, {"terrains[0].contact.model=ice"}),
+            "terrains[0].contact.model = \"ice\" is invalid: one of \"coulomb\", \"seed\"");
+  EXPECT_EQ(error_of(kGood, {"cube.n=1"}), "cube.n = 1 is invalid: an integer in [2, 400]");
+  EXPECT_EQ(error_of(kGood, {"springs.shear.kd=-1"}),
+            "springs.shear.kd = -1 is invalid: a finite damping >= 0");
+  EXPECT_EQ(error_of(kGood, {"terrains[1].size_x=0"}),
+            "terrains[1].size_x = 0 is invalid: a finite size > 0");
+  EXPECT_EQ(error_of(kGood, {"terrains[1].motion[1].duration=0"}),
+            "terrains[1].motion[1].duration = 0 is invalid: a finite duration > 0 s");
+  EXPECT_THAT(
+      error_of(kGood, {"terrains[1].motion[1].stop_at_end=false"}),
+      StartsWith(
+          "terrains[1].motion = a cycle ending at -2 m/s is invalid: a cycle that ends at rest"));
+  EXPECT_EQ(error_of(kGood, {"terrains[0].angle_degrees=90"}),
+            "terrains[0].angle_degrees = 90 is invalid: an angle in (-90, 90) degrees");
+  EXPECT_EQ(error_of(kGood, {"terrains[2].normal=[0,0,0]"}),
+            "terrains[2].normal = 0 0 0 is invalid: a finite, non-zero vector");
+  EXPECT_EQ(error_of(kGood, {"terrains[2].kind=wall"}),
+            "terrains[2].kind = \"wall\" is invalid: one of \"plane\", \"slope\", \"elevator\"");
+  EXPECT_EQ(error_of(kGood, {"integrator.dt=0"}),
+            "integrator.dt = 0 is invalid: a finite time step > 0 s");
+  EXPECT_EQ(error_of(kGood, {"duration=-1"}), "duration = -1 is invalid: a finite duration > 0 s");
+  EXPECT_EQ(error_of(kGood, {"output_interval=-1"}),
+            "output_interval = -1 is invalid: a finite interval >= 0 s (0 = every step)");
+  EXPECT_EQ(error_of(kGood, {"divergence.max_speed=0"}),
+            "divergence.max_speed = 0 is invalid: a speed > 0 m/s");
+  const std::string unknown = error_of(kGood, {"integrator.name=rk5"});
+  EXPECT_THAT(unknown, StartsWith("integrator.name = \"rk5\" is invalid: one of "));
+  for (const std::string& name : integrator_names()) {
+    EXPECT_THAT(unknown, HasSubstr("\"" + name + "\""));
+  }
+}
+
+TEST(BadScenes, MissingRequiredFields) {
+  EXPECT_EQ(error_of(R"({"duration": 1})"),
+            "integrator is missing: it is required ({\"name\": ...})");
+  EXPECT_EQ(error_of(R"({"integrator": {"dt": 0.01}, "duration": 1})"),
+            "integrator.name is missing: it is required");
+  EXPECT_EQ(error_of(R"({"integrator": {"name": "rk4"}})"), "duration is missing: it is required");
+  EXPECT_EQ(error_of(R"({"terrains": [{}], "integrator": {"name": "rk4"}, "duration": 1})"),
+            "terrains[0].kind is missing: it is required");
+  EXPECT_EQ(error_of(kGood, {"terrains[1].motion=[{\"duration\": 1}]"}),
+            "terrains[1].motion[0].acceleration is missing: it is required");
+}
+
+TEST(BadScenes, FilesThatCannotBeReadOrAreNotJson) {
+  EXPECT_THROW(load_scene(scene_path("no_such_scene.json")), InputError);
+  try {
+    load_scene(scene_path("no_such_scene.json"));
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), StartsWith("cannot read the scene file '"));
+  }
+  EXPECT_THAT(error_of("{\"duration\": 1,}"), StartsWith("scene is not valid JSON: parse error"));
+}
+
+TEST(Overrides, SetValuesAlongDottedAndIndexedPaths) {
+  const Scene s = parse_scene(
+      kGood, {"springs.structural.ks=2400", "terrains[0].contact.restitution=0.25",
+              "terrains.2.contact.model=seed", "integrator.name=midpoint", "cube.origin=[0, 1, 2]",
+              "description=a \"quoted\" = text", "terrains[1].mass=inf"});
+  EXPECT_EQ(s.cube.springs[0].ks, 2400);
+  EXPECT_EQ(s.cube.springs[1].ks, 1400);
+  EXPECT_EQ(s.terrains[0].contact.restitution, 0.25);
+  EXPECT_EQ(s.terrains[2].contact.model, ContactModel::kSeed);
+  EXPECT_EQ(s.integrator.name, "midpoint");
+  EXPECT_EQ(s.cube.origin, Vec3(0, 1, 2));
+  EXPECT_EQ(s.description, "a \"quoted\" = text");
+  EXPECT_TRUE(std::isinf(s.terrains[1].elevator.mass));
+}
+
+TEST(Overrides, TheTextVersionReturnsTheEditedScene) {
+  const std::string text = apply_override(kGood, "terrains[2].point=[0,-1,0]");
+  EXPECT_EQ(parse_scene(text).terrains[2].plane.point, Vec3(0, -1, 0));
+}
+
+TEST(Overrides, BadPathsAreInputErrors) {
+  EXPECT_EQ(error_of(kGood, {"terrains.3.contact.restitution=0.5"}),
+            "--set 'terrains.3.contact.restitution=0.5': terrains[3] does not exist (terrains "
+            "has 3 elements)");
+  EXPECT_EQ(error_of(kGood, {"duration.value=1"}),
+            "--set 'duration.value=1': duration is 1, not an object with a key \"value\"");
+  EXPECT_EQ(error_of(kGood, {"integrator[0]=1"}),
+            "--set 'integrator[0]=1': integrator is not an array");
+  EXPECT_EQ(error_of(kGood, {"springs.structural.ks"}),
+            "--set 'springs.structural.ks': expected path=value, e.g. springs.structural.ks=2400");
+  EXPECT_EQ(error_of(kGood, {"springs..ks=1"}),
+            "--set 'springs..ks=1': empty key in the path 'springs..ks'");
+  EXPECT_EQ(error_of(kGood, {"terrains[x].kind=plane"}),
+            "--set 'terrains[x].kind=plane': 'terrains[x]' is not a key or key[index] (indices are "
+            "integers >= 0)");
+  EXPECT_EQ(error_of(kGood, {"=1"}), "--set '=1': empty key in the path ''");
+}
+
+TEST(MakeSimulator, BuildsTheSceneAndRunsIt) {
+  // The library API of DESIGN.md, on a small cube.
+  Scene scene = load_scene(scene_path("seed_slope.json"), {"cube.n=4"});
+  scene.integrator.name = "symplectic_euler";
+  scene.integrator.dt = 0.002;
+  Simulator sim = make_simulator(scene);
+  EXPECT_EQ(sim.integrator().name(), "symplectic_euler");
+  EXPECT_EQ(sim.options().dt, 0.002);
+  EXPECT_EQ(sim.options().output_interval, 1.0 / 60);
+  ASSERT_EQ(sim.terrains().size(), 1u);
+  EXPECT_EQ(sim.terrains()[0]->contact().model, ContactModel::kSeed);
+  const RunReport report = sim.run_until(0.2);
+  EXPECT_TRUE(report.ok()) << report.brief();
+  const Vec3 com = center_of_mass(sim.model(), sim.state());
+  // Free fall for 0.2 s (the cube is still far above the slope): y drops by g t^2 / 2.
+  EXPECT_NEAR(com.y(), 79.0 / 9 - 0.5 * 9.8 * 0.2 * 0.2, 1e-2);
+}
+
+TEST(MakeSimulator, RejectsAnInvalidSceneBuiltInCode) {
+  Scene scene;
+  scene.integrator.name = "rk4";
+  scene.terrains.resize(1);
+  scene.terrains[0].contact.friction = -1;
+  try {
+    make_simulator(scene);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "terrains[0].contact.friction = -1 is invalid: a finite number >= 0");
+  }
+}
+
+}  // namespace
+}  // namespace jelly
