@@ -2,7 +2,7 @@
 include(CMakePackageConfigHelpers)
 foreach(module IN LISTS JELLY_MODULES)
   install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${module}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly/${module}
-          FILES_MATCHING PATTERN "*.hpp")
+          FILES_MATCHING PATTERN "*.hpp" PATTERN "detail" EXCLUDE)
 endforeach()
 install(FILES ${JELLY_BUILD_INCLUDE_DIR}/jelly/version.hpp ${JELLY_BUILD_INCLUDE_DIR}/jelly/jelly.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly)
