@@ -33,8 +33,8 @@ CheckpointWriter::CheckpointWriter(hid_t file, int num_particles, const std::str
                  name);
     Handle properties(H5Pcreate(H5P_DATASET_CREATE), name);
     check(H5Pset_chunk(properties.get(), static_cast<int>(chunk.size()), chunk.data()), name);
-    return Handle(H5Dcreate2(group_.get(), name, type, space.get(), H5P_DEFAULT,
-                             properties.get(), H5P_DEFAULT),
+    return Handle(H5Dcreate2(group_.get(), name, type, space.get(), H5P_DEFAULT, properties.get(),
+                             H5P_DEFAULT),
                   std::string("create checkpoint/") + name);
   };
   seed_particle_ = resizable("seed_particle", H5T_STD_I32LE, 1);
@@ -55,12 +55,12 @@ void overwrite(hid_t dataset, hid_t memory_type, std::vector<hsize_t> dims, cons
 }  // namespace
 
 void CheckpointWriter::write(const SimulatorSnapshot& s) {
-  check(H5Dwrite(position_.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                 s.state.x.data()),
-        "write checkpoint/position");
-  check(H5Dwrite(velocity_.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                 s.state.v.data()),
-        "write checkpoint/velocity");
+  check(
+      H5Dwrite(position_.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.state.x.data()),
+      "write checkpoint/position");
+  check(
+      H5Dwrite(velocity_.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.state.v.data()),
+      "write checkpoint/velocity");
   const hsize_t k = s.seed_contacts.size();
   particles_.clear();
   normals_.clear();
@@ -110,9 +110,9 @@ Checkpoint read_checkpoint(const std::string& path) {
     const std::vector<double> normals = h5::read_doubles(g.get(), "seed_normal");
     const std::vector<double> frictions = h5::read_doubles(g.get(), "seed_friction");
     for (size_t i = 0; i < particles.size(); ++i) {
-      cp.seed_contacts.push_back(
-          {particles[i], Vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]),
-           frictions[i]});
+      cp.seed_contacts.push_back({particles[i],
+                                  Vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]),
+                                  frictions[i]});
     }
     cp.integrator = h5::read_string_attribute(g.get(), "integrator");
     cp.dt = h5::read_double_attribute(g.get(), "dt");

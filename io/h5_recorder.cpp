@@ -22,8 +22,8 @@ namespace jelly {
 
 void RecorderOptions::validate() const {
   require(flush_every_frames >= 1, "flush_every_frames", flush_every_frames, "an integer >= 1");
-  require(compression_level >= 0 && compression_level <= 9, "compression_level",
-          compression_level, "an integer in 0..9 (0 = off)");
+  require(compression_level >= 0 && compression_level <= 9, "compression_level", compression_level,
+          "an integer in 0..9 (0 = off)");
 }
 
 std::string xdmf_path_for(const std::string& h5_path) {
@@ -94,9 +94,16 @@ struct Batch {
   }
 };
 
-// Frames per chunk of a series whose frame holds `values` numbers: about 128 KiB per chunk.
-hsize_t chunk_frames(size_t values) {
-  return std::clamp<hsize_t>(131072 / (8 * std::max<size_t>(values, 1)), 1, 1024);
+// Frames per chunk of a series whose frame holds `values` numbers: the flush block, or the
+// largest divisor of it whose chunk fits in HDF5's 1 MiB chunk cache. A chunk then never spans
+// two flushes, so a flush writes whole new chunks and never rewrites (and moves) a compressed
+// chunk that the file on disk still points to: a killed run leaves intact chunks behind.
+hsize_t chunk_frames(size_t values, int flush_every) {
+  const size_t bytes = 8 * std::max<size_t>(values, 1);
+  for (int d = flush_every; d > 1; --d) {
+    if (flush_every % d == 0 && bytes * d <= (size_t{1} << 20)) return static_cast<hsize_t>(d);
+  }
+  return 1;
 }
 
 std::string terrain_group_name(size_t index, const Terrain& terrain) {
@@ -183,13 +190,15 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
   h5::write_dataset(jelly.get(), "mass", {N}, model.mass.data());
   h5::write_dataset(jelly.get(), "rest_position", {N, 3}, model.rest_position.data());
   const int level = options.compression_level;
-  const hsize_t frame_chunk = chunk_frames(3 * N);
+  const int every = options.flush_every_frames;
+  const hsize_t frame_chunk = chunk_frames(3 * N, every);
+  const hsize_t clock_chunk = chunk_frames(1, every);
   {
     h5::Handle g = h5::create_group(jelly.get(), "position");
-    step = h5::Series(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LONG, {}, 1024, level);
-    time = h5::Series(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, 1024, level);
-    position = h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3},
-                          frame_chunk, level);
+    step = h5::Series(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LONG, {}, clock_chunk, level);
+    time = h5::Series(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, clock_chunk, level);
+    position =
+        h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3}, frame_chunk, level);
   }
   // H5MD lets time-dependent groups sampled at the same frames share step and time by hard links.
   const auto link_clock = [&](hid_t group) {
@@ -199,8 +208,8 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
   {
     h5::Handle g = h5::create_group(jelly.get(), "velocity");
     link_clock(g.get());
-    velocity = h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3},
-                          frame_chunk, level);
+    velocity =
+        h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3}, frame_chunk, level);
   }
 
   const Springs& s = model.springs;
@@ -218,8 +227,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
     h5::write_dataset(g.get(), "rest_length", {M}, s.rest_length.data());
     h5::write_dataset(g.get(), "ks", {M}, s.ks.data());
     h5::write_dataset(g.get(), "kd", {M}, s.kd.data());
-    h5::write_attribute(g.get(), "type_names",
-                        std::string("0 structural, 1 shear, 2 bending"));
+    h5::write_attribute(g.get(), "type_names", std::string("0 structural, 1 shear, 2 bending"));
   }
 
   {
@@ -230,7 +238,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       std::vector<hsize_t> shape;
       if (spec.width > 1) shape.push_back(static_cast<hsize_t>(spec.width));
       observables.emplace_back(o.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, shape,
-                               chunk_frames(spec.width), level);
+                               chunk_frames(spec.width, every), level);
       observable_work.emplace_back();
     }
   }
@@ -256,7 +264,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       h5::Handle pos = h5::create_group(t.get(), "position");
       link_clock(pos.get());
       terrains.emplace_back(pos.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                            std::vector<hsize_t>{3}, chunk_frames(3), level);
+                            std::vector<hsize_t>{3}, chunk_frames(3, every), level);
     }
   }
 
@@ -284,8 +292,10 @@ void H5Recorder::Impl::write_batch(Batch& batch) {
     time.append(batch.time.data(), frames);
     position.append(batch.position.data(), frames);
     velocity.append(batch.velocity.data(), frames);
-    for (size_t k = 0; k < specs.size(); ++k) observables[k].append(observable_work[k].data(), frames);
-    for (size_t i = 0; i < terrains.size(); ++i) terrains[i].append(batch.terrain[i].data(), frames);
+    for (size_t k = 0; k < specs.size(); ++k)
+      observables[k].append(observable_work[k].data(), frames);
+    for (size_t i = 0; i < terrains.size(); ++i)
+      terrains[i].append(batch.terrain[i].data(), frames);
   }
   if (batch.has_checkpoint) checkpoint->write(batch.checkpoint);
   h5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + path);

@@ -10,7 +10,7 @@
 namespace jelly {
 
 struct RecorderOptions {
-  std::string scene_json;       // the whole scene as JSON text (stored as an attribute), may be empty
+  std::string scene_json;  // the whole scene as JSON text (stored as an attribute), may be empty
   std::string integrator_name;  // attribute; defaults to sim.integrator().name()
   // Frames are written in blocks of this many and the file is flushed after each block (with a
   // fresh /checkpoint): a run killed by SIGKILL leaves a file readable up to the last flush.

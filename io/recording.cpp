@@ -45,7 +45,8 @@ Recording read(hid_t file) {
   std::vector<double> mass = h5::read_doubles(file, "/particles/jelly/mass");
   r.model.mass = Eigen::Map<const VecX>(mass.data(), static_cast<Eigen::Index>(mass.size()));
   std::vector<double> rest = h5::read_doubles(file, "/particles/jelly/rest_position");
-  r.model.rest_position = Eigen::Map<const VecX>(rest.data(), static_cast<Eigen::Index>(rest.size()));
+  r.model.rest_position =
+      Eigen::Map<const VecX>(rest.data(), static_cast<Eigen::Index>(rest.size()));
   const std::vector<int> pairs = h5::read_ints(file, "/connectivity/springs");
   const std::vector<int> type = h5::read_ints(file, "/connectivity/type");
   const std::vector<double> rest_length = h5::read_doubles(file, "/connectivity/rest_length");
@@ -70,8 +71,8 @@ Recording read(hid_t file) {
   r.position = split_frames(h5::read_doubles(file, "/particles/jelly/position/value", &dims), dims);
   r.velocity = split_frames(h5::read_doubles(file, "/particles/jelly/velocity/value", &dims), dims);
   // A killed run may have flushed one series further than another: keep the common frames.
-  const size_t frames = std::min({r.time.size(), r.step.size(), r.position.size(),
-                                  r.velocity.size()});
+  const size_t frames =
+      std::min({r.time.size(), r.step.size(), r.position.size(), r.velocity.size()});
   r.time.resize(frames);
   r.step.resize(frames);
   r.position.resize(frames);
@@ -94,7 +95,8 @@ Recording read(hid_t file) {
     track.attributes = attributes_of(g.get());
     track.kind = track.attributes["kind"];
     const std::vector<double> p = h5::read_doubles(g.get(), "position/value");
-    for (size_t i = 0; i + 2 < p.size(); i += 3) track.position.emplace_back(p[i], p[i + 1], p[i + 2]);
+    for (size_t i = 0; i + 2 < p.size(); i += 3)
+      track.position.emplace_back(p[i], p[i + 1], p[i + 2]);
     r.terrains.push_back(std::move(track));
   }
   return r;

@@ -19,8 +19,8 @@ struct TerrainTrack {
 
 struct Recording {
   Model model;
-  std::vector<Real> time;  // per frame
-  std::vector<long> step;  // per frame: the simulator's total step count
+  std::vector<Real> time;                // per frame
+  std::vector<long> step;                // per frame: the simulator's total step count
   std::vector<VecX> position, velocity;  // per frame, [3N] each
   std::string scene_json;
   std::map<std::string, std::string> attributes;  // of /parameters, as text

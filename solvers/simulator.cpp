@@ -46,14 +46,13 @@ void Simulator::set_state(State state) {
 }
 
 SimulatorSnapshot Simulator::snapshot() const {
-  return {state_, contacts_.seed_contacts(), contacts_.contact_count(), total_steps_,
-          next_output_};
+  return {state_, contacts_.seed_contacts(), contacts_.contact_count(), total_steps_, next_output_};
 }
 
 void Simulator::restore(SimulatorSnapshot snapshot) {
   State& s = snapshot.state;
-  require(s.x.size() == model_.num_dofs() && s.v.size() == model_.num_dofs(), "snapshot.state.x.size",
-          s.x.size(), "3 x the number of particles");
+  require(s.x.size() == model_.num_dofs() && s.v.size() == model_.num_dofs(),
+          "snapshot.state.x.size", s.x.size(), "3 x the number of particles");
   require(std::isfinite(s.t), "snapshot.state.t", s.t, "a finite time");
   require(std::isfinite(snapshot.next_output), "snapshot.next_output", snapshot.next_output,
           "a finite time");

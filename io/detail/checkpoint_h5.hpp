@@ -5,9 +5,9 @@
 
 namespace jelly::h5 {
 
-// /checkpoint attrs integrator (its name()), dt, t, total_steps, next_output, contact_count; datasets position [N][3],
-// velocity [N][3] (fixed size), seed_particle [K], seed_normal [K][3], seed_friction [K]
-// (resized to the current seed contacts). All in full double precision.
+// /checkpoint attrs integrator (its name()), dt, t, total_steps, next_output, contact_count;
+// datasets position [N][3], velocity [N][3] (fixed size), seed_particle [K], seed_normal [K][3],
+// seed_friction [K] (resized to the current seed contacts). All in full double precision.
 class CheckpointWriter {
  public:
   CheckpointWriter(hid_t file, int num_particles, const std::string& integrator, Real dt);
