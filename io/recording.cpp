@@ -129,6 +129,13 @@ std::string describe_recording(const std::string& path) {
       auto it = attributes.find(name);
       return it == attributes.end() ? std::string("-") : it->second;
     };
+    // Numbers with 6 significant digits for reading (the attributes keep full precision).
+    const auto number = [&](const std::string& name) {
+      if (!h5::has_attribute(par.get(), name)) return std::string("-");
+      std::ostringstream text;
+      text << h5::read_double_attribute(par.get(), name);
+      return text.str();
+    };
     out << "file:          " << path << " (" << std::filesystem::file_size(path) << " bytes)\n";
     out << "creator:       " << h5::read_string_attribute(h5md.get(), "creator") << ' '
         << h5::read_string_attribute(h5md.get(), "creator_version") << '\n';
@@ -150,12 +157,12 @@ std::string describe_recording(const std::string& path) {
     out << "frames:        " << frames;
     if (frames > 0) out << ", t = " << time.front() << " .. " << time[frames - 1] << " s";
     out << '\n';
-    out << "integrator:    " << attribute("integrator") << ", dt = " << attribute("dt")
-        << " s, output every " << attribute("output_interval") << " s\n";
+    out << "integrator:    " << attribute("integrator") << ", dt = " << number("dt")
+        << " s, output every " << number("output_interval") << " s\n";
     out << "status:        " << attribute("run_status");
     if (attribute("run_status") != "running") {
-      out << " at t = " << attribute("run_t") << " s, " << attribute("run_steps") << " steps, "
-          << attribute("run_wall_seconds") << " s wall, " << attribute("run_force_evaluations")
+      out << " at t = " << number("run_t") << " s, " << attribute("run_steps") << " steps, "
+          << number("run_wall_seconds") << " s wall, " << attribute("run_force_evaluations")
           << " force evaluations";
       if (!attribute("run_reason").empty() && attribute("run_reason") != "-") {
         out << " (" << attribute("run_reason") << ")";

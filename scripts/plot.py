@@ -25,9 +25,9 @@ def draw_snapshot(ax, rec, frame, limits, all_springs):
     for X, Z, Y in jelly_h5.terrain_surfaces(rec, frame, limits):
         ax.plot_surface(X, Z, Y, color="tan", alpha=0.35, linewidth=0)
     lines = Line3DCollection(jelly_h5.spring_segments(x, rec.springs[keep]), colors="tab:blue",
-                             linewidths=0.5, alpha=0.7)
+                             linewidths=0.4, alpha=0.6)
     ax.add_collection3d(lines)
-    ax.scatter(x[:, 0], x[:, 2], x[:, 1], s=2, c="navy", depthshade=False)
+    ax.scatter(x[:, 0], x[:, 2], x[:, 1], s=0.5, c="navy", depthshade=False)
     jelly_h5.style_axis(ax, limits)
     ax.view_init(elev=15, azim=-70)
     ax.set_title(f"t = {rec.time[frame]:.2f} s")
@@ -55,8 +55,11 @@ def main():
     ax = fig.add_subplot(top[0, 0])
     for k, name in enumerate("xyz"):
         ax.plot(t, com[:, k], label=f"{name}")
+    for terrain in rec.terrains:
+        if terrain["kind"] == "elevator":
+            ax.plot(t, terrain["position"][:, 1], "--", color="tan", label="platform y")
     ax.set_xlabel("time (s)")
-    ax.set_ylabel("centre of mass (m)")
+    ax.set_ylabel("position (m)")
     ax.set_title("Centre of mass against time")
     ax.legend()
     ax.grid(alpha=0.3)
@@ -69,8 +72,11 @@ def main():
         n = np.asarray(terrain.get("normal", [0, 1, 0]), float)
         p = terrain["position"][0]
         if terrain["kind"] == "plane" and abs(n[1]) > 1e-6:
-            xs = np.array(ax.get_xlim())
-            ax.plot(xs, p[1] - n[0] * (xs - p[0]) / n[1], color="tan", label="plane (z = 0)")
+            span = com[:, 0].max() - com[:, 0].min() + 2
+            xs = np.array([com[:, 0].min() - 1, com[:, 0].max() + 1]) if span > 2 else \
+                np.array([com[0, 0] - 3, com[0, 0] + 3])
+            ax.plot(xs, p[1] - n[0] * (xs - p[0]) / n[1], color="tan",
+                    label="plane (section z = 0)")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title("Centre-of-mass path (x-y)")
