@@ -94,10 +94,10 @@ struct Batch {
   }
 };
 
-// Frames per chunk of a series whose frame holds `values` numbers: the flush block, or the
-// largest divisor of it whose chunk fits in HDF5's 1 MiB chunk cache. A chunk then never spans
-// two flushes, so a flush writes whole new chunks and never rewrites (and moves) a compressed
-// chunk that the file on disk still points to: a killed run leaves intact chunks behind.
+// Frames per chunk of the particle series (a frame holds `values` numbers): the flush block, or
+// the largest divisor of it whose chunk fits in HDF5's 1 MiB chunk cache. A chunk then never
+// spans two flushes, so a flush writes whole new chunks and never rewrites (and moves) a
+// compressed chunk that the file on disk already points to: a killed run leaves intact chunks.
 hsize_t chunk_frames(size_t values, int flush_every) {
   const size_t bytes = 8 * std::max<size_t>(values, 1);
   for (int d = flush_every; d > 1; --d) {
@@ -105,6 +105,11 @@ hsize_t chunk_frames(size_t values, int flush_every) {
   }
   return 1;
 }
+
+// The small series (clock, observables, terrain: 1 or 3 numbers a frame) are stored
+// uncompressed in chunks of this many frames: a chunk is allocated once and then filled in place,
+// flush after flush, instead of a new tiny compressed chunk per flush.
+constexpr hsize_t kSmallSeriesChunk = 256;
 
 std::string terrain_group_name(size_t index, const Terrain& terrain) {
   return std::to_string(index) + "_" + std::string(terrain.kind());
@@ -192,11 +197,10 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
   const int level = options.compression_level;
   const int every = options.flush_every_frames;
   const hsize_t frame_chunk = chunk_frames(3 * N, every);
-  const hsize_t clock_chunk = chunk_frames(1, every);
   {
     h5::Handle g = h5::create_group(jelly.get(), "position");
-    step = h5::Series(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LONG, {}, clock_chunk, level);
-    time = h5::Series(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, clock_chunk, level);
+    step = h5::Series(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LONG, {}, kSmallSeriesChunk, 0);
+    time = h5::Series(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, kSmallSeriesChunk, 0);
     position =
         h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3}, frame_chunk, level);
   }
@@ -238,7 +242,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       std::vector<hsize_t> shape;
       if (spec.width > 1) shape.push_back(static_cast<hsize_t>(spec.width));
       observables.emplace_back(o.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, shape,
-                               chunk_frames(spec.width, every), level);
+                               kSmallSeriesChunk, 0);
       observable_work.emplace_back();
     }
   }
@@ -264,7 +268,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       h5::Handle pos = h5::create_group(t.get(), "position");
       link_clock(pos.get());
       terrains.emplace_back(pos.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                            std::vector<hsize_t>{3}, chunk_frames(3, every), level);
+                            std::vector<hsize_t>{3}, kSmallSeriesChunk, 0);
     }
   }
 

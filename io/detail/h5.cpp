@@ -127,11 +127,24 @@ void Handle::reset() {
   id_ = -1;
 }
 
+namespace {
+
+// The operating system's reason quoted in HDF5's "unable to open file" message ("No such file or
+// directory"), or the whole HDF5 text when there is none.
+std::string file_error_reason() {
+  const std::string text = error_text();
+  const std::string key = "error message = '";
+  const size_t start = text.find(key);
+  if (start == std::string::npos) return text;
+  const size_t end = text.find('\'', start + key.size());
+  return text.substr(start + key.size(), end == std::string::npos ? end : end - start - key.size());
+}
+
+}  // namespace
+
 Handle create_file(const std::string& path) {
   const hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  if (id < 0) {
-    throw InputError("cannot create HDF5 file '" + path + "': " + error_text());
-  }
+  if (id < 0) throw InputError("cannot create HDF5 file '" + path + "': " + file_error_reason());
   return Handle(id);
 }
 
@@ -143,7 +156,7 @@ Handle open_file(const std::string& path, bool writable) {
     throw InputError("cannot open '" + path + "': not an HDF5 file");
   }
   const hid_t id = H5Fopen(path.c_str(), writable ? H5F_ACC_RDWR : H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (id < 0) throw InputError("cannot open HDF5 file '" + path + "': " + error_text());
+  if (id < 0) throw InputError("cannot open HDF5 file '" + path + "': " + file_error_reason());
   return Handle(id);
 }
 
