@@ -7,6 +7,7 @@ mp4 goes through ffmpeg (matplotlib's FFMpegWriter); gif through Pillow when it 
 else ffmpeg. Frames are skipped or repeated so that playback runs at real time.
 """
 import argparse
+import importlib.util
 import os
 import sys
 
@@ -23,12 +24,8 @@ import jelly_h5  # noqa: E402
 
 
 def writer_for(output, fps):
-    if output.endswith(".gif"):
-        try:
-            import PIL  # noqa: F401
-            return animation.PillowWriter(fps=fps)
-        except ImportError:
-            pass
+    if output.endswith(".gif") and importlib.util.find_spec("PIL") is not None:
+        return animation.PillowWriter(fps=fps)
     if not animation.FFMpegWriter.isAvailable():
         sys.exit("error: ffmpeg is not installed (apt-get install ffmpeg)")
     return animation.FFMpegWriter(fps=fps, bitrate=2400)
