@@ -15,14 +15,13 @@ namespace {
 void frame_slab(std::ostream& out, const XdmfLayout& layout, size_t frame, int rows,
                 const char* dataset) {
   const size_t frames = layout.times.size();
-  out << "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 " << rows
-      << " 3\" Type=\"HyperSlab\">\n"
-      << "          <DataItem Dimensions=\"3 3\" Format=\"XML\">" << frame << " 0 0 1 1 1 1 "
+  out << "          <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 " << rows << " 3\">\n"
+      << "            <DataItem Dimensions=\"3 3\" Format=\"XML\">" << frame << " 0 0 1 1 1 1 "
       << rows << " 3</DataItem>\n"
-      << "          <DataItem Dimensions=\"" << frames << ' ' << rows
+      << "            <DataItem Dimensions=\"" << frames << ' ' << rows
       << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << layout.h5_file << ':'
       << dataset << "</DataItem>\n"
-      << "        </DataItem>\n";
+      << "          </DataItem>\n";
 }
 
 }  // namespace
