@@ -11,14 +11,14 @@ namespace jelly {
 
 namespace {
 
-// A HyperSlab DataItem selecting frame `frame` ([1][rows][3]) of the dataset [T][rows][3].
+// A HyperSlab DataItem selecting frame `frame` ([1][rows][3]) of the dataset [T][rows][3]:
+// start (frame, 0, 0), stride (1, 1, 1), count (1, rows, 3).
 void frame_slab(std::ostream& out, const XdmfLayout& layout, size_t frame, int rows,
                 const char* dataset) {
-  const size_t frames = layout.times.size();
   out << "          <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 " << rows << " 3\">\n"
       << "            <DataItem Dimensions=\"3 3\" Format=\"XML\">" << frame << " 0 0 1 1 1 1 "
       << rows << " 3</DataItem>\n"
-      << "            <DataItem Dimensions=\"" << frames << ' ' << rows
+      << "            <DataItem Dimensions=\"" << layout.times.size() << ' ' << rows
       << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << layout.h5_file << ':'
       << dataset << "</DataItem>\n"
       << "          </DataItem>\n";
@@ -32,7 +32,7 @@ std::string xdmf_text(const XdmfLayout& layout) {
   const int n = layout.num_particles, m = layout.num_springs;
   out << "<?xml version=\"1.0\" ?>\n"
       << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-      << "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+      << "<Xdmf Version=\"2.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
       << "  <Domain>\n"
       << "    <Grid Name=\"jelly\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (size_t f = 0; f < layout.times.size(); ++f) {

@@ -1,7 +1,8 @@
 #pragma once
-// The XDMF 3 sidecar of a recording: a temporal collection of one uniform grid per frame, whose
+// The XDMF sidecar of a recording: a temporal collection of one uniform grid per frame, whose
 // topology (a polyline per spring), geometry and attributes point into the HDF5 file, so that
-// ParaView shows the jelly and its springs as a time series.
+// ParaView's "XDMF Reader" shows the jelly and its springs as a time series. (The "Xdmf3 Reader"
+// variants of ParaView 5.11 load no points from HyperSlab geometry; docs/output.md.)
 #include <string>
 #include <vector>
 

@@ -234,7 +234,7 @@ TEST(Xdmf, WellFormedTemporalCollection) {
   std::ifstream in(xdmf);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("run.h5:/particles/jelly/position/value"), std::string::npos);
-  EXPECT_NE(text.find("25 0 0 1 1 1 1 27 3"), std::string::npos);  // the last frame's slab
+  EXPECT_NE(text.find(">25 0 0 1 1 1 1 27 3<"), std::string::npos);  // the last frame
   if (!testing::python_has("xml.etree.ElementTree")) GTEST_SKIP() << "no /usr/bin/python3";
   const std::string check =
       "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1])."
@@ -252,6 +252,20 @@ TEST(Xdmf, WellFormedTemporalCollection) {
   std::ifstream again(xdmf);
   EXPECT_EQ(std::string((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>()),
             text);
+}
+
+// ParaView's XDMF Reader shows every frame, bit for bit (when ParaView is installed; it is not a
+// dependency of jelly).
+TEST(Xdmf, ParaViewReadsEveryFrame) {
+  if (!std::filesystem::exists("/usr/bin/pvbatch"))
+    GTEST_SKIP() << "ParaView (pvbatch) not installed";
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  record_slope(path);
+  const std::string command = "/usr/bin/pvbatch --force-offscreen-rendering " JELLY_SOURCE_DIR
+                              "/tests/io/paraview_check.py " +
+                              dir.file("run.xdmf") + " " + path + " 2>&1 | grep -v '^$'";
+  EXPECT_EQ(std::system(command.c_str()), 0);
 }
 
 }  // namespace
