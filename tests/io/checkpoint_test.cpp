@@ -10,6 +10,10 @@
 #include "io/io_support.hpp"
 
 namespace jelly {
+
+// Names the contact model in test output (GoogleTest finds it in the type's namespace).
+void PrintTo(ContactModel model, std::ostream* out) { *out << contact_model_name(model); }
+
 namespace {
 
 using testing::TempDir;
