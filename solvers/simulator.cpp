@@ -81,13 +81,11 @@ StepResult Simulator::step() {
 }
 
 void Simulator::emit_frame() {
-  // The next output time is advanced first, so that an observer taking a snapshot() in on_frame
-  // gets the one a restart needs.
+  for (Observer* o : observers_) o->on_frame(*this);
+  ++frames_;
   if (options_.output_interval > 0) {
     while (next_output_ <= state_.t + 1e-9 * options_.dt) next_output_ += options_.output_interval;
   }
-  for (Observer* o : observers_) o->on_frame(*this);
-  ++frames_;
 }
 
 RunReport Simulator::run_until(Real t_end) {

@@ -38,7 +38,9 @@ struct SimulatorSnapshot {
   std::vector<ContactSolver::SeedContact> seed_contacts;  // active during the next step
   int contact_count = 0;
   long total_steps = 0;
-  Real next_output = 0;  // time of the next observer frame
+  // Time of the next observer frame (taken inside on_frame: that frame's own time, which the
+  // frame restore() emits first moves on as the original run did).
+  Real next_output = 0;
 };
 
 class Simulator {
