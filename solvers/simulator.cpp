@@ -45,6 +45,29 @@ void Simulator::set_state(State state) {
   frames_ = 0;
 }
 
+SimulatorSnapshot Simulator::snapshot() const {
+  return {state_, contacts_.seed_contacts(), contacts_.contact_count(), total_steps_, next_output_};
+}
+
+void Simulator::restore(SimulatorSnapshot snapshot) {
+  State& s = snapshot.state;
+  require(s.x.size() == model_.num_dofs() && s.v.size() == model_.num_dofs(),
+          "snapshot.state.x.size", s.x.size(), "3 x the number of particles");
+  require(std::isfinite(s.t), "snapshot.state.t", s.t, "a finite time");
+  require(std::isfinite(snapshot.next_output), "snapshot.next_output", snapshot.next_output,
+          "a finite time");
+  require(snapshot.total_steps >= 0, "snapshot.total_steps", snapshot.total_steps, ">= 0");
+  for (const ContactSolver::SeedContact& c : snapshot.seed_contacts) {
+    require(c.particle >= 0 && c.particle < model_.num_particles(),
+            "snapshot.seed_contacts.particle", c.particle, "a particle index of the model");
+  }
+  state_ = std::move(s);
+  contacts_.restore(std::move(snapshot.seed_contacts), snapshot.contact_count);
+  total_steps_ = snapshot.total_steps;
+  next_output_ = snapshot.next_output;
+  frames_ = 0;
+}
+
 StepResult Simulator::step() {
   const Dynamics dynamics(model_, contacts_);
   before_.x = state_.x;

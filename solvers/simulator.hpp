@@ -30,6 +30,19 @@ struct SimulatorOptions {
   void validate() const;
 };
 
+// What the future of a run depends on besides the model, terrains, integrator and options: a
+// simulator restored from it continues bit for bit (for integrators that keep no state between
+// steps, which all explicit ones do).
+struct SimulatorSnapshot {
+  State state;
+  std::vector<ContactSolver::SeedContact> seed_contacts;  // active during the next step
+  int contact_count = 0;
+  long total_steps = 0;
+  // Time of the next observer frame (taken inside on_frame: that frame's own time, which the
+  // frame restore() emits first moves on as the original run did).
+  Real next_output = 0;
+};
+
 class Simulator {
  public:
   // Throws InputError for an invalid model, state size or option.
@@ -53,6 +66,11 @@ class Simulator {
   const State& state() const { return state_; }
   // Replaces the state (a restart); forgets the active contacts.
   void set_state(State state);
+  SimulatorSnapshot snapshot() const;
+  // Continues from a snapshot (taken from a simulator with the same model, terrains, integrator
+  // and options); the next run_until() first emits a frame of the restored state. Throws
+  // InputError for a snapshot that does not fit the model.
+  void restore(SimulatorSnapshot snapshot);
   const Terrains& terrains() const { return terrains_; }
   const Integrator& integrator() const { return *integrator_; }
   Integrator& integrator() { return *integrator_; }

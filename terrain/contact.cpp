@@ -105,4 +105,9 @@ void ContactSolver::clear() {
   contact_count_ = 0;
 }
 
+void ContactSolver::restore(std::vector<SeedContact> seed_contacts, int contact_count) {
+  seed_contacts_ = std::move(seed_contacts);
+  contact_count_ = contact_count;
+}
+
 }  // namespace jelly

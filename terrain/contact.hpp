@@ -18,6 +18,14 @@ using Terrains = std::vector<std::unique_ptr<Terrain>>;
 
 class ContactSolver {
  public:
+  // A particle the seed model flagged at the last resolve(): it gets the contact and friction
+  // forces during the next step.
+  struct SeedContact {
+    int particle;
+    Vec3 normal;
+    Real friction;
+  };
+
   // Applies every terrain's contact response to `state` (time state.t) after a step of size h
   // from the state `before`.
   void resolve(const Model& model, const Terrains& terrains, const State& before, State& state,
@@ -31,12 +39,11 @@ class ContactSolver {
   // Forget the seed contacts (after a restart or a state set from outside).
   void clear();
 
+  // The seed contacts of the last resolve(), and their restoration (checkpoint restart).
+  const std::vector<SeedContact>& seed_contacts() const { return seed_contacts_; }
+  void restore(std::vector<SeedContact> seed_contacts, int contact_count);
+
  private:
-  struct SeedContact {
-    int particle;
-    Vec3 normal;
-    Real friction;
-  };
   std::vector<SeedContact> seed_contacts_;
   int contact_count_ = 0;
 };

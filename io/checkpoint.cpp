@@ -1,0 +1,138 @@
+#include <jelly/io/checkpoint.hpp>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/io/detail/checkpoint_h5.hpp>
+#include <jelly/io/detail/h5.hpp>
+
+namespace jelly {
+
+namespace h5 {
+
+CheckpointWriter::CheckpointWriter(hid_t file, int num_particles, const std::string& integrator,
+                                   Real dt) {
+  group_ = create_group(file, "checkpoint");
+  write_attribute(group_.get(), "integrator", integrator);
+  write_attribute(group_.get(), "dt", dt);
+  const hsize_t n = static_cast<hsize_t>(num_particles);
+  const auto fixed = [&](const char* name) {
+    Handle space(H5Screate_simple(2, std::vector<hsize_t>{n, 3}.data(), nullptr), name);
+    return Handle(H5Dcreate2(group_.get(), name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                             H5P_DEFAULT, H5P_DEFAULT),
+                  std::string("create checkpoint/") + name);
+  };
+  position_ = fixed("position");
+  velocity_ = fixed("velocity");
+  const auto resizable = [&](const char* name, hid_t type, hsize_t width) {
+    std::vector<hsize_t> dims{0}, max_dims{H5S_UNLIMITED}, chunk{256};
+    if (width > 1) {
+      dims.push_back(width);
+      max_dims.push_back(width);
+      chunk.push_back(width);
+    }
+    Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), max_dims.data()),
+                 name);
+    Handle properties(H5Pcreate(H5P_DATASET_CREATE), name);
+    check(H5Pset_chunk(properties.get(), static_cast<int>(chunk.size()), chunk.data()), name);
+    return Handle(H5Dcreate2(group_.get(), name, type, space.get(), H5P_DEFAULT, properties.get(),
+                             H5P_DEFAULT),
+                  std::string("create checkpoint/") + name);
+  };
+  seed_particle_ = resizable("seed_particle", H5T_STD_I32LE, 1);
+  seed_normal_ = resizable("seed_normal", H5T_IEEE_F64LE, 3);
+  seed_friction_ = resizable("seed_friction", H5T_IEEE_F64LE, 1);
+}
+
+namespace {
+
+void overwrite(hid_t dataset, hid_t memory_type, std::vector<hsize_t> dims, const void* data) {
+  check(H5Dset_extent(dataset, dims.data()), "resize checkpoint dataset");
+  if (dims[0] > 0) {
+    check(H5Dwrite(dataset, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
+          "write checkpoint dataset");
+  }
+}
+
+}  // namespace
+
+void CheckpointWriter::write(const SimulatorSnapshot& s) {
+  check(
+      H5Dwrite(position_.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.state.x.data()),
+      "write checkpoint/position");
+  check(
+      H5Dwrite(velocity_.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.state.v.data()),
+      "write checkpoint/velocity");
+  const hsize_t k = s.seed_contacts.size();
+  particles_.clear();
+  normals_.clear();
+  frictions_.clear();
+  for (const ContactSolver::SeedContact& c : s.seed_contacts) {
+    particles_.push_back(c.particle);
+    normals_.insert(normals_.end(), c.normal.data(), c.normal.data() + 3);
+    frictions_.push_back(c.friction);
+  }
+  overwrite(seed_particle_.get(), H5T_NATIVE_INT, {k}, particles_.data());
+  overwrite(seed_normal_.get(), H5T_NATIVE_DOUBLE, {k, 3}, normals_.data());
+  overwrite(seed_friction_.get(), H5T_NATIVE_DOUBLE, {k}, frictions_.data());
+  write_attribute(group_.get(), "t", s.state.t);
+  write_attribute(group_.get(), "total_steps", s.total_steps);
+  write_attribute(group_.get(), "next_output", s.next_output);
+  write_attribute(group_.get(), "contact_count", static_cast<long>(s.contact_count));
+}
+
+}  // namespace h5
+
+SimulatorSnapshot Checkpoint::snapshot() const {
+  return {state, seed_contacts, contact_count, total_steps, next_output};
+}
+
+Checkpoint read_checkpoint(const std::string& path) {
+  std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
+  h5::QuietErrors quiet;
+  h5::Handle file = h5::open_file(path);
+  if (!h5::exists(file.get(), "checkpoint")) {
+    throw InputError("'" + path + "' holds no /checkpoint group (not a jelly recording?)");
+  }
+  Checkpoint cp;
+  try {
+    h5::Handle g = h5::open_group(file.get(), "checkpoint");
+    if (!h5::has_attribute(g.get(), "t")) {
+      throw InputError("'" + path + "' has an empty /checkpoint: its run wrote no flush");
+    }
+    std::vector<double> x = h5::read_doubles(g.get(), "position");
+    std::vector<double> v = h5::read_doubles(g.get(), "velocity");
+    cp.state.t = h5::read_double_attribute(g.get(), "t");
+    cp.state.x = Eigen::Map<const VecX>(x.data(), static_cast<Eigen::Index>(x.size()));
+    cp.state.v = Eigen::Map<const VecX>(v.data(), static_cast<Eigen::Index>(v.size()));
+    cp.total_steps = h5::read_long_attribute(g.get(), "total_steps");
+    cp.next_output = h5::read_double_attribute(g.get(), "next_output");
+    cp.contact_count = static_cast<int>(h5::read_long_attribute(g.get(), "contact_count"));
+    const std::vector<int> particles = h5::read_ints(g.get(), "seed_particle");
+    const std::vector<double> normals = h5::read_doubles(g.get(), "seed_normal");
+    const std::vector<double> frictions = h5::read_doubles(g.get(), "seed_friction");
+    for (size_t i = 0; i < particles.size(); ++i) {
+      cp.seed_contacts.push_back({particles[i],
+                                  Vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]),
+                                  frictions[i]});
+    }
+    cp.integrator = h5::read_string_attribute(g.get(), "integrator");
+    cp.dt = h5::read_double_attribute(g.get(), "dt");
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError("'" + path + "' has an invalid /checkpoint: " + e.what());
+  }
+  return cp;
+}
+
+void restore(Simulator& sim, const Checkpoint& cp) {
+  require(cp.state.x.size() == sim.model().num_dofs(), "checkpoint particles",
+          cp.state.x.size() / 3,
+          "the simulator's particle count (" + std::to_string(sim.model().num_particles()) + ")");
+  require(cp.integrator == sim.integrator().name(), "checkpoint integrator", cp.integrator,
+          "the simulator's integrator '" + std::string(sim.integrator().name()) + "'");
+  require(cp.dt == sim.options().dt, "checkpoint dt", cp.dt,
+          "the simulator's time step (" + to_text(sim.options().dt) + ")");
+  sim.restore(cp.snapshot());
+}
+
+}  // namespace jelly

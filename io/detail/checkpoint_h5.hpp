@@ -1,0 +1,22 @@
+#pragma once
+// Internal: the /checkpoint group of a recording, overwritten in place at each flush.
+#include <jelly/io/detail/h5.hpp>
+#include <jelly/solvers/simulator.hpp>
+
+namespace jelly::h5 {
+
+// /checkpoint attrs integrator (its name()), dt, t, total_steps, next_output, contact_count;
+// datasets position [N][3], velocity [N][3] (fixed size), seed_particle [K], seed_normal [K][3],
+// seed_friction [K] (resized to the current seed contacts). All in full double precision.
+class CheckpointWriter {
+ public:
+  CheckpointWriter(hid_t file, int num_particles, const std::string& integrator, Real dt);
+  void write(const SimulatorSnapshot& snapshot);
+
+ private:
+  Handle group_, position_, velocity_, seed_particle_, seed_normal_, seed_friction_;
+  std::vector<int> particles_;
+  std::vector<double> normals_, frictions_;
+};
+
+}  // namespace jelly::h5

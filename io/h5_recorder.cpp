@@ -1,0 +1,460 @@
+#include <jelly/io/h5_recorder.hpp>
+
+#include <algorithm>
+#include <array>
+#include <condition_variable>
+#include <cstring>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <thread>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
+#include <jelly/io/detail/checkpoint_h5.hpp>
+#include <jelly/io/detail/h5.hpp>
+#include <jelly/io/xdmf.hpp>
+#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/plane.hpp>
+#include <jelly/version.hpp>
+
+namespace jelly {
+
+void RecorderOptions::validate() const {
+  require(flush_every_frames >= 1, "flush_every_frames", flush_every_frames, "an integer >= 1");
+  require(compression_level >= 0 && compression_level <= 9, "compression_level", compression_level,
+          "an integer in 0..9 (0 = off)");
+}
+
+std::string xdmf_path_for(const std::string& h5_path) {
+  const size_t slash = h5_path.find_last_of('/');
+  const size_t dot = h5_path.find_last_of('.');
+  if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) {
+    return h5_path.substr(0, dot) + ".xdmf";
+  }
+  return h5_path + ".xdmf";
+}
+
+namespace {
+
+// The observables of DESIGN.md, computed from a frame's positions and velocities.
+struct ObservableSpec {
+  const char* name;
+  int width;  // 1 (scalar) or 3 (vector)
+  std::function<void(const Model&, const VecX& x, const VecX& v, double* out)> compute;
+};
+
+const std::vector<ObservableSpec>& observable_specs() {
+  static const std::vector<ObservableSpec> specs{
+      {"kinetic_energy", 1,
+       [](const Model& m, const VecX&, const VecX& v, double* o) { *o = kinetic_energy(m, v); }},
+      {"elastic_energy", 1,
+       [](const Model& m, const VecX& x, const VecX&, double* o) { *o = elastic_energy(m, x); }},
+      {"gravitational_energy", 1,
+       [](const Model& m, const VecX& x, const VecX&, double* o) {
+         *o = gravitational_energy(m, x);
+       }},
+      {"total_energy", 1,
+       [](const Model& m, const VecX& x, const VecX& v, double* o) {
+         *o = kinetic_energy(m, v) + elastic_energy(m, x) + gravitational_energy(m, x);
+       }},
+      {"center_of_mass", 3,
+       [](const Model& m, const VecX& x, const VecX&, double* o) {
+         Eigen::Map<Vec3>{o} = center_of_mass(m, x);
+       }},
+      {"linear_momentum", 3,
+       [](const Model& m, const VecX&, const VecX& v, double* o) {
+         Eigen::Map<Vec3>{o} = linear_momentum(m, v);
+       }},
+      {"angular_momentum", 3,
+       [](const Model& m, const VecX& x, const VecX& v, double* o) {
+         Eigen::Map<Vec3>{o} = angular_momentum(m, x, v);
+       }},
+  };
+  return specs;
+}
+
+// Frames waiting to be written: each array holds `frames` frames back to back.
+struct Batch {
+  hsize_t frames = 0;
+  std::vector<long> step;
+  std::vector<double> time, position, velocity;
+  std::vector<std::vector<double>> terrain;  // per terrain, 3 per frame
+  bool has_checkpoint = false;
+  SimulatorSnapshot checkpoint;
+
+  void clear() {
+    frames = 0;
+    step.clear();
+    time.clear();
+    position.clear();
+    velocity.clear();
+    for (auto& t : terrain) t.clear();
+    has_checkpoint = false;
+  }
+};
+
+// Frames per chunk of the particle series (a frame holds `values` numbers): the flush block, or
+// the largest divisor of it whose chunk fits in HDF5's 1 MiB chunk cache. A chunk then never
+// spans two flushes, so a flush writes whole new chunks and never rewrites (and moves) a
+// compressed chunk that the file on disk already points to: a killed run leaves intact chunks.
+hsize_t chunk_frames(size_t values, int flush_every) {
+  const size_t bytes = 8 * std::max<size_t>(values, 1);
+  for (int d = flush_every; d > 1; --d) {
+    if (flush_every % d == 0 && bytes * d <= (size_t{1} << 20)) return static_cast<hsize_t>(d);
+  }
+  return 1;
+}
+
+// The small series (clock, observables, terrain: 1 or 3 numbers a frame) are stored
+// uncompressed in chunks of this many frames: a chunk is allocated once and then filled in place,
+// flush after flush, instead of a new tiny compressed chunk per flush.
+constexpr hsize_t kSmallSeriesChunk = 256;
+
+std::string terrain_group_name(size_t index, const Terrain& terrain) {
+  return std::to_string(index) + "_" + std::string(terrain.kind());
+}
+
+}  // namespace
+
+struct H5Recorder::Impl {
+  std::string path;
+  RecorderOptions options;
+  Model model;
+  int n = 0;
+  h5::Handle file, parameters;
+  h5::Series step, time, position, velocity;
+  std::vector<h5::Series> observables, terrains;
+  std::unique_ptr<h5::CheckpointWriter> checkpoint;
+  std::vector<double> times;  // every frame's time, for the XDMF sidecar
+  long frames_received = 0;
+
+  // Writer-thread side: the HDF5 work and the observables happen there, under the library mutex.
+  VecX x_work, v_work;
+  std::vector<std::vector<double>> observable_work;
+
+  // Hand-off between on_frame (producer) and the writer thread (consumer).
+  std::unique_ptr<Batch> current;
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::deque<std::unique_ptr<Batch>> queue, spare;
+  bool writing = false, stopping = false;
+  std::exception_ptr error;
+  std::thread writer;
+
+  Impl(const std::string& p, const Simulator& sim, RecorderOptions o);
+  void write_static(const Simulator& sim);
+  void write_batch(Batch& batch);
+  void writer_loop();
+  void submit();
+  void drain();
+  void stop();
+  std::unique_ptr<Batch> take_spare();
+};
+
+H5Recorder::Impl::Impl(const std::string& p, const Simulator& sim, RecorderOptions o)
+    : path(p), options(std::move(o)), model(sim.model()), n(sim.model().num_particles()) {
+  options.validate();
+  if (options.integrator_name.empty()) options.integrator_name = sim.integrator().name();
+  {
+    std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
+    h5::QuietErrors quiet;
+    file = h5::create_file(path);
+    write_static(sim);
+    h5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + path);
+  }
+  current = take_spare();
+  current->terrain.resize(terrains.size());
+  if (options.background_writer) writer = std::thread([this] { writer_loop(); });
+}
+
+void H5Recorder::Impl::write_static(const Simulator& sim) {
+  const hid_t f = file.get();
+  {
+    h5::Handle h5md = h5::create_group(f, "h5md");
+    h5::write_attribute(h5md.get(), "version", std::vector<int>{1, 1});
+    h5::write_attribute(h5md.get(), "creator", std::string("jelly"));
+    h5::write_attribute(h5md.get(), "creator_version", std::string(JELLY_VERSION_STRING));
+  }
+  parameters = h5::create_group(f, "parameters");
+  const hid_t par = parameters.get();
+  h5::write_attribute(par, "scene_json", options.scene_json);
+  h5::write_attribute(par, "integrator", options.integrator_name);
+  h5::write_attribute(par, "dt", sim.options().dt);
+  h5::write_attribute(par, "output_interval", sim.options().output_interval);
+  h5::write_attribute(par, "library_version", std::string(JELLY_VERSION_STRING));
+  h5::write_attribute(par, "gravity",
+                      std::vector<double>(model.gravity.data(), model.gravity.data() + 3));
+  h5::write_attribute(par, "num_particles", static_cast<long>(n));
+  h5::write_attribute(par, "num_springs", static_cast<long>(model.springs.size()));
+  h5::write_attribute(par, "run_status", std::string("running"));
+
+  const hsize_t N = static_cast<hsize_t>(n);
+  h5::create_group(f, "particles");
+  h5::Handle jelly = h5::create_group(f, "particles/jelly");
+  h5::write_dataset(jelly.get(), "mass", {N}, model.mass.data());
+  h5::write_dataset(jelly.get(), "rest_position", {N, 3}, model.rest_position.data());
+  const int level = options.compression_level;
+  const int every = options.flush_every_frames;
+  const hsize_t frame_chunk = chunk_frames(3 * N, every);
+  {
+    h5::Handle g = h5::create_group(jelly.get(), "position");
+    step = h5::Series(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LONG, {}, kSmallSeriesChunk, 0);
+    time = h5::Series(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, kSmallSeriesChunk, 0);
+    position =
+        h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3}, frame_chunk, level);
+  }
+  // H5MD lets time-dependent groups sampled at the same frames share step and time by hard links.
+  const auto link_clock = [&](hid_t group) {
+    h5::hard_link(f, "/particles/jelly/position/step", group, "step");
+    h5::hard_link(f, "/particles/jelly/position/time", group, "time");
+  };
+  {
+    h5::Handle g = h5::create_group(jelly.get(), "velocity");
+    link_clock(g.get());
+    velocity =
+        h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3}, frame_chunk, level);
+  }
+
+  const Springs& s = model.springs;
+  const hsize_t M = static_cast<hsize_t>(s.size());
+  {
+    h5::Handle g = h5::create_group(f, "connectivity");
+    std::vector<int> pairs(2 * M), type(M);
+    for (hsize_t i = 0; i < M; ++i) {
+      pairs[2 * i] = s.a[i];
+      pairs[2 * i + 1] = s.b[i];
+      type[i] = static_cast<int>(s.type[i]);
+    }
+    h5::write_dataset(g.get(), "springs", {M, 2}, pairs.data());
+    h5::write_dataset(g.get(), "type", {M}, type.data());
+    h5::write_dataset(g.get(), "rest_length", {M}, s.rest_length.data());
+    h5::write_dataset(g.get(), "ks", {M}, s.ks.data());
+    h5::write_dataset(g.get(), "kd", {M}, s.kd.data());
+    h5::write_attribute(g.get(), "type_names", std::string("0 structural, 1 shear, 2 bending"));
+  }
+
+  {
+    h5::Handle g = h5::create_group(f, "observables");
+    for (const ObservableSpec& spec : observable_specs()) {
+      h5::Handle o = h5::create_group(g.get(), spec.name);
+      link_clock(o.get());
+      std::vector<hsize_t> shape;
+      if (spec.width > 1) shape.push_back(static_cast<hsize_t>(spec.width));
+      observables.emplace_back(o.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, shape,
+                               kSmallSeriesChunk, 0);
+      observable_work.emplace_back();
+    }
+  }
+
+  {
+    h5::Handle g = h5::create_group(f, "terrain");
+    for (size_t i = 0; i < sim.terrains().size(); ++i) {
+      const Terrain& terrain = *sim.terrains()[i];
+      h5::Handle t = h5::create_group(g.get(), terrain_group_name(i, terrain));
+      const Real t0 = sim.state().t;
+      const Vec3 p = terrain.position(t0), normal = terrain.normal(p, t0);
+      h5::write_attribute(t.get(), "kind", std::string(terrain.kind()));
+      h5::write_attribute(t.get(), "normal", std::vector<double>(normal.data(), normal.data() + 3));
+      h5::write_attribute(t.get(), "contact_model",
+                          std::string(contact_model_name(terrain.contact().model)));
+      h5::write_attribute(t.get(), "restitution", terrain.contact().restitution);
+      h5::write_attribute(t.get(), "friction", terrain.contact().friction);
+      if (const auto* elevator = dynamic_cast<const Elevator*>(&terrain)) {
+        h5::write_attribute(t.get(), "size_x", elevator->spec().size_x);
+        h5::write_attribute(t.get(), "size_z", elevator->spec().size_z);
+        h5::write_attribute(t.get(), "mass", elevator->spec().mass);
+      }
+      h5::Handle pos = h5::create_group(t.get(), "position");
+      link_clock(pos.get());
+      terrains.emplace_back(pos.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                            std::vector<hsize_t>{3}, kSmallSeriesChunk, 0);
+    }
+  }
+
+  checkpoint = std::make_unique<h5::CheckpointWriter>(f, n, std::string(sim.integrator().name()),
+                                                      sim.options().dt);
+}
+
+// Runs on the writer thread (or the caller's, without one), holding the library mutex.
+void H5Recorder::Impl::write_batch(Batch& batch) {
+  const hsize_t frames = batch.frames;
+  if (frames > 0) {
+    const Eigen::Index dofs = 3 * static_cast<Eigen::Index>(n);
+    const auto& specs = observable_specs();
+    for (size_t k = 0; k < specs.size(); ++k) observable_work[k].resize(frames * specs[k].width);
+    ensure_size(x_work, dofs);
+    ensure_size(v_work, dofs);
+    for (hsize_t f = 0; f < frames; ++f) {
+      std::memcpy(x_work.data(), batch.position.data() + f * dofs, sizeof(double) * dofs);
+      std::memcpy(v_work.data(), batch.velocity.data() + f * dofs, sizeof(double) * dofs);
+      for (size_t k = 0; k < specs.size(); ++k) {
+        specs[k].compute(model, x_work, v_work, observable_work[k].data() + f * specs[k].width);
+      }
+    }
+    step.append(batch.step.data(), frames);
+    time.append(batch.time.data(), frames);
+    position.append(batch.position.data(), frames);
+    velocity.append(batch.velocity.data(), frames);
+    for (size_t k = 0; k < specs.size(); ++k)
+      observables[k].append(observable_work[k].data(), frames);
+    for (size_t i = 0; i < terrains.size(); ++i)
+      terrains[i].append(batch.terrain[i].data(), frames);
+  }
+  if (batch.has_checkpoint) checkpoint->write(batch.checkpoint);
+  h5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + path);
+}
+
+void H5Recorder::Impl::writer_loop() {
+  std::unique_lock<std::mutex> lock(mutex);
+  for (;;) {
+    changed.wait(lock, [this] { return stopping || !queue.empty(); });
+    if (queue.empty()) return;  // stopping, nothing left
+    std::unique_ptr<Batch> batch = std::move(queue.front());
+    queue.pop_front();
+    writing = true;
+    lock.unlock();
+    std::exception_ptr failure;
+    if (!error) {
+      try {
+        std::lock_guard<std::recursive_mutex> library(h5::library_mutex());
+        h5::QuietErrors quiet;
+        write_batch(*batch);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+    }
+    batch->clear();
+    lock.lock();
+    if (failure && !error) error = failure;
+    spare.push_back(std::move(batch));
+    writing = false;
+    changed.notify_all();
+  }
+}
+
+std::unique_ptr<Batch> H5Recorder::Impl::take_spare() {
+  std::lock_guard<std::mutex> lock(mutex);
+  if (spare.empty()) {
+    auto batch = std::make_unique<Batch>();
+    batch->terrain.resize(terrains.size());
+    return batch;
+  }
+  std::unique_ptr<Batch> batch = std::move(spare.front());
+  spare.pop_front();
+  return batch;
+}
+
+// Hands the current batch to the writer (or writes it here) and starts a new one.
+void H5Recorder::Impl::submit() {
+  if (!options.background_writer) {
+    std::lock_guard<std::recursive_mutex> library(h5::library_mutex());
+    h5::QuietErrors quiet;
+    write_batch(*current);
+    current->clear();
+    return;
+  }
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    // At most two blocks wait: a writer slower than the run holds the run back, not memory.
+    changed.wait(lock, [this] { return queue.size() < 2 || error; });
+    if (error) std::rethrow_exception(error);
+    queue.push_back(std::move(current));
+    changed.notify_all();
+  }
+  current = take_spare();
+}
+
+// Waits until the writer has written everything submitted; rethrows its failure.
+void H5Recorder::Impl::drain() {
+  if (!options.background_writer) return;
+  std::unique_lock<std::mutex> lock(mutex);
+  changed.wait(lock, [this] { return queue.empty() && !writing; });
+  if (error) std::rethrow_exception(error);
+}
+
+void H5Recorder::Impl::stop() {
+  if (!writer.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    stopping = true;
+    changed.notify_all();
+  }
+  writer.join();
+}
+
+H5Recorder::H5Recorder(const std::string& path, const Simulator& sim, RecorderOptions options)
+    : impl_(std::make_unique<Impl>(path, sim, std::move(options))) {}
+
+H5Recorder::~H5Recorder() {
+  try {
+    if (impl_->current->frames > 0) impl_->submit();
+    impl_->drain();
+  } catch (...) {
+    // A destructor cannot report; on_finish does.
+  }
+  impl_->stop();
+  std::lock_guard<std::recursive_mutex> library(h5::library_mutex());
+  h5::QuietErrors quiet;
+  impl_.reset();  // closes every handle, then the file
+}
+
+void H5Recorder::on_frame(const Simulator& sim) {
+  Impl& m = *impl_;
+  Batch& b = *m.current;
+  const State& s = sim.state();
+  b.step.push_back(sim.total_steps());
+  b.time.push_back(s.t);
+  b.position.insert(b.position.end(), s.x.data(), s.x.data() + s.x.size());
+  b.velocity.insert(b.velocity.end(), s.v.data(), s.v.data() + s.v.size());
+  for (size_t i = 0; i < m.terrains.size(); ++i) {
+    const Vec3 p = sim.terrains()[i]->position(s.t);
+    b.terrain[i].insert(b.terrain[i].end(), p.data(), p.data() + 3);
+  }
+  ++b.frames;
+  m.times.push_back(s.t);
+  ++m.frames_received;
+  if (static_cast<int>(b.frames) >= m.options.flush_every_frames) {
+    b.checkpoint = sim.snapshot();
+    b.has_checkpoint = true;
+    m.submit();
+  }
+}
+
+void H5Recorder::on_finish(const Simulator& sim, const RunReport& report) {
+  Impl& m = *impl_;
+  m.current->checkpoint = sim.snapshot();
+  m.current->has_checkpoint = true;
+  m.submit();
+  m.drain();
+  {
+    std::lock_guard<std::recursive_mutex> library(h5::library_mutex());
+    h5::QuietErrors quiet;
+    const hid_t par = m.parameters.get();
+    h5::write_attribute(par, "run_status", std::string(run_status_name(report.status)));
+    h5::write_attribute(par, "run_reason", report.reason);
+    h5::write_attribute(par, "run_t", report.t);
+    h5::write_attribute(par, "run_steps", report.steps);
+    h5::write_attribute(par, "run_wall_seconds", report.wall_seconds);
+    h5::write_attribute(par, "run_force_evaluations", report.force_evaluations);
+    h5::write_attribute(par, "total_steps", sim.total_steps());
+    for (const auto& [name, value] : report.statistics) {
+      h5::write_attribute(par, "statistics." + name, value);
+    }
+    h5::check(H5Fflush(m.file.get(), H5F_SCOPE_GLOBAL), "flush " + m.path);
+  }
+  if (m.options.write_xdmf) {
+    XdmfLayout layout;
+    const size_t slash = m.path.find_last_of('/');
+    layout.h5_file = slash == std::string::npos ? m.path : m.path.substr(slash + 1);
+    layout.num_particles = m.n;
+    layout.num_springs = m.model.springs.size();
+    layout.times = m.times;
+    write_xdmf(xdmf_path_for(m.path), layout);
+  }
+}
+
+const std::string& H5Recorder::path() const { return impl_->path; }
+long H5Recorder::frames() const { return impl_->frames_received; }
+
+}  // namespace jelly
