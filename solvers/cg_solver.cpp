@@ -71,6 +71,22 @@ LinearResult CgSolver::analyze(const SparseMatrix& a) {
     }
     inverse_blocks_.assign(block3_ ? 3 * static_cast<size_t>(n) : 0, 0.0);
   }
+  upper_start_.assign(1, 0);
+  upper_row_.clear();
+  upper_source_.clear();
+  if (block3_) {
+    const int* outer = a.outerIndexPtr();
+    const int* inner = a.innerIndexPtr();
+    for (Eigen::Index j = 0; j < n; j += 3) {
+      for (int q = outer[j]; q < outer[j + 1]; q += 3) {
+        if (inner[q] > j) break;  // rows are sorted: the rest is below the diagonal
+        upper_row_.push_back(inner[q] / 3);
+        upper_source_.push_back(q);
+      }
+      upper_start_.push_back(static_cast<int>(upper_row_.size()));
+    }
+    upper_values_.assign(9 * upper_row_.size(), 0.0);
+  }
   ++counters_.analyses;
   if (factor_) {
     LinearResult r = factor_->analyze(a);
@@ -84,6 +100,20 @@ LinearResult CgSolver::factorize(const SparseMatrix& a) {
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CG: factorize: the matrix does not have the analysed size");
   a_ = &a;
+  if (block3_) {
+    const int* outer = a.outerIndexPtr();
+    const Real* values = a.valuePtr();
+    const int blocks_per_row = static_cast<int>(upper_start_.size()) - 1;
+    for (int j = 0; j < blocks_per_row; ++j) {
+      const int s = outer[3 * j + 1] - outer[3 * j];
+      for (int k = upper_start_[j]; k < upper_start_[j + 1]; ++k) {
+        const Real* src = values + upper_source_[k];
+        Real* dst = &upper_values_[9 * static_cast<size_t>(k)];
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) dst[3 * r + c] = src[c * s + r];
+      }
+    }
+  }
   if (!factor_) {
     if (block3_) {
       const int* outer = a.outerIndexPtr();
@@ -139,37 +169,40 @@ LinearResult CgSolver::factorize(const SparseMatrix& a) {
 }
 
 void CgSolver::multiply(const VecX& x, VecX& y) const {
-  const SparseMatrix& a = *a_;
   if (!block3_) {
-    y.noalias() = a * x;
+    y.noalias() = *a_ * x;
     return;
   }
-  // A is symmetric, so y_j = (column j) . x: a gather, and columns 3j..3j+2 share their rows,
-  // so one index load serves three values.
-  const int* outer = a.outerIndexPtr();
-  const int* inner = a.innerIndexPtr();
-  const Real* values = a.valuePtr();
+  // Upper block triangle only: block (i, j), i < j, adds B x_j to y_i and B^T x_i to y_j.
   const Real* px = x.data();
   Real* py = y.data();
-  const Eigen::Index n = a.cols();
-  for (Eigen::Index j = 0; j < n; j += 3) {
-    const int base = outer[j];
-    const int s = outer[j + 1] - base;
-    const Real* v0 = values + base;
-    const Real* v1 = v0 + s;
-    const Real* v2 = v1 + s;
-    const int* rows = inner + base;
-    Real y0 = 0, y1 = 0, y2 = 0;
-    for (int q = 0; q < s; q += 3) {
-      const Real* xr = px + rows[q];
-      const Real xa = xr[0], xb = xr[1], xc = xr[2];
-      y0 += v0[q] * xa + v0[q + 1] * xb + v0[q + 2] * xc;
-      y1 += v1[q] * xa + v1[q + 1] * xb + v1[q + 2] * xc;
-      y2 += v2[q] * xa + v2[q + 1] * xb + v2[q + 2] * xc;
+  y.setZero();
+  const int blocks_per_row = static_cast<int>(upper_start_.size()) - 1;
+  const Real* b = upper_values_.data();
+  for (int j = 0; j < blocks_per_row; ++j) {
+    const Real xj0 = px[3 * j], xj1 = px[3 * j + 1], xj2 = px[3 * j + 2];
+    Real yj0 = 0, yj1 = 0, yj2 = 0;
+    const int end = upper_start_[j + 1];
+    for (int k = upper_start_[j]; k < end; ++k, b += 9) {
+      const int i = upper_row_[k];
+      if (i == j) {
+        yj0 += b[0] * xj0 + b[1] * xj1 + b[2] * xj2;
+        yj1 += b[3] * xj0 + b[4] * xj1 + b[5] * xj2;
+        yj2 += b[6] * xj0 + b[7] * xj1 + b[8] * xj2;
+        continue;
+      }
+      Real* yi = py + 3 * i;
+      const Real* xi = px + 3 * i;
+      yi[0] += b[0] * xj0 + b[1] * xj1 + b[2] * xj2;
+      yi[1] += b[3] * xj0 + b[4] * xj1 + b[5] * xj2;
+      yi[2] += b[6] * xj0 + b[7] * xj1 + b[8] * xj2;
+      yj0 += b[0] * xi[0] + b[3] * xi[1] + b[6] * xi[2];
+      yj1 += b[1] * xi[0] + b[4] * xi[1] + b[7] * xi[2];
+      yj2 += b[2] * xi[0] + b[5] * xi[1] + b[8] * xi[2];
     }
-    py[j] = y0;
-    py[j + 1] = y1;
-    py[j + 2] = y2;
+    py[3 * j] += yj0;
+    py[3 * j + 1] += yj1;
+    py[3 * j + 2] += yj2;
   }
 }
 
