@@ -243,8 +243,9 @@ void BM_ImplicitStep(benchmark::State& st) {
   st.counters["assembly_ms/step"] = 1e3 * per_step("assembly_seconds");
   st.counters["factor_ms/step"] = 1e3 * per_step("factorization_seconds");
   st.counters["solve_ms/step"] = 1e3 * per_step("solve_seconds");
-  st.SetLabel(backend + " -> " +
-              std::string(static_cast<const ImplicitEuler&>(sim.integrator()).linear_solver_name()));
+  st.SetLabel(
+      backend + " -> " +
+      std::string(static_cast<const ImplicitEuler&>(sim.integrator()).linear_solver_name()));
 }
 
 void orderings(benchmark::internal::Benchmark* b) {

@@ -60,9 +60,9 @@ class SpringJacobian {
 
  private:
   int num_particles_ = 0;
-  std::vector<int> col_start_;    // [3N + 1]
-  std::vector<int> row_index_;    // [nnz]
-  std::vector<int> spring_base_;  // [4 M]: value index of entry (0, 0) of blocks aa, ab, ba, bb
+  std::vector<int> col_start_;      // [3N + 1]
+  std::vector<int> row_index_;      // [nnz]
+  std::vector<int> spring_base_;    // [4 M]: value index of entry (0, 0) of blocks aa, ab, ba, bb
   std::vector<int> column_stride_;  // [N]: distance between columns 3j and 3j + 1 of particle j
   std::vector<int> diagonal_;       // [3N]: value index of entry (i, i)
 };

@@ -129,9 +129,9 @@ LinearResult CgSolver::factorize(const SparseMatrix& a) {
         block.computeInverseWithCheck(inverse, invertible);
         if (!invertible || !(block(0, 0) > 0 && block(1, 1) > 0 && block(2, 2) > 0)) {
           a_ = nullptr;
-          return LinearResult::failure(LinearStatus::kNotPositiveDefinite,
-                                       "CG: diagonal block " + std::to_string(i + 1) +
-                                           " is not positive definite");
+          return LinearResult::failure(
+              LinearStatus::kNotPositiveDefinite,
+              "CG: diagonal block " + std::to_string(i + 1) + " is not positive definite");
         }
         std::copy(inverse.data(), inverse.data() + 9, &inverse_blocks_[9 * i]);
       }
@@ -141,9 +141,9 @@ LinearResult CgSolver::factorize(const SparseMatrix& a) {
       const Real d = a.coeff(j, j);
       if (!(d > 0)) {
         a_ = nullptr;
-        return LinearResult::failure(LinearStatus::kNotPositiveDefinite,
-                                     "CG: diagonal entry " + std::to_string(j + 1) +
-                                         " is not positive");
+        return LinearResult::failure(
+            LinearStatus::kNotPositiveDefinite,
+            "CG: diagonal entry " + std::to_string(j + 1) + " is not positive");
       }
       inverse_diagonal_[j] = 1.0 / d;
     }
@@ -247,8 +247,8 @@ LinearResult CgSolver::run(const VecX& b, VecX& x, int max_iterations) {
       if (!(curvature > 0)) {
         result = LinearResult::failure(
             LinearStatus::kNotPositiveDefinite,
-            "CG: non-positive curvature p^T A p = " + std::to_string(curvature) +
-                " at iteration " + std::to_string(k + 1) + ": matrix not positive definite");
+            "CG: non-positive curvature p^T A p = " + std::to_string(curvature) + " at iteration " +
+                std::to_string(k + 1) + ": matrix not positive definite");
         break;
       }
       const Real alpha = rz / curvature;
@@ -268,11 +268,10 @@ LinearResult CgSolver::run(const VecX& b, VecX& x, int max_iterations) {
   result.iterations = k;
   result.residual = r_norm / b_norm;
   if (result.ok() && !(r_norm <= target)) {
-    result = LinearResult::failure(
-        LinearStatus::kNotConverged,
-        "CG: relative residual " + std::to_string(r_norm / b_norm) + " after " +
-            std::to_string(k) + " iterations (tolerance " + std::to_string(options_.tolerance) +
-            ")");
+    result = LinearResult::failure(LinearStatus::kNotConverged,
+                                   "CG: relative residual " + std::to_string(r_norm / b_norm) +
+                                       " after " + std::to_string(k) + " iterations (tolerance " +
+                                       std::to_string(options_.tolerance) + ")");
     result.iterations = k;
     result.residual = r_norm / b_norm;
   }
@@ -288,9 +287,9 @@ LinearResult CgSolver::solve(const VecX& b, VecX& x) {
   ++counters_.solves;
   const double start = factor_ ? thread_seconds() : 0;
   // With a lagged factor, give up early: a fresh factorization is cheaper than many iterations.
-  const int first_limit =
-      factor_ && !fresh_ ? std::min(options_.max_iterations, options_.lagged_iteration_limit)
-                         : options_.max_iterations;
+  const int first_limit = factor_ && !fresh_
+                              ? std::min(options_.max_iterations, options_.lagged_iteration_limit)
+                              : options_.max_iterations;
   LinearResult result = run(b, x, first_limit);
   if (factor_ && !fresh_ && result.status == LinearStatus::kNotConverged) {
     // The lagged factor is too far from A: refactor now and solve again.

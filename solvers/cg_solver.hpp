@@ -48,13 +48,13 @@ class CgSolver final : public LinearSolver {
   void multiply(const VecX& x, VecX& y) const;  // y = A x
 
   bool block3_ = false;  // columns 3j, 3j + 1, 3j + 2 share one row pattern (3x3 blocks)
-  std::vector<int> diagonal_block_;  // [N]: value index of diagonal block (0, 0), when block3_
+  std::vector<int> diagonal_block_;     // [N]: value index of diagonal block (0, 0), when block3_
   std::vector<double> inverse_blocks_;  // [9 N]: inverses of the 3x3 diagonal blocks
   // Upper block triangle of A (block3_): for column block j, blocks (i, j) with i <= j, each
   // 9 values row-major; half the memory traffic of the full matrix per mat-vec.
-  std::vector<int> upper_start_;   // [N + 1] first block of column block j
-  std::vector<int> upper_row_;     // [blocks] row block i
-  std::vector<int> upper_source_;  // [blocks] value index of entry (0, 0) of the block in A
+  std::vector<int> upper_start_;    // [N + 1] first block of column block j
+  std::vector<int> upper_row_;      // [blocks] row block i
+  std::vector<int> upper_source_;   // [blocks] value index of entry (0, 0) of the block in A
   std::vector<Real> upper_values_;  // [9 blocks]
   double factor_seconds_ = 0;       // CPU time of the last refresh of the lagged factor
   double lagged_seconds_ = 0;       // ... plus the CPU time of the solves since

@@ -37,20 +37,23 @@ LinearResult from_status(int status, const std::string& what) {
       // A warning: the factorization succeeded but a diagonal entry of L is tiny.
       return {};
     case CHOLMOD_OUT_OF_MEMORY:
-      return LinearResult::failure(LinearStatus::kOutOfMemory, "CHOLMOD: " + what + ": out of memory");
+      return LinearResult::failure(LinearStatus::kOutOfMemory,
+                                   "CHOLMOD: " + what + ": out of memory");
     case CHOLMOD_TOO_LARGE:
       return LinearResult::failure(LinearStatus::kOutOfMemory,
                                    "CHOLMOD: " + what + ": problem too large (integer overflow)");
     case CHOLMOD_INVALID:
-      return LinearResult::failure(LinearStatus::kInvalidInput, "CHOLMOD: " + what + ": invalid input");
+      return LinearResult::failure(LinearStatus::kInvalidInput,
+                                   "CHOLMOD: " + what + ": invalid input");
     case CHOLMOD_NOT_INSTALLED:
       return LinearResult::failure(LinearStatus::kFailure,
                                    "CHOLMOD: " + what + ": method not installed");
     case CHOLMOD_GPU_PROBLEM:
       return LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: " + what + ": GPU problem");
     default:
-      return LinearResult::failure(LinearStatus::kFailure,
-                                   "CHOLMOD: " + what + ": unknown status " + std::to_string(status));
+      return LinearResult::failure(
+          LinearStatus::kFailure,
+          "CHOLMOD: " + what + ": unknown status " + std::to_string(status));
   }
 }
 
@@ -153,8 +156,9 @@ LinearResult CholmodSolver::factorize(const SparseMatrix& a) {
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CHOLMOD: factorize called before analyze");
   if (a.rows() != m.rows || a.nonZeros() != m.nnz || !a.isCompressed())
-    return LinearResult::failure(LinearStatus::kInvalidInput,
-                                 "CHOLMOD: factorize: the matrix does not have the analysed pattern");
+    return LinearResult::failure(
+        LinearStatus::kInvalidInput,
+        "CHOLMOD: factorize: the matrix does not have the analysed pattern");
   m.wrap(a);
   m.factorized = false;
   m.common.status = CHOLMOD_OK;
@@ -162,11 +166,10 @@ LinearResult CholmodSolver::factorize(const SparseMatrix& a) {
   ++counters_.factorizations;
   const int status = m.common.status;
   if (status == CHOLMOD_NOT_POSDEF || m.factor->minor < m.factor->n) {
-    return LinearResult::failure(
-        LinearStatus::kNotPositiveDefinite,
-        "CHOLMOD: matrix not positive definite (leading minor of order " +
-            std::to_string(m.factor->minor + 1) + " of " + std::to_string(m.factor->n) +
-            " is not positive)");
+    return LinearResult::failure(LinearStatus::kNotPositiveDefinite,
+                                 "CHOLMOD: matrix not positive definite (leading minor of order " +
+                                     std::to_string(m.factor->minor + 1) + " of " +
+                                     std::to_string(m.factor->n) + " is not positive)");
   }
   LinearResult r = from_status(status, "factorize");
   if (r.ok() && !ok) r = LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: factorize failed");
@@ -191,8 +194,8 @@ LinearResult CholmodSolver::solve(const VecX& b, VecX& x) {
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
   m.common.status = CHOLMOD_OK;
-  const int ok = cholmod_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.x, nullptr, &m.y, &m.e,
-                                &m.common);
+  const int ok =
+      cholmod_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.x, nullptr, &m.y, &m.e, &m.common);
   ++counters_.solves;
   LinearResult r = from_status(m.common.status, "solve");
   if (r.ok() && !ok) r = LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: solve failed");

@@ -91,10 +91,10 @@ StepResult ImplicitEuler::prepare(const Model& model, Real h) {
       solver_ = std::make_unique<LdltSolver>();
     } else {
       CgOptions cg;
-      cg.preconditioner = kind == "cg_lagged_cholmod" ||
-                                  (kind == "cg" && options_.cg_preconditioner == "cholmod")
-                              ? CgPreconditioner::kLaggedCholesky
-                              : CgPreconditioner::kJacobi;
+      cg.preconditioner =
+          kind == "cg_lagged_cholmod" || (kind == "cg" && options_.cg_preconditioner == "cholmod")
+              ? CgPreconditioner::kLaggedCholesky
+              : CgPreconditioner::kJacobi;
       cg.tolerance = options_.cg_tolerance;
       cg.max_iterations = options_.cg_max_iterations;
       cg.refactor_iterations = options_.refactor_iterations;
@@ -132,9 +132,9 @@ StepResult ImplicitEuler::solve(const Model& model, const VecX& x, const VecX& v
     r = solver_->solve(b, y);
     solve_seconds_ += seconds_since(start);
   }
-  if (!r.ok()) return StepResult::failure("implicit_euler: linear solve failed (" +
-                                          std::string(linear_status_name(r.status)) +
-                                          "): " + r.message);
+  if (!r.ok())
+    return StepResult::failure("implicit_euler: linear solve failed (" +
+                               std::string(linear_status_name(r.status)) + "): " + r.message);
   if (!y.allFinite())
     return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
   if (r.iterations > 0) restore_momentum(model.mass, b, y);
@@ -170,9 +170,8 @@ StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
   }
   if (!lr.ok()) {
     have_dv_ = false;
-    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(s.t) +
-                               " (" + std::string(linear_status_name(lr.status)) +
-                               "): " + lr.message);
+    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(s.t) + " (" +
+                               std::string(linear_status_name(lr.status)) + "): " + lr.message);
   }
   if (!dv_.allFinite()) {
     have_dv_ = false;

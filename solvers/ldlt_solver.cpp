@@ -27,8 +27,8 @@ LinearResult LdltSolver::factorize(const SparseMatrix& a) {
   if (!(ldlt_.vectorD()[worst] > 0))
     return LinearResult::failure(LinearStatus::kNotPositiveDefinite,
                                  "LDLT: matrix not positive definite (pivot " +
-                                     std::to_string(worst + 1) + " of " +
-                                     std::to_string(a.rows()) + " is not positive)");
+                                     std::to_string(worst + 1) + " of " + std::to_string(a.rows()) +
+                                     " is not positive)");
   factorized_ = true;
   return {};
 }

@@ -15,8 +15,8 @@ enum class LinearStatus {
   kNotPositiveDefinite,  // a non-positive pivot (direct) or curvature (CG)
   kNotConverged,         // CG reached its iteration limit
   kOutOfMemory,
-  kInvalidInput,         // wrong sizes, solve before factorize, CHOLMOD_INVALID, ...
-  kFailure,              // anything else the backend reports
+  kInvalidInput,  // wrong sizes, solve before factorize, CHOLMOD_INVALID, ...
+  kFailure,       // anything else the backend reports
 };
 std::string_view linear_status_name(LinearStatus status);
 

@@ -65,7 +65,8 @@ Real relative_error(const Dense& a, const Dense& b) { return (a - b).norm() / b.
 
 // With no definiteness fix and the exact damper term, K and D are the exact df/dx and df/dv.
 TEST(SpringJacobian, ExactJacobiansMatchCentralDifferences) {
-  for (const auto& [ks, kd] : {std::pair<Real, Real>{1400, 50}, {100000, 50}, {10, 20}, {2400, 120}}) {
+  for (const auto& [ks, kd] :
+       {std::pair<Real, Real>{1400, 50}, {100000, 50}, {10, 20}, {2400, 120}}) {
     const Model model = cube_model(ks, kd);
     for (int seed : {1, 2, 3}) {
       const State s = random_state(model, seed);

@@ -72,8 +72,8 @@ TEST(LinearSolvers, BackendsAgreeOnTheSameSystem) {
     CholmodSolver reference;
     const VecX x = solve_with(reference, s);
     EXPECT_LT((s.a * x - s.b).norm(), 1e-13 * s.b.norm());
-    for (CholmodOrdering o : {CholmodOrdering::kAmd, CholmodOrdering::kNesdis,
-                              CholmodOrdering::kBest}) {
+    for (CholmodOrdering o :
+         {CholmodOrdering::kAmd, CholmodOrdering::kNesdis, CholmodOrdering::kBest}) {
       CholmodOptions options;
       options.ordering = o;
       options.supernodal = o != CholmodOrdering::kAmd;  // also the simplicial path
@@ -135,8 +135,8 @@ TEST(LinearSolvers, NotPositiveDefiniteIsAStatus) {
   if (c.ok()) c = cg.solve(s.b, x);
   EXPECT_EQ(c.status, LinearStatus::kNotPositiveDefinite) << c.message;
   // With the default fix the same state is fine.
-  const System fixed = backward_euler_system(4, 100000, 1.0 / 30,
-                                             DefinitenessFix::kClampCompressed, 0.4);
+  const System fixed =
+      backward_euler_system(4, 100000, 1.0 / 30, DefinitenessFix::kClampCompressed, 0.4);
   CholmodSolver ok;
   ASSERT_TRUE(ok.analyze(fixed.a).ok());
   EXPECT_TRUE(ok.factorize(fixed.a).ok());
@@ -295,12 +295,12 @@ struct Material {
 
 struct SceneOutcome {
   RunReport report;
-  Real deepest = 0;        // most negative signed distance to the terrain seen (m)
-  Real worst_growth = 0;   // largest energy increase between frames (J)
-  Real energy_scale = 0;   // initial |kinetic + elastic + gravitational| (J)
-  Real initial = 0;        // initial energy (J)
-  Real highest = -1e300;   // highest energy seen (J)
-  Real final_energy = 0;   // energy at the end (J)
+  Real deepest = 0;       // most negative signed distance to the terrain seen (m)
+  Real worst_growth = 0;  // largest energy increase between frames (J)
+  Real energy_scale = 0;  // initial |kinetic + elastic + gravitational| (J)
+  Real initial = 0;       // initial energy (J)
+  Real highest = -1e300;  // highest energy seen (J)
+  Real final_energy = 0;  // energy at the end (J)
 };
 
 enum class Scene { kSlope, kElevator, kFree };
