@@ -70,11 +70,12 @@ struct CholmodSolver::Impl {
   int rows = 0;
   long nnz = 0;
 
-  explicit Impl(const CholmodOptions& options) {
+  CholmodOptions options;
+
+  explicit Impl(const CholmodOptions& o) : options(o) {
     cholmod_start(&common);
     common.print = 0;
     common.error_handler = &silent_error_handler;
-    common.supernodal = options.supernodal ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
     common.final_ll = 1;
     switch (options.ordering) {
       case CholmodOrdering::kAmd:
@@ -138,6 +139,8 @@ LinearResult CholmodSolver::analyze(const SparseMatrix& a) {
   impl_->free_all();
   impl_->wrap(a);
   impl_->common.status = CHOLMOD_OK;
+  impl_->common.supernodal =
+      a.rows() >= impl_->options.supernodal_min_rows ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
   impl_->factor = cholmod_analyze(&impl_->view, &impl_->common);
   ++counters_.analyses;
   if (impl_->factor == nullptr) {

@@ -20,7 +20,12 @@ struct CholmodOptions {
   // Measured on the seed cube (docs/implicit.md): METIS gives the least fill and the fastest
   // factorization there.
   CholmodOrdering ordering = CholmodOrdering::kMetis;
-  bool supernodal = true;  // supernodal (BLAS-3) rather than simplicial factorization
+  // Supernodal (BLAS-3) factorization from this many unknowns on; simplicial (no BLAS) below,
+  // where BLAS calls, and OpenBLAS waking its threads on a busy machine, cost more than they
+  // save (a 64-particle cube on a loaded 2-core machine: supernodal 45 ms per step with
+  // OpenBLAS's default threads, 1.2 ms with one thread; simplicial 0.5 ms either way).
+  // 0 = always supernodal; a huge value = always simplicial.
+  int supernodal_min_rows = 1000;
 };
 
 class CholmodSolver final : public LinearSolver {
