@@ -15,6 +15,7 @@ void add_spring_forces(const Model& model, const VecX& x, const VecX& v, VecX& f
   const Real* kd = s.kd.data();
   const Real* px = x.data();
   const Real* pv = v.data();
+  const Real* pr = model.rest_position.data();
   Real* pf = f.data();
   // Springs are stored grouped by their first particle (build_cube does so): while a repeats, its
   // position and velocity stay in registers and its force is summed there, which halves the
@@ -36,17 +37,23 @@ void add_spring_forces(const Model& model, const VecX& x, const VecX& v, VecX& f
       xa = px[ia], ya = px[ia + 1], za = px[ia + 2];
       ua = pv[ia], va = pv[ia + 1], wa = pv[ia + 2];
     }
-    const Real dx = xa - px[ib];
-    const Real dy = ya - px[ib + 1];
-    const Real dz = za - px[ib + 2];
+    Real dx = xa - px[ib];
+    Real dy = ya - px[ib + 1];
+    Real dz = za - px[ib + 2];
     const Real length = std::sqrt(dx * dx + dy * dy + dz * dz);
-    const Real inv = 1.0 / length;
-    // (va - vb) . d |xa - xb|: the closing speed times the length.
-    const Real closing_times_length =
-        (ua - pv[ib]) * dx + (va - pv[ib + 1]) * dy + (wa - pv[ib + 2]) * dz;
-    // magnitude / |xa - xb|, so that the force is scale * (xa - xb).
-    const Real scale = (-ks[k] * (length - rest[k]) - kd[k] * closing_times_length * inv) * inv;
-    const Real fx = scale * dx, fy = scale * dy, fz = scale * dz;
+    Real inv = 1.0 / length;
+    if (!(length > kDegenerateLength * rest[k])) {
+      // Coincident particles (e.g. two projected onto one contact point): no direction, so the
+      // spring pushes along its rest direction instead of producing NaN.
+      dx = pr[ia] - pr[ib];
+      dy = pr[ia + 1] - pr[ib + 1];
+      dz = pr[ia + 2] - pr[ib + 2];
+      inv = 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
+    }
+    const Real ux = dx * inv, uy = dy * inv, uz = dz * inv;
+    const Real closing = (ua - pv[ib]) * ux + (va - pv[ib + 1]) * uy + (wa - pv[ib + 2]) * uz;
+    const Real magnitude = -ks[k] * (length - rest[k]) - kd[k] * closing;
+    const Real fx = magnitude * ux, fy = magnitude * uy, fz = magnitude * uz;
     sum_x += fx;
     sum_y += fy;
     sum_z += fz;
