@@ -1,0 +1,327 @@
+#include <jelly/fit/spring_fit.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include <ceres/ceres.h>
+#include <ceres/covariance.h>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/solvers/simulator.hpp>
+
+namespace jelly {
+
+namespace {
+
+constexpr std::array<SpringType, kSpringTypeCount> kTypes{
+    SpringType::kStructural, SpringType::kShear, SpringType::kBending};
+
+// Frames [first, last] of the recording: replayed from frame `first`, compared at the others.
+struct Window {
+  int first = 0;
+  int last = 0;
+};
+
+std::vector<Window> make_windows(const Trajectory& trajectory, Real length) {
+  std::vector<Window> windows;
+  const int last = trajectory.frames() - 1;
+  const Real slack = 1e-9 * std::max<Real>(1, std::abs(trajectory.times[last]));
+  int first = 0;
+  while (first < last) {
+    int end = first + 1;
+    if (length == 0) {
+      end = last;
+    } else {
+      while (end < last && trajectory.times[end + 1] - trajectory.times[first] <= length + slack)
+        ++end;
+    }
+    windows.push_back({first, end});
+    first = end;
+  }
+  return windows;
+}
+
+void set_parameter(Model& model, const FitParameter& p, Real value) {
+  Springs& s = model.springs;
+  std::vector<Real>& target = p.quantity == FitParameter::Quantity::kKs ? s.ks : s.kd;
+  for (int j = 0; j < s.size(); ++j)
+    if (p.applies_to(s.type[j])) target[j] = value;
+}
+
+// Replays one window with the model's coefficients and writes x_replay - x_recorded for each
+// compared frame into `residuals`. Returns false if the integrator fails or the state blows up.
+bool replay_window(const Trajectory& trajectory, const Model& model, const Window& w,
+                   double* residuals) {
+  SimulatorOptions options;
+  options.dt = trajectory.dt;
+  Simulator sim(model, trajectory.state(w.first),
+                make_fit_integrator(trajectory.integrator, trajectory.integrator_options), options);
+  for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
+  const Eigen::Index n = model.num_dofs();
+  for (int k = w.first + 1; k <= w.last; ++k) {
+    const long steps =
+        std::lround((trajectory.times[k] - trajectory.times[k - 1]) / trajectory.dt);
+    for (long i = 0; i < steps; ++i)
+      if (!sim.step().ok) return false;
+    if (!sim.state().x.allFinite()) return false;
+    Eigen::Map<VecX>(residuals + (k - w.first - 1) * n, n) = sim.state().x - trajectory.positions[k];
+  }
+  return true;
+}
+
+// The residuals of one window as a function of the log-coefficients (Ceres numeric diff).
+class WindowResiduals {
+ public:
+  WindowResiduals(const Trajectory& trajectory, const std::vector<FitParameter>& free, Window w,
+                  std::atomic<long>& replays)
+      : trajectory_(&trajectory), free_(&free), window_(w), replays_(&replays) {}
+
+  bool operator()(double const* const* parameters, double* residuals) const {
+    Model model = trajectory_->model;
+    for (size_t p = 0; p < free_->size(); ++p)
+      set_parameter(model, (*free_)[p], std::exp(parameters[0][p]));
+    ++*replays_;
+    return replay_window(*trajectory_, model, window_, residuals);
+  }
+
+ private:
+  const Trajectory* trajectory_;
+  const std::vector<FitParameter>* free_;
+  Window window_;
+  std::atomic<long>* replays_;
+};
+
+Real mean_coefficient(const Model& model, const FitParameter& p) {
+  const Springs& s = model.springs;
+  Real sum = 0;
+  int count = 0;
+  for (int j = 0; j < s.size(); ++j) {
+    if (!p.applies_to(s.type[j])) continue;
+    sum += p.quantity == FitParameter::Quantity::kKs ? s.ks[j] : s.kd[j];
+    ++count;
+  }
+  return count > 0 ? sum / count : 0;
+}
+
+}  // namespace
+
+std::string FitParameter::name() const {
+  std::string n = quantity == Quantity::kKs ? "ks" : "kd";
+  if (type) n += "." + std::string(spring_type_name(*type));
+  return n;
+}
+
+std::vector<FitParameter> parse_free_parameters(std::string_view list) {
+  std::vector<FitParameter> result;
+  const std::string allowed =
+      "a comma-separated list of ks, kd, ks.structural, ks.shear, ks.bending, kd.structural, "
+      "kd.shear, kd.bending, without overlaps";
+  size_t start = 0;
+  while (start <= list.size()) {
+    const size_t comma = std::min(list.find(',', start), list.size());
+    std::string_view item = list.substr(start, comma - start);
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
+    FitParameter p;
+    const std::string_view quantity = item.substr(0, item.find('.'));
+    require(quantity == "ks" || quantity == "kd", "free", std::string(list), allowed);
+    p.quantity = quantity == "ks" ? FitParameter::Quantity::kKs : FitParameter::Quantity::kKd;
+    if (item.size() > 2) {
+      bool known = false;
+      for (SpringType t : kTypes) {
+        if (item.substr(3) == spring_type_name(t) && item[2] == '.') {
+          p.type = t;
+          known = true;
+        }
+      }
+      require(known, "free", std::string(list), allowed);
+    }
+    for (const FitParameter& q : result) {
+      const bool overlap = q.quantity == p.quantity && (!q.type || !p.type || *q.type == *p.type);
+      require(!overlap, "free", std::string(list), allowed);
+    }
+    result.push_back(p);
+    start = comma + 1;
+  }
+  return result;
+}
+
+void FitOptions::validate() const {
+  require(!free.empty(), "free", "(empty)", "at least one free coefficient");
+  for (const auto& [name, value] : initial) {
+    bool known = false;
+    for (const FitParameter& p : free) known = known || p.name() == name;
+    require(known, "initial." + name, value, "a value for one of the free parameters");
+    require(std::isfinite(value) && value > 0, "initial." + name, value,
+            "a finite value > 0 (the fit works on the logarithm)");
+  }
+  require(std::isfinite(window) && window >= 0, "window", window,
+          "a finite length >= 0 s (0 = the whole recording)");
+  require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
+  require(function_tolerance >= 0 && gradient_tolerance >= 0 && parameter_tolerance >= 0,
+          "tolerance", std::min({function_tolerance, gradient_tolerance, parameter_tolerance}),
+          ">= 0");
+  require(relative_step > 0 && relative_step < 0.1, "relative_step", relative_step,
+          "in (0, 0.1)");
+  require(num_threads >= 1, "num_threads", num_threads, ">= 1");
+}
+
+const FittedParameter& FitResult::at(std::string_view name) const {
+  for (const FittedParameter& p : parameters)
+    if (p.name == name) return p;
+  throw InputError("parameter", std::string(name), "one of the fitted parameters");
+}
+
+std::string FitResult::report() const {
+  std::ostringstream out;
+  out.precision(6);
+  out << "fit of " << parameters.size() << " coefficient(s) over " << windows << " window(s), "
+      << residuals << " residuals:\n";
+  for (const FittedParameter& p : parameters) {
+    out << "  " << p.name << " = " << p.value << " +- " << p.stddev << "  (start " << p.initial
+        << ")\n";
+  }
+  out << "cost " << initial_cost << " -> " << final_cost << " m^2 (rms residual " << residual_rms
+      << " m), " << iterations << " iterations, " << replays << " window replays, "
+      << wall_seconds << " s, " << (converged ? "converged" : "NOT converged") << "\n";
+  out << "covariance: " << (covariance_ok ? "ok" : "failed: " + covariance_message) << "\n";
+  out << "ceres: " << brief_report << "\n";
+  return out.str();
+}
+
+Real replay_cost(const Trajectory& trajectory, Real window) {
+  trajectory.validate();
+  Real cost = 0;
+  for (const Window& w : make_windows(trajectory, window)) {
+    VecX r(static_cast<Eigen::Index>(w.last - w.first) * trajectory.model.num_dofs());
+    if (!replay_window(trajectory, trajectory.model, w, r.data()))
+      return std::numeric_limits<Real>::infinity();
+    cost += 0.5 * r.squaredNorm();
+  }
+  return cost;
+}
+
+FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  trajectory.validate();
+  options.validate();
+  const std::vector<FitParameter>& free = options.free;
+  const int p_count = static_cast<int>(free.size());
+
+  FitResult result;
+  std::vector<double> log_k(p_count);
+  for (int p = 0; p < p_count; ++p) {
+    FittedParameter fitted;
+    fitted.parameter = free[p];
+    fitted.name = free[p].name();
+    int springs = 0;
+    for (SpringType t : trajectory.model.springs.type) springs += free[p].applies_to(t);
+    require(springs > 0, "free", fitted.name, "a spring type the model has");
+    const auto given = options.initial.find(fitted.name);
+    fitted.initial = given != options.initial.end() ? given->second
+                                                    : mean_coefficient(trajectory.model, free[p]);
+    require(std::isfinite(fitted.initial) && fitted.initial > 0, "initial." + fitted.name,
+            fitted.initial, "a finite start > 0 (the fit works on the logarithm)");
+    log_k[p] = std::log(fitted.initial);
+    result.parameters.push_back(fitted);
+  }
+
+  const std::vector<Window> windows = make_windows(trajectory, options.window);
+  const int n = trajectory.model.num_dofs();
+  std::atomic<long> replays{0};
+  ceres::Problem problem;
+  ceres::NumericDiffOptions diff;
+  diff.relative_step_size = options.relative_step;
+  for (const Window& w : windows) {
+    auto* cost = new ceres::DynamicNumericDiffCostFunction<WindowResiduals, ceres::CENTRAL>(
+        new WindowResiduals(trajectory, free, w, replays), ceres::TAKE_OWNERSHIP, diff);
+    cost->AddParameterBlock(p_count);
+    cost->SetNumResiduals((w.last - w.first) * n);
+    problem.AddResidualBlock(cost, nullptr, log_k.data());
+    result.residuals += (w.last - w.first) * n;
+  }
+  result.windows = static_cast<int>(windows.size());
+
+  ceres::Solver::Options solver;
+  solver.minimizer_type = ceres::TRUST_REGION;
+  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  solver.gradient_tolerance = options.gradient_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
+  solver.num_threads = options.num_threads;
+  solver.minimizer_progress_to_stdout = options.progress_to_stdout;
+  solver.logging_type = options.progress_to_stdout ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  result.termination = summary.message;
+  result.brief_report = summary.BriefReport();
+  result.residual_rms = std::sqrt(2 * summary.final_cost / result.residuals);
+  for (int p = 0; p < p_count; ++p) {
+    result.parameters[p].value = std::exp(log_k[p]);
+    result.parameters[p].stddev = std::numeric_limits<Real>::quiet_NaN();
+  }
+
+  if (options.compute_covariance) {
+    if (result.residuals <= p_count) {
+      result.covariance_message = "fewer residuals than parameters";
+    } else {
+      // Ceres returns (J^T J)^-1 for the log-coefficients, i.e. assumes unit residual variance;
+      // scale it by the estimated variance s^2 = 2 cost / (m - p) of a position residual. The
+      // delta method turns sd(log k) into sd(k) = k sd(log k).
+      ceres::Covariance::Options cov_options;
+      cov_options.algorithm_type = ceres::DENSE_SVD;
+      cov_options.num_threads = options.num_threads;
+      ceres::Covariance covariance(cov_options);
+      const std::vector<std::pair<const double*, const double*>> blocks{
+          {log_k.data(), log_k.data()}};
+      if (covariance.Compute(blocks, &problem)) {
+        std::vector<double> c(static_cast<size_t>(p_count) * p_count);
+        covariance.GetCovarianceBlock(log_k.data(), log_k.data(), c.data());
+        const Real s2 = 2 * summary.final_cost / (result.residuals - p_count);
+        for (int p = 0; p < p_count; ++p) {
+          result.parameters[p].stddev =
+              result.parameters[p].value * std::sqrt(s2 * c[static_cast<size_t>(p) * p_count + p]);
+        }
+        result.covariance_ok = true;
+      } else {
+        result.covariance_message =
+            "the Jacobian is rank deficient: some coefficient is not identifiable from this "
+            "recording";
+      }
+    }
+  } else {
+    result.covariance_message = "not requested";
+  }
+  result.replays = replays.load();
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+void apply_fit(Model& model, const FitResult& result) {
+  for (const FittedParameter& p : result.parameters) set_parameter(model, p.parameter, p.value);
+}
+
+void apply_fit(CubeSpec& spec, const FitResult& result) {
+  for (const FittedParameter& p : result.parameters) {
+    for (SpringType t : kTypes) {
+      if (!p.parameter.applies_to(t)) continue;
+      SpringCoefficients& c = spec.springs[static_cast<int>(t)];
+      (p.parameter.quantity == FitParameter::Quantity::kKs ? c.ks : c.kd) = p.value;
+    }
+  }
+}
+
+}  // namespace jelly
