@@ -2,13 +2,20 @@
 // Options for the integrators that take any; the explicit methods take none.
 #include <string>
 
+#include <jelly/core/errors.hpp>
 #include <jelly/core/types.hpp>
+#include <jelly/solvers/implicit_euler_options.hpp>
 
 namespace jelly {
 
 struct IntegratorOptions {
-  // Throws InputError naming the first invalid option.
-  void validate() const {}
+  ImplicitEulerOptions implicit;  // implicit_euler
+
+  // Throws InputError naming the first invalid option ("integrator.implicit.<field> = ...").
+  void validate() const {
+    std::string why;
+    if (!implicit.is_valid(&why)) throw InputError("integrator." + why);
+  }
 };
 
 }  // namespace jelly
