@@ -1,5 +1,6 @@
 #include <jelly/fit/spring_fit.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,7 @@
 
 #include <ceres/ceres.h>
 #include <ceres/covariance.h>
+#include <Eigen/Dense>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/fit/implicit_euler_ceres.hpp>
@@ -18,8 +20,8 @@ namespace jelly {
 
 namespace {
 
-constexpr std::array<SpringType, kSpringTypeCount> kTypes{
-    SpringType::kStructural, SpringType::kShear, SpringType::kBending};
+constexpr std::array<SpringType, kSpringTypeCount> kTypes{SpringType::kStructural,
+                                                          SpringType::kShear, SpringType::kBending};
 
 // Frames [first, last] of the recording: replayed from frame `first`, compared at the others.
 struct Window {
@@ -56,22 +58,27 @@ void set_parameter(Model& model, const FitParameter& p, Real value) {
 // Replays one window with the model's coefficients and writes x_replay - x_recorded for each
 // compared frame into `residuals`. Returns false if the integrator fails or the state blows up.
 bool replay_window(const Trajectory& trajectory, const Model& model, const Window& w,
-                   double* residuals) {
+                   const State& start, double* residuals) {
   SimulatorOptions options;
   options.dt = trajectory.dt;
-  Simulator sim(model, trajectory.state(w.first),
+  Simulator sim(model, start,
                 make_fit_integrator(trajectory.integrator, trajectory.integrator_options), options);
   for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
   const Eigen::Index n = model.num_dofs();
   for (int k = w.first + 1; k <= w.last; ++k) {
-    const long steps =
-        std::lround((trajectory.times[k] - trajectory.times[k - 1]) / trajectory.dt);
+    const long steps = std::lround((trajectory.times[k] - trajectory.times[k - 1]) / trajectory.dt);
     for (long i = 0; i < steps; ++i)
       if (!sim.step().ok) return false;
     if (!sim.state().x.allFinite()) return false;
-    Eigen::Map<VecX>(residuals + (k - w.first - 1) * n, n) = sim.state().x - trajectory.positions[k];
+    Eigen::Map<VecX>(residuals + (k - w.first - 1) * n, n) =
+        sim.state().x - trajectory.positions[k];
   }
   return true;
+}
+
+bool replay_window(const Trajectory& trajectory, const Model& model, const Window& w,
+                   double* residuals) {
+  return replay_window(trajectory, model, w, trajectory.state(w.first), residuals);
 }
 
 // The residuals of one window as a function of the log-coefficients (Ceres numeric diff).
@@ -95,6 +102,75 @@ class WindowResiduals {
   Window window_;
   std::atomic<long>* replays_;
 };
+
+// Covariance of the log-coefficients when the recorded positions carry independent noise of
+// variance s^2, which enters twice: in the frames compared (residual -e) and in the restart
+// states of the windows (positions, and velocities by finite differences when none were
+// recorded), which every replayed frame of the window inherits. Linearised, r = r0 + A e and
+// the least-squares estimate moves by -H^-1 J^T A e, H = J^T J, so
+//   Cov = s^2 H^-1 (B^T B) H^-1,   B = A^T J,   s^2 = |r|^2 / (trace(A A^T) - p).
+// The columns of A that go through a restart are central differences of replays.
+struct RestartAwareCovariance {
+  Eigen::MatrixXd meat;  // B^T B
+  Real trace = 0;        // trace(A A^T)
+  long replays = 0;
+};
+
+RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, const Model& model,
+                                                const std::vector<Window>& windows,
+                                                const Eigen::MatrixXd& jacobian) {
+  const int n = trajectory.model.num_dofs();
+  const int p_count = static_cast<int>(jacobian.cols());
+  std::vector<int> offset(windows.size() + 1, 0);
+  for (size_t w = 0; w < windows.size(); ++w)
+    offset[w + 1] = offset[w] + (windows[w].last - windows[w].first) * n;
+  RestartAwareCovariance out;
+  out.meat.setZero(p_count, p_count);
+  Trajectory perturbed = trajectory;  // positions perturbed one coordinate at a time
+  const Real delta = 1e-6;
+  VecX plus, minus;
+  Eigen::VectorXd b(p_count);
+  for (int k = 0; k < trajectory.frames(); ++k) {
+    // Windows whose restart state depends on frame k.
+    std::vector<size_t> restarts;
+    for (size_t w = 0; w < windows.size(); ++w) {
+      const int first = windows[w].first;
+      const bool uses = trajectory.has_velocities()
+                            ? first == k
+                            : std::abs(std::clamp(first, 1, trajectory.frames() - 2) - k) <= 1;
+      if (uses) restarts.push_back(w);
+    }
+    for (int c = 0; c < n; ++c) {
+      b.setZero();
+      for (size_t w = 0; w < windows.size(); ++w) {
+        if (k > windows[w].first && k <= windows[w].last) {
+          const int row = offset[w] + (k - windows[w].first - 1) * n + c;
+          b -= jacobian.row(row).transpose();
+          out.trace += 1;
+        }
+      }
+      for (size_t w : restarts) {
+        const int rows = offset[w + 1] - offset[w];
+        plus.resize(rows);
+        minus.resize(rows);
+        perturbed.positions[k][c] = trajectory.positions[k][c] + delta;
+        const bool ok_plus = replay_window(trajectory, model, windows[w],
+                                           perturbed.state(windows[w].first), plus.data());
+        perturbed.positions[k][c] = trajectory.positions[k][c] - delta;
+        const bool ok_minus = replay_window(trajectory, model, windows[w],
+                                            perturbed.state(windows[w].first), minus.data());
+        perturbed.positions[k][c] = trajectory.positions[k][c];
+        out.replays += 2;
+        if (!ok_plus || !ok_minus) continue;
+        const VecX column = (plus - minus) / (2 * delta);
+        b += jacobian.middleRows(offset[w], rows).transpose() * column;
+        out.trace += column.squaredNorm();
+      }
+      out.meat += b * b.transpose();
+    }
+  }
+  return out;
+}
 
 Real mean_coefficient(const Model& model, const FitParameter& p) {
   const Springs& s = model.springs;
@@ -166,8 +242,7 @@ void FitOptions::validate() const {
   require(function_tolerance >= 0 && gradient_tolerance >= 0 && parameter_tolerance >= 0,
           "tolerance", std::min({function_tolerance, gradient_tolerance, parameter_tolerance}),
           ">= 0");
-  require(relative_step > 0 && relative_step < 0.1, "relative_step", relative_step,
-          "in (0, 0.1)");
+  require(relative_step > 0 && relative_step < 0.1, "relative_step", relative_step, "in (0, 0.1)");
   require(num_threads >= 1, "num_threads", num_threads, ">= 1");
 }
 
@@ -184,11 +259,11 @@ std::string FitResult::report() const {
       << residuals << " residuals:\n";
   for (const FittedParameter& p : parameters) {
     out << "  " << p.name << " = " << p.value << " +- " << p.stddev << "  (start " << p.initial
-        << ")\n";
+        << "; +- " << p.stddev_independent << " if residuals were independent)\n";
   }
   out << "cost " << initial_cost << " -> " << final_cost << " m^2 (rms residual " << residual_rms
-      << " m), " << iterations << " iterations, " << replays << " window replays, "
-      << wall_seconds << " s, " << (converged ? "converged" : "NOT converged") << "\n";
+      << " m), " << iterations << " iterations, " << replays << " window replays, " << wall_seconds
+      << " s, " << (converged ? "converged" : "NOT converged") << "\n";
   out << "covariance: " << (covariance_ok ? "ok" : "failed: " + covariance_message) << "\n";
   out << "ceres: " << brief_report << "\n";
   return out.str();
@@ -271,15 +346,15 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
   for (int p = 0; p < p_count; ++p) {
     result.parameters[p].value = std::exp(log_k[p]);
     result.parameters[p].stddev = std::numeric_limits<Real>::quiet_NaN();
+    result.parameters[p].stddev_independent = std::numeric_limits<Real>::quiet_NaN();
   }
 
   if (options.compute_covariance) {
     if (result.residuals <= p_count) {
       result.covariance_message = "fewer residuals than parameters";
     } else {
-      // Ceres returns (J^T J)^-1 for the log-coefficients, i.e. assumes unit residual variance;
-      // scale it by the estimated variance s^2 = 2 cost / (m - p) of a position residual. The
-      // delta method turns sd(log k) into sd(k) = k sd(log k).
+      // Ceres returns (J^T J)^-1 for the log-coefficients: the covariance for residuals that are
+      // independent with unit variance.
       ceres::Covariance::Options cov_options;
       cov_options.algorithm_type = ceres::DENSE_SVD;
       cov_options.num_threads = options.num_threads;
@@ -287,12 +362,31 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
       const std::vector<std::pair<const double*, const double*>> blocks{
           {log_k.data(), log_k.data()}};
       if (covariance.Compute(blocks, &problem)) {
-        std::vector<double> c(static_cast<size_t>(p_count) * p_count);
-        covariance.GetCovarianceBlock(log_k.data(), log_k.data(), c.data());
-        const Real s2 = 2 * summary.final_cost / (result.residuals - p_count);
+        Eigen::MatrixXd h_inv(p_count, p_count);
+        covariance.GetCovarianceBlock(log_k.data(), log_k.data(), h_inv.data());
+        // The Jacobian at the solution, as Ceres differentiated it.
+        ceres::CRSMatrix crs;
+        ceres::Problem::EvaluateOptions evaluate;
+        problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+        Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+        for (int r = 0; r < crs.num_rows; ++r)
+          for (int i = crs.rows[r]; i < crs.rows[r + 1]; ++i)
+            jacobian(r, crs.cols[i]) = crs.values[i];
+        Model fitted = trajectory.model;
+        for (int p = 0; p < p_count; ++p) set_parameter(fitted, free[p], std::exp(log_k[p]));
+        const RestartAwareCovariance restart =
+            restart_aware_covariance(trajectory, fitted, windows, jacobian);
+        replays += restart.replays;
+        const Real sum_squares = 2 * summary.final_cost;
+        // Independent residuals: s^2 = |r|^2 / (m - p), Cov = s^2 (J^T J)^-1.
+        const Real s2_independent = sum_squares / (result.residuals - p_count);
+        const Real s2 = sum_squares / std::max<Real>(restart.trace - p_count, 1);
+        const Eigen::MatrixXd cov = s2 * h_inv * restart.meat * h_inv;
+        // Delta method: sd(k) = k sd(log k).
         for (int p = 0; p < p_count; ++p) {
-          result.parameters[p].stddev =
-              result.parameters[p].value * std::sqrt(s2 * c[static_cast<size_t>(p) * p_count + p]);
+          FittedParameter& fp = result.parameters[p];
+          fp.stddev = fp.value * std::sqrt(cov(p, p));
+          fp.stddev_independent = fp.value * std::sqrt(s2_independent * h_inv(p, p));
         }
         result.covariance_ok = true;
       } else {

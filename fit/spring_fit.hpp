@@ -57,9 +57,13 @@ struct FittedParameter {
   std::string name;
   Real initial = 0;
   Real value = 0;
-  // Standard deviation by the delta method from the covariance of log(value); NaN when the
-  // covariance could not be computed.
+  // Standard deviation by the delta method, sd(k) = k sd(log k), from the covariance of the
+  // log-coefficients; NaN when the covariance could not be computed. `stddev` accounts for the
+  // noise of the restart states (docs/fitting.md); `stddev_independent` is the textbook
+  // s^2 (J^T J)^-1, which treats every residual as independent and is too small when the
+  // recorded positions are noisy.
   Real stddev = 0;
+  Real stddev_independent = 0;
 };
 
 struct FitResult {
@@ -67,7 +71,7 @@ struct FitResult {
   Real initial_cost = 0;  // 1/2 sum of squared position residuals (m^2)
   Real final_cost = 0;
   int iterations = 0;
-  bool converged = false;  // Ceres terminated with CONVERGENCE
+  bool converged = false;   // Ceres terminated with CONVERGENCE
   std::string termination;  // Ceres' message
   std::string brief_report;
   bool covariance_ok = false;

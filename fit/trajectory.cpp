@@ -34,8 +34,7 @@ void Trajectory::validate() const {
     require(std::isfinite(times[k]), at("times", k), times[k], "a finite time");
     require(positions[k].size() == n, at("positions", k) + ".size", positions[k].size(),
             "3 x the number of particles (" + std::to_string(n) + ")");
-    require(positions[k].allFinite(), at("positions", k), "a non-finite value",
-            "finite positions");
+    require(positions[k].allFinite(), at("positions", k), "a non-finite value", "finite positions");
     if (!velocities.empty()) {
       require(velocities[k].size() == n, at("velocities", k) + ".size", velocities[k].size(),
               "3 x the number of particles (" + std::to_string(n) + ")");
@@ -49,8 +48,9 @@ void Trajectory::validate() const {
     const Real steps = interval / dt;
     require(std::abs(steps - std::round(steps)) <= 1e-6 * std::max<Real>(1, steps),
             at("times", k) + " - times[" + std::to_string(k - 1) + "]", interval,
-            "a whole number of steps of dt = " + to_text(dt) + " s (the replay steps like the "
-            "recording)");
+            "a whole number of steps of dt = " + to_text(dt) +
+                " s (the replay steps like the "
+                "recording)");
   }
   // Something must move, and some spring must change length, or no coefficient is identifiable.
   Real moved = 0, stretched = 0;
@@ -97,8 +97,8 @@ Trajectory simulate_trajectory(const Model& model, const State& initial, Terrain
                                const std::string& integrator, Real dt, Real frame_interval,
                                Real duration, bool record_velocities,
                                const IntegratorOptions& integrator_options) {
-  require(std::isfinite(frame_interval) && frame_interval >= dt, "frame_interval",
-          frame_interval, "a finite interval >= dt");
+  require(std::isfinite(frame_interval) && frame_interval >= dt, "frame_interval", frame_interval,
+          "a finite interval >= dt");
   require(std::isfinite(duration) && duration > 0, "duration", duration, "a finite time > 0 s");
   Trajectory trajectory;
   trajectory.model = model;

@@ -20,10 +20,10 @@ struct Trajectory {
   // Masses, springs (a, b, rest length, type) and gravity. The coefficients ks and kd are the
   // starting guess of a fit unless FitOptions::initial names other values.
   Model model;
-  std::vector<Real> times;      // [T] s, strictly increasing
-  std::vector<VecX> positions;  // [T] frames of 3N positions (m)
-  std::vector<VecX> velocities;  // empty, or [T] frames of 3N velocities (m/s)
-  TerrainFactory terrains;       // empty = no terrain
+  std::vector<Real> times;         // [T] s, strictly increasing
+  std::vector<VecX> positions;     // [T] frames of 3N positions (m)
+  std::vector<VecX> velocities;    // empty, or [T] frames of 3N velocities (m/s)
+  TerrainFactory terrains;         // empty = no terrain
   std::string integrator = "rk4";  // the integrator the recording was made with
   IntegratorOptions integrator_options;
   Real dt = 0.001;  // s; every frame interval is a whole number of steps

@@ -2,10 +2,12 @@
 // answers and against Newton's method on the same equations.
 #include <jelly/fit/implicit_euler_ceres.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
@@ -132,7 +134,7 @@ State deformed_state(const Model& model) {
   State s = rest_state(model);
   for (int i = 0; i < model.num_particles(); ++i) {
     s.x[3 * i + 1] = 1 + 0.8 * (s.x[3 * i + 1] - 1);  // squashed by 20 % along y
-    s.v[3 * i] = -2 * (s.x[3 * i + 1] - 1.5);           // sheared
+    s.v[3 * i] = -2 * (s.x[3 * i + 1] - 1.5);         // sheared
     s.v[3 * i + 2] = 0.5 * std::sin(3.0 * i);
   }
   return s;
@@ -147,11 +149,42 @@ TEST(ImplicitEulerCeres, AgreesWithDenseNewton) {
     reference = dense_newton_step(model, reference, h);
     ASSERT_TRUE(sim.step().ok);
     EXPECT_LT((sim.state().x - reference.x).lpNorm<Eigen::Infinity>(), 1e-8) << "step " << step;
-    EXPECT_LT((sim.state().v - reference.v).lpNorm<Eigen::Infinity>(), 1e-8 / h)
-        << "step " << step;
+    // v = (x - x_n) / h: the position agreement divided by h.
+    EXPECT_LT((sim.state().v - reference.v).lpNorm<Eigen::Infinity>(), 1e-8 / h) << "step " << step;
   }
   // The cube did deform: the comparison is not between two rigid motions.
   EXPECT_GT((sim.state().x - deformed_state(model).x).norm(), 0.1);
+}
+
+// The fully nonlinear implicit_euler of the solvers (Newton on the velocity form, sparse Cholesky)
+// and the Ceres least-squares solve of the position form reach the same backward-Euler step.
+TEST(ImplicitEulerCeres, AgreesWithNewtonImplicitEuler) {
+  const Model model = undamped_cube();
+  const Real h = 0.01;
+  IntegratorOptions newton;
+  newton.implicit.newton_iterations = 50;
+  newton.implicit.newton_tolerance = 1e-13;
+  SimulatorOptions options;
+  options.dt = h;
+  Simulator reference(model, deformed_state(model), make_integrator("implicit_euler", newton),
+                      options);
+  Simulator sim = make_ceres_sim(model, deformed_state(model), h);
+  Real max_dx = 0, max_dv = 0;
+  for (int step = 0; step < 10; ++step) {
+    ASSERT_TRUE(reference.step().ok);
+    ASSERT_TRUE(sim.step().ok);
+    EXPECT_LT((sim.state().x - reference.state().x).lpNorm<Eigen::Infinity>(), 1e-8)
+        << "step " << step;
+    EXPECT_LT((sim.state().v - reference.state().v).lpNorm<Eigen::Infinity>(), 1e-8 / h)
+        << "step " << step;
+    max_dx = std::max(max_dx, (sim.state().x - reference.state().x).lpNorm<Eigen::Infinity>());
+    max_dv = std::max(max_dv, (sim.state().v - reference.state().v).lpNorm<Eigen::Infinity>());
+  }
+  std::cout << "implicit_euler_ceres vs implicit_euler (Newton), 10 steps of " << h
+            << " s: max |dx| = " << max_dx << " m, max |dv| = " << max_dv << " m/s\n";
+  EXPECT_EQ(reference.integrator().statistics().at("newton_not_converged"), 0);
+  // Newton did iterate: the linearized step alone would differ.
+  EXPECT_GT(reference.integrator().statistics().at("newton_iterations"), 10);
 }
 
 }  // namespace

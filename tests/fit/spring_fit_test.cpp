@@ -35,8 +35,8 @@ Real true_value(const FittedParameter& p,
 }
 
 void expect_recovered(const FitResult& result,
-                      const std::array<SpringCoefficients, kSpringTypeCount>& truth,
-                      Real relative, Real sigmas = 0) {
+                      const std::array<SpringCoefficients, kSpringTypeCount>& truth, Real relative,
+                      Real sigmas = 0) {
   EXPECT_TRUE(result.converged) << result.report();
   for (const FittedParameter& p : result.parameters) {
     const Real expected = true_value(p, truth);
@@ -82,8 +82,8 @@ TEST(FitRecording, PerTypeFreeFlight) {
   Trajectory recording = testing::free_recording(fit_cube(kPerType));
   reset_to_seed(recording);
   FitOptions options;
-  options.free = parse_free_parameters(
-      "ks.structural,ks.shear,ks.bending,kd.structural,kd.shear,kd.bending");
+  options.free =
+      parse_free_parameters("ks.structural,ks.shear,ks.bending,kd.structural,kd.shear,kd.bending");
   expect_recovered(fit_recording(recording, options), kPerType, 0.01);
 }
 
@@ -97,8 +97,8 @@ TEST(FitRecording, PerTypeOnSlope) {
   Trajectory recording = testing::slope_recording(fit_cube(kPerType, testing::kSlopeOrigin));
   reset_to_seed(recording);
   FitOptions options;
-  options.free = parse_free_parameters(
-      "ks.structural,ks.shear,ks.bending,kd.structural,kd.shear,kd.bending");
+  options.free =
+      parse_free_parameters("ks.structural,ks.shear,ks.bending,kd.structural,kd.shear,kd.bending");
   expect_recovered(fit_recording(recording, options), kPerType, 0.01);
 }
 
@@ -116,6 +116,17 @@ TEST(FitRecording, NoisyPositionsOnSlope) {
   testing::add_noise(recording, 1e-3);
   reset_to_seed(recording);
   expect_recovered(fit_recording(recording), kEqual, 0.05, 3);
+}
+
+// Without recorded velocities the restarts use finite differences of the positions. Their error
+// (frames 10 ms apart against oscillation periods of about 0.1 s) biases the fit: measured
+// ks -9.7 % and kd -3.4 % on this noise-free recording, a bias the standard deviations do not
+// cover (docs/fitting.md). The test bounds that bias; it is a known limitation, not a target.
+TEST(FitRecording, WithoutVelocitiesFreeFlight) {
+  Trajectory recording = testing::free_recording(fit_cube(kEqual), /*velocities=*/false);
+  ASSERT_FALSE(recording.has_velocities());
+  reset_to_seed(recording);
+  expect_recovered(fit_recording(recording), kEqual, 0.12);
 }
 
 }  // namespace
