@@ -79,8 +79,9 @@ struct FitResult {
   Real residual_rms = 0;  // sqrt(2 final_cost / residuals) (m)
   int windows = 0;
   int residuals = 0;
-  long replays = 0;  // window replays (each one simulation of a window)
-  Real wall_seconds = 0;
+  long replays = 0;             // window replays (each one simulation of a window)
+  Real wall_seconds = 0;        // the whole call
+  Real covariance_seconds = 0;  // of which the covariance
 
   // The estimate named "ks", "kd.shear", ...; throws InputError for a name not fitted.
   const FittedParameter& at(std::string_view name) const;

@@ -118,6 +118,74 @@ TEST(FitRecording, NoisyPositionsOnSlope) {
   expect_recovered(fit_recording(recording), kEqual, 0.05, 3);
 }
 
+TEST(FitRecording, ApplyFitAndReport) {
+  Trajectory recording = testing::free_recording(fit_cube(kPerType));
+  reset_to_seed(recording);
+  FitOptions options;
+  options.free = parse_free_parameters("ks.structural,ks.shear,ks.bending,kd");
+  options.initial = {{"kd", 25}};
+  options.compute_covariance = false;
+  const FitResult result = fit_recording(recording, options);
+  EXPECT_EQ(result.at("kd").initial, 25);
+  EXPECT_EQ(result.at("ks.shear").initial, 1400);
+  EXPECT_THROW(result.at("kd.shear"), InputError);
+  // One kd for all types cannot match 20 / 30 / 10 exactly, but lands in between.
+  EXPECT_GT(result.at("kd").value, 10);
+  EXPECT_LT(result.at("kd").value, 30);
+  EXPECT_FALSE(result.covariance_ok);
+
+  CubeSpec spec = testing::small_cube(3, 1, Vec3(-0.5, 1, -0.5));
+  apply_fit(spec, result);
+  EXPECT_EQ(spec.springs[1].ks, result.at("ks.shear").value);
+  EXPECT_EQ(spec.springs[2].ks, result.at("ks.bending").value);
+  for (const SpringCoefficients& c : spec.springs) EXPECT_EQ(c.kd, result.at("kd").value);
+  // The spec and the model agree, and the fitted model replays better than the start.
+  Model model = recording.model;
+  apply_fit(model, result);
+  const Model from_spec = build_cube(spec);
+  EXPECT_EQ(model.springs.ks, from_spec.springs.ks);
+  EXPECT_EQ(model.springs.kd, from_spec.springs.kd);
+  Trajectory fitted = recording;
+  fitted.model = model;
+  EXPECT_NEAR(replay_cost(fitted, options.window), result.final_cost, 1e-12);
+  EXPECT_LT(result.final_cost, 0.5 * result.initial_cost);
+
+  const std::string report = result.report();
+  for (const char* part : {"ks.structural = ", "kd = ", "iterations", "Ceres Solver Report",
+                           "covariance: failed: not requested"})
+    EXPECT_NE(report.find(part), std::string::npos) << part << "\n" << report;
+}
+
+TEST(FitRecording, InvalidOptions) {
+  const Trajectory recording = testing::free_recording(fit_cube(kEqual));
+  auto message = [&](const FitOptions& options) -> std::string {
+    try {
+      fit_recording(recording, options);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  FitOptions options;
+  options.initial = {{"ks.shear", 1000}};
+  EXPECT_EQ(message(options).rfind("initial.ks.shear = 1000 is invalid", 0), 0u);
+  options.initial = {{"ks", -1}};
+  EXPECT_EQ(message(options).rfind("initial.ks = -1 is invalid", 0), 0u);
+  options = {};
+  options.window = -0.1;
+  EXPECT_EQ(message(options).rfind("window = -0.10000000000000001 is invalid", 0), 0u);
+  // A model without bending springs (n = 2) has no ks.bending to fit.
+  Trajectory two = testing::free_recording(build_cube(testing::small_cube(2, 1)));
+  options = {};
+  options.free = parse_free_parameters("ks.bending");
+  try {
+    fit_recording(two, options);
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "free = ks.bending is invalid: a spring type the model has");
+  }
+}
+
 // Without recorded velocities the restarts use finite differences of the positions. Their error
 // (frames 10 ms apart against oscillation periods of about 0.1 s) biases the fit: measured
 // ks -9.7 % and kd -3.4 % on this noise-free recording, a bias the standard deviations do not
