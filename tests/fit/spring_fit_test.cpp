@@ -156,6 +156,21 @@ TEST(FitRecording, ApplyFitAndReport) {
     EXPECT_NE(report.find(part), std::string::npos) << part << "\n" << report;
 }
 
+// Windows are independent residual blocks: two threads evaluate them in parallel, each replay
+// with its own simulator and terrains, and find the same coefficients.
+TEST(FitRecording, TwoThreadsAgreeWithOne) {
+  Trajectory recording = testing::slope_recording(fit_cube(kEqual, testing::kSlopeOrigin));
+  reset_to_seed(recording);
+  testing::add_noise(recording, 1e-3);
+  FitOptions options;
+  options.compute_covariance = false;
+  const FitResult one = fit_recording(recording, options);
+  options.num_threads = 2;
+  const FitResult two = fit_recording(recording, options);
+  for (const char* name : {"ks", "kd"})
+    EXPECT_NEAR(two.at(name).value, one.at(name).value, 1e-8 * one.at(name).value) << name;
+}
+
 TEST(FitRecording, InvalidOptions) {
   const Trajectory recording = testing::free_recording(fit_cube(kEqual));
   auto message = [&](const FitOptions& options) -> std::string {
