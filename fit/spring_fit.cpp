@@ -81,46 +81,59 @@ bool replay_window(const Trajectory& trajectory, const Model& model, const Windo
   return replay_window(trajectory, model, w, trajectory.state(w.first), residuals);
 }
 
-// The residuals of one window as a function of the log-coefficients (Ceres numeric diff).
+// The residuals of one window as a function of the log-coefficients (parameter block 0) and,
+// when the restart velocities are fitted, of the window's initial velocity (block 1).
 class WindowResiduals {
  public:
   WindowResiduals(const Trajectory& trajectory, const std::vector<FitParameter>& free, Window w,
-                  std::atomic<long>& replays)
-      : trajectory_(&trajectory), free_(&free), window_(w), replays_(&replays) {}
+                  bool fitted_velocity, std::atomic<long>& replays)
+      : trajectory_(&trajectory),
+        free_(&free),
+        window_(w),
+        fitted_velocity_(fitted_velocity),
+        replays_(&replays) {}
 
   bool operator()(double const* const* parameters, double* residuals) const {
     Model model = trajectory_->model;
     for (size_t p = 0; p < free_->size(); ++p)
       set_parameter(model, (*free_)[p], std::exp(parameters[0][p]));
     ++*replays_;
-    return replay_window(*trajectory_, model, window_, residuals);
+    State start = trajectory_->state(window_.first);
+    if (fitted_velocity_) start.v = Eigen::Map<const VecX>(parameters[1], start.v.size());
+    return replay_window(*trajectory_, model, window_, start, residuals);
   }
 
  private:
   const Trajectory* trajectory_;
   const std::vector<FitParameter>* free_;
   Window window_;
+  bool fitted_velocity_;
   std::atomic<long>* replays_;
 };
 
 // Covariance of the log-coefficients when the recorded positions carry independent noise of
 // variance s^2, which enters twice: in the frames compared (residual -e) and in the restart
 // states of the windows (positions, and velocities by finite differences when none were
-// recorded), which every replayed frame of the window inherits. Linearised, r = r0 + A e and
-// the least-squares estimate moves by -H^-1 J^T A e, H = J^T J, so
-//   Cov = s^2 H^-1 (B^T B) H^-1,   B = A^T J,   s^2 = |r|^2 / (trace(A A^T) - p).
-// The columns of A that go through a restart are central differences of replays.
+// recorded and they are not fitted), which every replayed frame of the window inherits.
+// Linearised, r = r0 + A e and the least-squares estimate of all unknowns moves by
+// -H^-1 J^T A e, H = J^T J. With G the rows of H^-1 that belong to the log-coefficients,
+//   Cov = s^2 sum_e (G J^T a_e) (G J^T a_e)^T,   s^2 = |r|^2 / (trace(A A^T) - q),
+// q the number of unknowns. The columns a_e that go through a restart are central differences
+// of replays.
 struct RestartAwareCovariance {
-  Eigen::MatrixXd meat;  // B^T B
+  Eigen::MatrixXd meat;  // sum_e (G J^T a_e) (G J^T a_e)^T
   Real trace = 0;        // trace(A A^T)
   long replays = 0;
 };
 
 RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, const Model& model,
                                                 const std::vector<Window>& windows,
-                                                const Eigen::MatrixXd& jacobian) {
+                                                const std::vector<VecX>& fitted_velocities,
+                                                const Eigen::MatrixXd& jacobian,
+                                                const Eigen::MatrixXd& gain) {
   const int n = trajectory.model.num_dofs();
-  const int p_count = static_cast<int>(jacobian.cols());
+  const int p_count = static_cast<int>(gain.rows());
+  const bool fitted = !fitted_velocities.empty();
   std::vector<int> offset(windows.size() + 1, 0);
   for (size_t w = 0; w < windows.size(); ++w)
     offset[w + 1] = offset[w] + (windows[w].last - windows[w].first) * n;
@@ -129,13 +142,18 @@ RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, co
   Trajectory perturbed = trajectory;  // positions perturbed one coordinate at a time
   const Real delta = 1e-6;
   VecX plus, minus;
-  Eigen::VectorXd b(p_count);
+  Eigen::VectorXd b(jacobian.cols());
+  auto start_state = [&](size_t w) {
+    State start = perturbed.state(windows[w].first);
+    if (fitted) start.v = fitted_velocities[w];
+    return start;
+  };
   for (int k = 0; k < trajectory.frames(); ++k) {
     // Windows whose restart state depends on frame k.
     std::vector<size_t> restarts;
     for (size_t w = 0; w < windows.size(); ++w) {
       const int first = windows[w].first;
-      const bool uses = trajectory.has_velocities()
+      const bool uses = trajectory.has_velocities() || fitted
                             ? first == k
                             : std::abs(std::clamp(first, 1, trajectory.frames() - 2) - k) <= 1;
       if (uses) restarts.push_back(w);
@@ -154,11 +172,11 @@ RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, co
         plus.resize(rows);
         minus.resize(rows);
         perturbed.positions[k][c] = trajectory.positions[k][c] + delta;
-        const bool ok_plus = replay_window(trajectory, model, windows[w],
-                                           perturbed.state(windows[w].first), plus.data());
+        const bool ok_plus =
+            replay_window(trajectory, model, windows[w], start_state(w), plus.data());
         perturbed.positions[k][c] = trajectory.positions[k][c] - delta;
-        const bool ok_minus = replay_window(trajectory, model, windows[w],
-                                            perturbed.state(windows[w].first), minus.data());
+        const bool ok_minus =
+            replay_window(trajectory, model, windows[w], start_state(w), minus.data());
         perturbed.positions[k][c] = trajectory.positions[k][c];
         out.replays += 2;
         if (!ok_plus || !ok_minus) continue;
@@ -166,7 +184,8 @@ RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, co
         b += jacobian.middleRows(offset[w], rows).transpose() * column;
         out.trace += column.squaredNorm();
       }
-      out.meat += b * b.transpose();
+      const Eigen::VectorXd shift = gain * b;
+      out.meat += shift * shift.transpose();
     }
   }
   return out;
@@ -265,6 +284,10 @@ std::string FitResult::report() const {
       << " m), " << iterations << " iterations, " << replays << " window replays, " << wall_seconds
       << " s (covariance " << covariance_seconds << " s), "
       << (converged ? "converged" : "NOT converged") << "\n";
+  if (!restart_velocities.empty()) {
+    out << "restart velocities fitted: " << restart_velocities.size() << " windows x "
+        << restart_velocities.front().size() << " unknowns\n";
+  }
   out << "covariance: " << (covariance_ok ? "ok" : "failed: " + covariance_message) << "\n";
   out << "ceres: " << brief_report << "\n";
   return out.str();
@@ -313,20 +336,40 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
   ceres::Problem problem;
   ceres::NumericDiffOptions diff;
   diff.relative_step_size = options.relative_step;
-  for (const Window& w : windows) {
+  // With fitted restart velocities every window has its own 3N velocity block, started from the
+  // recorded (or finite-difference) velocity.
+  const bool fit_velocities = options.fit_restart_velocities;
+  std::vector<VecX> velocities;
+  std::vector<double*> blocks{log_k.data()};
+  if (fit_velocities) {
+    velocities.reserve(windows.size());
+    for (const Window& w : windows) velocities.push_back(trajectory.state(w.first).v);
+    for (VecX& v : velocities) blocks.push_back(v.data());
+  }
+  for (size_t i = 0; i < windows.size(); ++i) {
+    const Window& w = windows[i];
     auto* cost = new ceres::DynamicNumericDiffCostFunction<WindowResiduals, ceres::CENTRAL>(
-        new WindowResiduals(trajectory, free, w, replays), ceres::TAKE_OWNERSHIP, diff);
+        new WindowResiduals(trajectory, free, w, fit_velocities, replays), ceres::TAKE_OWNERSHIP,
+        diff);
     cost->AddParameterBlock(p_count);
+    if (fit_velocities) cost->AddParameterBlock(n);
     cost->SetNumResiduals((w.last - w.first) * n);
-    problem.AddResidualBlock(cost, nullptr, log_k.data());
+    if (fit_velocities) {
+      problem.AddResidualBlock(cost, nullptr, log_k.data(), velocities[i].data());
+    } else {
+      problem.AddResidualBlock(cost, nullptr, log_k.data());
+    }
     result.residuals += (w.last - w.first) * n;
   }
   result.windows = static_cast<int>(windows.size());
+  const int unknowns = p_count + (fit_velocities ? n * result.windows : 0);
 
   ceres::Solver::Options solver;
   solver.minimizer_type = ceres::TRUST_REGION;
   solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver.linear_solver_type = ceres::DENSE_QR;
+  // A few coefficients: dense QR. With a velocity block per window, each residual block touches
+  // one of them, so the Schur complement onto the coefficients is exact and small.
+  solver.linear_solver_type = fit_velocities ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = options.function_tolerance;
   solver.gradient_tolerance = options.gradient_tolerance;
@@ -352,38 +395,45 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
 
   const auto covariance_start = std::chrono::steady_clock::now();
   if (options.compute_covariance) {
-    if (result.residuals <= p_count) {
-      result.covariance_message = "fewer residuals than parameters";
+    if (result.residuals <= unknowns) {
+      result.covariance_message = "fewer residuals than unknowns";
     } else {
-      // Ceres returns (J^T J)^-1 for the log-coefficients: the covariance for residuals that are
-      // independent with unit variance.
+      // Ceres returns the log-coefficients' block of (J^T J)^-1 (all unknowns): the covariance
+      // for residuals that are independent with unit variance.
       ceres::Covariance::Options cov_options;
       cov_options.algorithm_type = ceres::DENSE_SVD;
       cov_options.num_threads = options.num_threads;
       ceres::Covariance covariance(cov_options);
-      const std::vector<std::pair<const double*, const double*>> blocks{
+      const std::vector<std::pair<const double*, const double*>> pairs{
           {log_k.data(), log_k.data()}};
-      if (covariance.Compute(blocks, &problem)) {
+      if (covariance.Compute(pairs, &problem)) {
         Eigen::MatrixXd h_inv(p_count, p_count);
         covariance.GetCovarianceBlock(log_k.data(), log_k.data(), h_inv.data());
-        // The Jacobian at the solution, as Ceres differentiated it.
+        // The Jacobian at the solution, as Ceres differentiated it, columns in `blocks` order.
         ceres::CRSMatrix crs;
         ceres::Problem::EvaluateOptions evaluate;
+        evaluate.parameter_blocks = blocks;
         problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
         Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
         for (int r = 0; r < crs.num_rows; ++r)
           for (int i = crs.rows[r]; i < crs.rows[r + 1]; ++i)
             jacobian(r, crs.cols[i]) = crs.values[i];
+        // G: the coefficients' rows of H^-1 (H symmetric, so the solve of H G^T = E).
+        Eigen::MatrixXd gain = h_inv;
+        if (fit_velocities) {
+          const Eigen::MatrixXd h = jacobian.transpose() * jacobian;
+          gain = h.ldlt().solve(Eigen::MatrixXd::Identity(unknowns, p_count)).transpose();
+        }
         Model fitted = trajectory.model;
         for (int p = 0; p < p_count; ++p) set_parameter(fitted, free[p], std::exp(log_k[p]));
         const RestartAwareCovariance restart =
-            restart_aware_covariance(trajectory, fitted, windows, jacobian);
+            restart_aware_covariance(trajectory, fitted, windows, velocities, jacobian, gain);
         replays += restart.replays;
         const Real sum_squares = 2 * summary.final_cost;
-        // Independent residuals: s^2 = |r|^2 / (m - p), Cov = s^2 (J^T J)^-1.
-        const Real s2_independent = sum_squares / (result.residuals - p_count);
-        const Real s2 = sum_squares / std::max<Real>(restart.trace - p_count, 1);
-        const Eigen::MatrixXd cov = s2 * h_inv * restart.meat * h_inv;
+        // Independent residuals: s^2 = |r|^2 / (m - q), Cov = s^2 (J^T J)^-1.
+        const Real s2_independent = sum_squares / (result.residuals - unknowns);
+        const Real s2 = sum_squares / std::max<Real>(restart.trace - unknowns, 1);
+        const Eigen::MatrixXd cov = s2 * restart.meat;
         // Delta method: sd(k) = k sd(log k).
         for (int p = 0; p < p_count; ++p) {
           FittedParameter& fp = result.parameters[p];
@@ -400,6 +450,7 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
   } else {
     result.covariance_message = "not requested";
   }
+  result.restart_velocities = std::move(velocities);
   result.replays = replays.load();
   const auto end = std::chrono::steady_clock::now();
   result.covariance_seconds = std::chrono::duration<double>(end - covariance_start).count();
