@@ -119,7 +119,7 @@ class WindowResiduals {
 // -H^-1 J^T A e, H = J^T J. With G the rows of H^-1 that belong to the log-coefficients,
 //   Cov = s^2 sum_e (G J^T a_e) (G J^T a_e)^T,   s^2 = |r|^2 / (trace(A A^T) - q),
 // q the number of unknowns. The columns a_e that go through a restart are central differences
-// of replays.
+// of replays, with a step of the size of the noise.
 struct RestartAwareCovariance {
   Eigen::MatrixXd meat;  // sum_e (G J^T a_e) (G J^T a_e)^T
   Real trace = 0;        // trace(A A^T)
@@ -130,7 +130,7 @@ RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, co
                                                 const std::vector<Window>& windows,
                                                 const std::vector<VecX>& fitted_velocities,
                                                 const Eigen::MatrixXd& jacobian,
-                                                const Eigen::MatrixXd& gain) {
+                                                const Eigen::MatrixXd& gain, Real noise_scale) {
   const int n = trajectory.model.num_dofs();
   const int p_count = static_cast<int>(gain.rows());
   const bool fitted = !fitted_velocities.empty();
@@ -140,7 +140,11 @@ RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, co
   RestartAwareCovariance out;
   out.meat.setZero(p_count, p_count);
   Trajectory perturbed = trajectory;  // positions perturbed one coordinate at a time
-  const Real delta = 1e-6;
+  // Secant differences at the scale of the noise (the residual rms estimates it), not at
+  // 1e-6 m: with contact, noise of that size moves particles across the surface, where the
+  // projection responds non-smoothly; a tiny step sees one side only and gave standard
+  // deviations that were too small on the slope (docs/fitting.md). On smooth data both agree.
+  const Real delta = std::max<Real>(1e-6, noise_scale);
   VecX plus, minus;
   Eigen::VectorXd b(jacobian.cols());
   auto start_state = [&](size_t w) {
@@ -426,8 +430,8 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
         }
         Model fitted = trajectory.model;
         for (int p = 0; p < p_count; ++p) set_parameter(fitted, free[p], std::exp(log_k[p]));
-        const RestartAwareCovariance restart =
-            restart_aware_covariance(trajectory, fitted, windows, velocities, jacobian, gain);
+        const RestartAwareCovariance restart = restart_aware_covariance(
+            trajectory, fitted, windows, velocities, jacobian, gain, result.residual_rms);
         replays += restart.replays;
         const Real sum_squares = 2 * summary.final_cost;
         // Independent residuals: s^2 = |r|^2 / (m - q), Cov = s^2 (J^T J)^-1.
