@@ -1,0 +1,479 @@
+#include <jelly/fit/spring_fit.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include <ceres/ceres.h>
+#include <ceres/covariance.h>
+#include <Eigen/Dense>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/solvers/simulator.hpp>
+
+namespace jelly {
+
+namespace {
+
+constexpr std::array<SpringType, kSpringTypeCount> kTypes{SpringType::kStructural,
+                                                          SpringType::kShear, SpringType::kBending};
+
+// Frames [first, last] of the recording: replayed from frame `first`, compared at the others.
+struct Window {
+  int first = 0;
+  int last = 0;
+};
+
+std::vector<Window> make_windows(const Trajectory& trajectory, Real length) {
+  std::vector<Window> windows;
+  const int last = trajectory.frames() - 1;
+  const Real slack = 1e-9 * std::max<Real>(1, std::abs(trajectory.times[last]));
+  int first = 0;
+  while (first < last) {
+    int end = first + 1;
+    if (length == 0) {
+      end = last;
+    } else {
+      while (end < last && trajectory.times[end + 1] - trajectory.times[first] <= length + slack)
+        ++end;
+    }
+    windows.push_back({first, end});
+    first = end;
+  }
+  return windows;
+}
+
+void set_parameter(Model& model, const FitParameter& p, Real value) {
+  Springs& s = model.springs;
+  std::vector<Real>& target = p.quantity == FitParameter::Quantity::kKs ? s.ks : s.kd;
+  for (int j = 0; j < s.size(); ++j)
+    if (p.applies_to(s.type[j])) target[j] = value;
+}
+
+// Replays one window with the model's coefficients and writes x_replay - x_recorded for each
+// compared frame into `residuals`. Returns false if the integrator fails or the state blows up.
+bool replay_window(const Trajectory& trajectory, const Model& model, const Window& w,
+                   const State& start, double* residuals) {
+  SimulatorOptions options;
+  options.dt = trajectory.dt;
+  Simulator sim(model, start,
+                make_fit_integrator(trajectory.integrator, trajectory.integrator_options), options);
+  for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
+  const Eigen::Index n = model.num_dofs();
+  for (int k = w.first + 1; k <= w.last; ++k) {
+    const long steps = std::lround((trajectory.times[k] - trajectory.times[k - 1]) / trajectory.dt);
+    for (long i = 0; i < steps; ++i)
+      if (!sim.step().ok) return false;
+    if (!sim.state().x.allFinite()) return false;
+    Eigen::Map<VecX>(residuals + (k - w.first - 1) * n, n) =
+        sim.state().x - trajectory.positions[k];
+  }
+  return true;
+}
+
+bool replay_window(const Trajectory& trajectory, const Model& model, const Window& w,
+                   double* residuals) {
+  return replay_window(trajectory, model, w, trajectory.state(w.first), residuals);
+}
+
+// The residuals of one window as a function of the log-coefficients (parameter block 0) and,
+// when the restart velocities are fitted, of the window's initial velocity (block 1).
+class WindowResiduals {
+ public:
+  WindowResiduals(const Trajectory& trajectory, const std::vector<FitParameter>& free, Window w,
+                  bool fitted_velocity, std::atomic<long>& replays)
+      : trajectory_(&trajectory),
+        free_(&free),
+        window_(w),
+        fitted_velocity_(fitted_velocity),
+        replays_(&replays) {}
+
+  bool operator()(double const* const* parameters, double* residuals) const {
+    Model model = trajectory_->model;
+    for (size_t p = 0; p < free_->size(); ++p)
+      set_parameter(model, (*free_)[p], std::exp(parameters[0][p]));
+    ++*replays_;
+    State start = trajectory_->state(window_.first);
+    if (fitted_velocity_) start.v = Eigen::Map<const VecX>(parameters[1], start.v.size());
+    return replay_window(*trajectory_, model, window_, start, residuals);
+  }
+
+ private:
+  const Trajectory* trajectory_;
+  const std::vector<FitParameter>* free_;
+  Window window_;
+  bool fitted_velocity_;
+  std::atomic<long>* replays_;
+};
+
+// Covariance of the log-coefficients when the recorded positions carry independent noise of
+// variance s^2, which enters twice: in the frames compared (residual -e) and in the restart
+// states of the windows (positions, and velocities by finite differences when none were
+// recorded and they are not fitted), which every replayed frame of the window inherits.
+// Linearised, r = r0 + A e and the least-squares estimate of all unknowns moves by
+// -H^-1 J^T A e, H = J^T J. With G the rows of H^-1 that belong to the log-coefficients,
+//   Cov = s^2 sum_e (G J^T a_e) (G J^T a_e)^T,   s^2 = |r|^2 / (trace(A A^T) - q),
+// q the number of unknowns. The columns a_e that go through a restart are central differences
+// of replays, with a step of the size of the noise.
+struct RestartAwareCovariance {
+  Eigen::MatrixXd meat;  // sum_e (G J^T a_e) (G J^T a_e)^T
+  Real trace = 0;        // trace(A A^T)
+  long replays = 0;
+};
+
+RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, const Model& model,
+                                                const std::vector<Window>& windows,
+                                                const std::vector<VecX>& fitted_velocities,
+                                                const Eigen::MatrixXd& jacobian,
+                                                const Eigen::MatrixXd& gain, Real noise_scale) {
+  const int n = trajectory.model.num_dofs();
+  const int p_count = static_cast<int>(gain.rows());
+  const bool fitted = !fitted_velocities.empty();
+  std::vector<int> offset(windows.size() + 1, 0);
+  for (size_t w = 0; w < windows.size(); ++w)
+    offset[w + 1] = offset[w] + (windows[w].last - windows[w].first) * n;
+  RestartAwareCovariance out;
+  out.meat.setZero(p_count, p_count);
+  Trajectory perturbed = trajectory;  // positions perturbed one coordinate at a time
+  // Secant differences at the scale of the noise (the residual rms estimates it), not at
+  // 1e-6 m: with contact, noise of that size moves particles across the surface, where the
+  // projection responds non-smoothly; a tiny step sees one side only and gave standard
+  // deviations that were too small on the slope (docs/fitting.md). On smooth data both agree.
+  const Real delta = std::max<Real>(1e-6, noise_scale);
+  VecX plus, minus;
+  Eigen::VectorXd b(jacobian.cols());
+  auto start_state = [&](size_t w) {
+    State start = perturbed.state(windows[w].first);
+    if (fitted) start.v = fitted_velocities[w];
+    return start;
+  };
+  for (int k = 0; k < trajectory.frames(); ++k) {
+    // Windows whose restart state depends on frame k.
+    std::vector<size_t> restarts;
+    for (size_t w = 0; w < windows.size(); ++w) {
+      const int first = windows[w].first;
+      const bool uses = trajectory.has_velocities() || fitted
+                            ? first == k
+                            : std::abs(std::clamp(first, 1, trajectory.frames() - 2) - k) <= 1;
+      if (uses) restarts.push_back(w);
+    }
+    for (int c = 0; c < n; ++c) {
+      b.setZero();
+      for (size_t w = 0; w < windows.size(); ++w) {
+        if (k > windows[w].first && k <= windows[w].last) {
+          const int row = offset[w] + (k - windows[w].first - 1) * n + c;
+          b -= jacobian.row(row).transpose();
+          out.trace += 1;
+        }
+      }
+      for (size_t w : restarts) {
+        const int rows = offset[w + 1] - offset[w];
+        plus.resize(rows);
+        minus.resize(rows);
+        perturbed.positions[k][c] = trajectory.positions[k][c] + delta;
+        const bool ok_plus =
+            replay_window(trajectory, model, windows[w], start_state(w), plus.data());
+        perturbed.positions[k][c] = trajectory.positions[k][c] - delta;
+        const bool ok_minus =
+            replay_window(trajectory, model, windows[w], start_state(w), minus.data());
+        perturbed.positions[k][c] = trajectory.positions[k][c];
+        out.replays += 2;
+        if (!ok_plus || !ok_minus) continue;
+        const VecX column = (plus - minus) / (2 * delta);
+        b += jacobian.middleRows(offset[w], rows).transpose() * column;
+        out.trace += column.squaredNorm();
+      }
+      const Eigen::VectorXd shift = gain * b;
+      out.meat += shift * shift.transpose();
+    }
+  }
+  return out;
+}
+
+Real mean_coefficient(const Model& model, const FitParameter& p) {
+  const Springs& s = model.springs;
+  Real sum = 0;
+  int count = 0;
+  for (int j = 0; j < s.size(); ++j) {
+    if (!p.applies_to(s.type[j])) continue;
+    sum += p.quantity == FitParameter::Quantity::kKs ? s.ks[j] : s.kd[j];
+    ++count;
+  }
+  return count > 0 ? sum / count : 0;
+}
+
+}  // namespace
+
+std::string FitParameter::name() const {
+  std::string n = quantity == Quantity::kKs ? "ks" : "kd";
+  if (type) n += "." + std::string(spring_type_name(*type));
+  return n;
+}
+
+std::vector<FitParameter> parse_free_parameters(std::string_view list) {
+  std::vector<FitParameter> result;
+  const std::string allowed =
+      "a comma-separated list of ks, kd, ks.structural, ks.shear, ks.bending, kd.structural, "
+      "kd.shear, kd.bending, without overlaps";
+  size_t start = 0;
+  while (start <= list.size()) {
+    const size_t comma = std::min(list.find(',', start), list.size());
+    std::string_view item = list.substr(start, comma - start);
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
+    FitParameter p;
+    const std::string_view quantity = item.substr(0, item.find('.'));
+    require(quantity == "ks" || quantity == "kd", "free", std::string(list), allowed);
+    p.quantity = quantity == "ks" ? FitParameter::Quantity::kKs : FitParameter::Quantity::kKd;
+    if (item.size() > 2) {
+      bool known = false;
+      for (SpringType t : kTypes) {
+        if (item.substr(3) == spring_type_name(t) && item[2] == '.') {
+          p.type = t;
+          known = true;
+        }
+      }
+      require(known, "free", std::string(list), allowed);
+    }
+    for (const FitParameter& q : result) {
+      const bool overlap = q.quantity == p.quantity && (!q.type || !p.type || *q.type == *p.type);
+      require(!overlap, "free", std::string(list), allowed);
+    }
+    result.push_back(p);
+    start = comma + 1;
+  }
+  return result;
+}
+
+void FitOptions::validate() const {
+  require(!free.empty(), "free", "(empty)", "at least one free coefficient");
+  for (const auto& [name, value] : initial) {
+    bool known = false;
+    for (const FitParameter& p : free) known = known || p.name() == name;
+    require(known, "initial." + name, value, "a value for one of the free parameters");
+    require(std::isfinite(value) && value > 0, "initial." + name, value,
+            "a finite value > 0 (the fit works on the logarithm)");
+  }
+  require(std::isfinite(window) && window >= 0, "window", window,
+          "a finite length >= 0 s (0 = the whole recording)");
+  require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
+  require(function_tolerance >= 0 && gradient_tolerance >= 0 && parameter_tolerance >= 0,
+          "tolerance", std::min({function_tolerance, gradient_tolerance, parameter_tolerance}),
+          ">= 0");
+  require(relative_step > 0 && relative_step < 0.1, "relative_step", relative_step, "in (0, 0.1)");
+  require(num_threads >= 1, "num_threads", num_threads, ">= 1");
+}
+
+const FittedParameter& FitResult::at(std::string_view name) const {
+  for (const FittedParameter& p : parameters)
+    if (p.name == name) return p;
+  throw InputError("parameter", std::string(name), "one of the fitted parameters");
+}
+
+std::string FitResult::report() const {
+  std::ostringstream out;
+  out.precision(6);
+  out << "fit of " << parameters.size() << " coefficient(s) over " << windows << " window(s), "
+      << residuals << " residuals:\n";
+  for (const FittedParameter& p : parameters) {
+    out << "  " << p.name << " = " << p.value << " +- " << p.stddev << "  (start " << p.initial
+        << "; +- " << p.stddev_independent << " if residuals were independent)\n";
+  }
+  out << "cost " << initial_cost << " -> " << final_cost << " m^2 (rms residual " << residual_rms
+      << " m), " << iterations << " iterations, " << replays << " window replays, " << wall_seconds
+      << " s (covariance " << covariance_seconds << " s), "
+      << (converged ? "converged" : "NOT converged") << "\n";
+  if (!restart_velocities.empty()) {
+    out << "restart velocities fitted: " << restart_velocities.size() << " windows x "
+        << restart_velocities.front().size() << " unknowns\n";
+  }
+  out << "covariance: " << (covariance_ok ? "ok" : "failed: " + covariance_message) << "\n";
+  out << "ceres: " << brief_report << "\n";
+  return out.str();
+}
+
+Real replay_cost(const Trajectory& trajectory, Real window) {
+  trajectory.validate();
+  Real cost = 0;
+  for (const Window& w : make_windows(trajectory, window)) {
+    VecX r(static_cast<Eigen::Index>(w.last - w.first) * trajectory.model.num_dofs());
+    if (!replay_window(trajectory, trajectory.model, w, r.data()))
+      return std::numeric_limits<Real>::infinity();
+    cost += 0.5 * r.squaredNorm();
+  }
+  return cost;
+}
+
+FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  trajectory.validate();
+  options.validate();
+  const std::vector<FitParameter>& free = options.free;
+  const int p_count = static_cast<int>(free.size());
+
+  FitResult result;
+  std::vector<double> log_k(p_count);
+  for (int p = 0; p < p_count; ++p) {
+    FittedParameter fitted;
+    fitted.parameter = free[p];
+    fitted.name = free[p].name();
+    int springs = 0;
+    for (SpringType t : trajectory.model.springs.type) springs += free[p].applies_to(t);
+    require(springs > 0, "free", fitted.name, "a spring type the model has");
+    const auto given = options.initial.find(fitted.name);
+    fitted.initial = given != options.initial.end() ? given->second
+                                                    : mean_coefficient(trajectory.model, free[p]);
+    require(std::isfinite(fitted.initial) && fitted.initial > 0, "initial." + fitted.name,
+            fitted.initial, "a finite start > 0 (the fit works on the logarithm)");
+    log_k[p] = std::log(fitted.initial);
+    result.parameters.push_back(fitted);
+  }
+
+  const std::vector<Window> windows = make_windows(trajectory, options.window);
+  const int n = trajectory.model.num_dofs();
+  std::atomic<long> replays{0};
+  ceres::Problem problem;
+  ceres::NumericDiffOptions diff;
+  diff.relative_step_size = options.relative_step;
+  // With fitted restart velocities every window has its own 3N velocity block, started from the
+  // recorded (or finite-difference) velocity.
+  const bool fit_velocities = options.fit_restart_velocities;
+  std::vector<VecX> velocities;
+  std::vector<double*> blocks{log_k.data()};
+  if (fit_velocities) {
+    velocities.reserve(windows.size());
+    for (const Window& w : windows) velocities.push_back(trajectory.state(w.first).v);
+    for (VecX& v : velocities) blocks.push_back(v.data());
+  }
+  for (size_t i = 0; i < windows.size(); ++i) {
+    const Window& w = windows[i];
+    auto* cost = new ceres::DynamicNumericDiffCostFunction<WindowResiduals, ceres::CENTRAL>(
+        new WindowResiduals(trajectory, free, w, fit_velocities, replays), ceres::TAKE_OWNERSHIP,
+        diff);
+    cost->AddParameterBlock(p_count);
+    if (fit_velocities) cost->AddParameterBlock(n);
+    cost->SetNumResiduals((w.last - w.first) * n);
+    if (fit_velocities) {
+      problem.AddResidualBlock(cost, nullptr, log_k.data(), velocities[i].data());
+    } else {
+      problem.AddResidualBlock(cost, nullptr, log_k.data());
+    }
+    result.residuals += (w.last - w.first) * n;
+  }
+  result.windows = static_cast<int>(windows.size());
+  const int unknowns = p_count + (fit_velocities ? n * result.windows : 0);
+
+  ceres::Solver::Options solver;
+  solver.minimizer_type = ceres::TRUST_REGION;
+  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  // A few coefficients: dense QR. With a velocity block per window, each residual block touches
+  // one of them, so the Schur complement onto the coefficients is exact and small.
+  solver.linear_solver_type = fit_velocities ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  solver.gradient_tolerance = options.gradient_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
+  solver.num_threads = options.num_threads;
+  solver.minimizer_progress_to_stdout = options.progress_to_stdout;
+  solver.logging_type = options.progress_to_stdout ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  result.termination = summary.message;
+  result.brief_report = summary.BriefReport();
+  result.residual_rms = std::sqrt(2 * summary.final_cost / result.residuals);
+  for (int p = 0; p < p_count; ++p) {
+    result.parameters[p].value = std::exp(log_k[p]);
+    result.parameters[p].stddev = std::numeric_limits<Real>::quiet_NaN();
+    result.parameters[p].stddev_independent = std::numeric_limits<Real>::quiet_NaN();
+  }
+
+  const auto covariance_start = std::chrono::steady_clock::now();
+  if (options.compute_covariance) {
+    if (result.residuals <= unknowns) {
+      result.covariance_message = "fewer residuals than unknowns";
+    } else {
+      // Ceres returns the log-coefficients' block of (J^T J)^-1 (all unknowns): the covariance
+      // for residuals that are independent with unit variance.
+      ceres::Covariance::Options cov_options;
+      cov_options.algorithm_type = ceres::DENSE_SVD;
+      cov_options.num_threads = options.num_threads;
+      ceres::Covariance covariance(cov_options);
+      const std::vector<std::pair<const double*, const double*>> pairs{
+          {log_k.data(), log_k.data()}};
+      if (covariance.Compute(pairs, &problem)) {
+        Eigen::MatrixXd h_inv(p_count, p_count);
+        covariance.GetCovarianceBlock(log_k.data(), log_k.data(), h_inv.data());
+        // The Jacobian at the solution, as Ceres differentiated it, columns in `blocks` order.
+        ceres::CRSMatrix crs;
+        ceres::Problem::EvaluateOptions evaluate;
+        evaluate.parameter_blocks = blocks;
+        problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+        Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+        for (int r = 0; r < crs.num_rows; ++r)
+          for (int i = crs.rows[r]; i < crs.rows[r + 1]; ++i)
+            jacobian(r, crs.cols[i]) = crs.values[i];
+        // G: the coefficients' rows of H^-1 (H symmetric, so the solve of H G^T = E).
+        Eigen::MatrixXd gain = h_inv;
+        if (fit_velocities) {
+          const Eigen::MatrixXd h = jacobian.transpose() * jacobian;
+          gain = h.ldlt().solve(Eigen::MatrixXd::Identity(unknowns, p_count)).transpose();
+        }
+        Model fitted = trajectory.model;
+        for (int p = 0; p < p_count; ++p) set_parameter(fitted, free[p], std::exp(log_k[p]));
+        const RestartAwareCovariance restart = restart_aware_covariance(
+            trajectory, fitted, windows, velocities, jacobian, gain, result.residual_rms);
+        replays += restart.replays;
+        const Real sum_squares = 2 * summary.final_cost;
+        // Independent residuals: s^2 = |r|^2 / (m - q), Cov = s^2 (J^T J)^-1.
+        const Real s2_independent = sum_squares / (result.residuals - unknowns);
+        const Real s2 = sum_squares / std::max<Real>(restart.trace - unknowns, 1);
+        const Eigen::MatrixXd cov = s2 * restart.meat;
+        // Delta method: sd(k) = k sd(log k).
+        for (int p = 0; p < p_count; ++p) {
+          FittedParameter& fp = result.parameters[p];
+          fp.stddev = fp.value * std::sqrt(cov(p, p));
+          fp.stddev_independent = fp.value * std::sqrt(s2_independent * h_inv(p, p));
+        }
+        result.covariance_ok = true;
+      } else {
+        result.covariance_message =
+            "the Jacobian is rank deficient: some coefficient is not identifiable from this "
+            "recording";
+      }
+    }
+  } else {
+    result.covariance_message = "not requested";
+  }
+  result.restart_velocities = std::move(velocities);
+  result.replays = replays.load();
+  const auto end = std::chrono::steady_clock::now();
+  result.covariance_seconds = std::chrono::duration<double>(end - covariance_start).count();
+  result.wall_seconds = std::chrono::duration<double>(end - start).count();
+  return result;
+}
+
+void apply_fit(Model& model, const FitResult& result) {
+  for (const FittedParameter& p : result.parameters) set_parameter(model, p.parameter, p.value);
+}
+
+void apply_fit(CubeSpec& spec, const FitResult& result) {
+  for (const FittedParameter& p : result.parameters) {
+    for (SpringType t : kTypes) {
+      if (!p.parameter.applies_to(t)) continue;
+      SpringCoefficients& c = spec.springs[static_cast<int>(t)];
+      (p.parameter.quantity == FitParameter::Quantity::kKs ? c.ks : c.kd) = p.value;
+    }
+  }
+}
+
+}  // namespace jelly

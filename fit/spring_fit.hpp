@@ -1,0 +1,110 @@
+#pragma once
+// Parameter identification: the spring and damper coefficients for which a replay of a recorded
+// trajectory matches its positions best in the least-squares sense (docs/fitting.md).
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <jelly/core/cube.hpp>
+#include <jelly/core/model.hpp>
+#include <jelly/fit/trajectory.hpp>
+
+namespace jelly {
+
+// One free coefficient: ks or kd, of one spring type or of all types together.
+struct FitParameter {
+  enum class Quantity { kKs, kKd };
+  Quantity quantity = Quantity::kKs;
+  std::optional<SpringType> type;  // none = every spring type shares the value
+
+  // "ks", "kd", "ks.structural", "kd.bending", ...
+  std::string name() const;
+  bool applies_to(SpringType t) const { return !type || *type == t; }
+};
+
+// Parses a comma-separated list such as "ks,kd" or "ks.structural,ks.shear,kd". Throws
+// InputError (field "free") for an unknown name, a duplicate or an overlap ("ks" and
+// "ks.shear").
+std::vector<FitParameter> parse_free_parameters(std::string_view list);
+
+struct FitOptions {
+  std::vector<FitParameter> free = parse_free_parameters("ks,kd");
+  // Starting values by parameter name; a parameter not named starts at the mean of its springs'
+  // current coefficient in the trajectory's model. Every start must be > 0.
+  std::map<std::string, Real> initial;
+  // Multiple shooting: windows of this length (s), each replayed from its recorded first frame;
+  // 0 = one window over the whole recording.
+  Real window = 0.1;
+  int max_iterations = 50;
+  Real function_tolerance = 1e-10;
+  Real gradient_tolerance = 1e-12;
+  Real parameter_tolerance = 1e-10;
+  // Full multiple shooting on the velocities: each window's initial velocity becomes 3N extra
+  // unknowns, started from the recorded (or finite-difference) velocity. Removes the bias of
+  // finite-difference restarts for recordings without velocities, at 2 x 3N more replays of
+  // each window per Jacobian (docs/fitting.md). Positions still restart from the recording.
+  bool fit_restart_velocities = false;
+  // Relative step of the central differences, on the log of the coefficients.
+  Real relative_step = 1e-6;
+  int num_threads = 1;
+  bool compute_covariance = true;
+  bool progress_to_stdout = false;
+
+  // Throws InputError naming the first invalid option.
+  void validate() const;
+};
+
+struct FittedParameter {
+  FitParameter parameter;
+  std::string name;
+  Real initial = 0;
+  Real value = 0;
+  // Standard deviation by the delta method, sd(k) = k sd(log k), from the covariance of the
+  // log-coefficients; NaN when the covariance could not be computed. `stddev` accounts for the
+  // noise of the restart states (docs/fitting.md); `stddev_independent` is the textbook
+  // s^2 (J^T J)^-1, which treats every residual as independent and is too small when the
+  // recorded positions are noisy.
+  Real stddev = 0;
+  Real stddev_independent = 0;
+};
+
+struct FitResult {
+  std::vector<FittedParameter> parameters;
+  Real initial_cost = 0;  // 1/2 sum of squared position residuals (m^2)
+  Real final_cost = 0;
+  int iterations = 0;
+  bool converged = false;   // Ceres terminated with CONVERGENCE
+  std::string termination;  // Ceres' message
+  std::string brief_report;
+  bool covariance_ok = false;
+  std::string covariance_message;
+  Real residual_rms = 0;  // sqrt(2 final_cost / residuals) (m)
+  int windows = 0;
+  int residuals = 0;
+  // The fitted initial velocity of each window (fit_restart_velocities), else empty.
+  std::vector<VecX> restart_velocities;
+  long replays = 0;             // window replays (each one simulation of a window)
+  Real wall_seconds = 0;        // the whole call
+  Real covariance_seconds = 0;  // of which the covariance
+
+  // The estimate named "ks", "kd.shear", ...; throws InputError for a name not fitted.
+  const FittedParameter& at(std::string_view name) const;
+  // Several lines: estimates with standard deviations, costs, iterations, Ceres' brief report.
+  std::string report() const;
+};
+
+// Fits the free coefficients of `options` to `trajectory`. Throws InputError for an invalid
+// trajectory or options; a fit that does not converge is reported in the result.
+FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options = {});
+
+// Writes the fitted values into every spring they apply to.
+void apply_fit(Model& model, const FitResult& result);
+void apply_fit(CubeSpec& spec, const FitResult& result);
+
+// 1/2 sum over the windows of |x_replay - x_recorded|^2 with the model's current coefficients.
+Real replay_cost(const Trajectory& trajectory, Real window);
+
+}  // namespace jelly
