@@ -3,12 +3,15 @@
 #include <string>
 
 #include <jelly/core/types.hpp>
+#include <jelly/solvers/arkode_options.hpp>
 
 namespace jelly {
 
 struct IntegratorOptions {
+  ArkodeOptions arkode;  // arkode_erk, arkode_dirk
+
   // Throws InputError naming the first invalid option.
-  void validate() const {}
+  void validate() const { arkode.validate(); }
 };
 
 }  // namespace jelly

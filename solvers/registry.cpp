@@ -4,6 +4,7 @@
 #include <functional>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/arkode_erk.hpp>
 #include <jelly/solvers/explicit_euler.hpp>
 #include <jelly/solvers/midpoint.hpp>
 #include <jelly/solvers/rk4.hpp>
@@ -28,6 +29,8 @@ Factory plain() {
 const std::vector<Entry>& table() {
   static const std::vector<Entry> entries = [] {
     std::vector<Entry> e{
+        {{"arkode_erk", "SUNDIALS ARKODE adaptive explicit Runge-Kutta (default 5(4) pair)"},
+         [](const IntegratorOptions& o) { return std::make_unique<ArkodeErk>(o.arkode); }},
         {{"explicit_euler", "forward Euler, order 1, explicit"}, plain<ExplicitEuler>()},
         {{"midpoint", "explicit midpoint (the report's midpoint Euler), order 2"},
          plain<Midpoint>()},
