@@ -10,7 +10,7 @@ struct ArkodeOptions {
   Real rtol = 1e-6;  // relative tolerance of the local error test, in (0, 1)
   Real atol = 1e-8;  // absolute tolerance (m and m/s), > 0
   // An ARKODE Butcher table name with an embedding ("ARKODE_DORMAND_PRINCE_7_4_5" for
-  // arkode_erk, "ARKODE_ARK324L2SA_DIRK_4_2_3" for arkode_dirk); empty = that default.
+  // arkode_erk, "ARKODE_ARK548L2SA_DIRK_8_4_5" for arkode_dirk); empty = that default.
   std::string method;
   Real max_step = 0;                    // s, largest internal step; 0 = the contact interval dt
   std::string linear_solver = "schur";  // arkode_dirk: "schur" (default) or "klu"

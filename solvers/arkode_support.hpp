@@ -55,7 +55,8 @@ ContextPtr make_context();
 struct RhsData {
   const Dynamics* dynamics = nullptr;
   VecX x, v, a;
-  std::string error;  // the last message of ARKODE's error handler
+  std::string error;      // the last message of ARKODE's error handler
+  void* owner = nullptr;  // the Driver, for callbacks that need more (Jacobian)
 };
 
 // ARKRhsFn: ydot = [v; a(x, v)]. Returns 1 (recoverable: ARKODE retries with a smaller step)
@@ -114,6 +115,7 @@ class Driver {
   virtual void add_statistics(Statistics& /*stats*/) const {}
   // A failure message: what failed, SUNDIALS' flag name and its last message.
   std::string failure(const char* call, int flag) const;
+  const Counters& total() const { return total_; }
 
   std::string name_;
   const StepperApi& api_;

@@ -1,0 +1,157 @@
+#include <jelly/solvers/arkode_schur.hpp>
+
+#include <arkode/arkode_arkstep.h>
+
+namespace jelly::arkode {
+
+namespace {
+
+struct SchurContent {
+  void* arkode_memory = nullptr;
+  const RhsData* data = nullptr;
+  std::unique_ptr<SchurSystem> system;
+  Real gamma = 0;  // of the last factorization
+  VecX x, v, r, dv;
+  SchurStatistics statistics;
+  long last_flag = 0;
+};
+
+SchurContent& content(SUNLinearSolver s) { return *static_cast<SchurContent*>(s->content); }
+
+// ARKODE 6.4 never calls setup() of a SUNLINEARSOLVER_MATRIX_EMBEDDED solver, so this one
+// presents itself as a matrix-free ("iterative") solver that converges in one iteration: ARKODE
+// then calls setup() by its usual heuristics (gamma changed by 20%, every 20 steps, after a
+// convergence failure) as long as a preconditioner setup is set (attach_schur_solver).
+SUNLinearSolver_Type get_type(SUNLinearSolver) { return SUNLINEARSOLVER_ITERATIVE; }
+SUNLinearSolver_ID get_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
+int initialize(SUNLinearSolver) { return SUNLS_SUCCESS; }
+// Accept and ignore ARKODE's matrix-vector product and preconditioner: the Schur solve is direct.
+int set_atimes(SUNLinearSolver, void*, SUNATimesFn) { return SUNLS_SUCCESS; }
+int set_preconditioner(SUNLinearSolver, void*, SUNPSetupFn, SUNPSolveFn) { return SUNLS_SUCCESS; }
+int num_iterations(SUNLinearSolver) { return 1; }
+realtype residual_norm(SUNLinearSolver) { return 0; }
+sunindextype last_flag(SUNLinearSolver s) { return content(s).last_flag; }
+
+// Assembles K, D at ARKODE's current Newton iterate and factorizes S for its current gamma.
+int setup(SUNLinearSolver s, SUNMatrix /*unused: the matrix is embedded*/) {
+  SchurContent& c = content(s);
+  try {
+    const Model& model = c.data->dynamics->model();
+    const Eigen::Index n = model.num_dofs();
+    if (!c.system || c.system->size() != n) c.system = std::make_unique<SchurSystem>(model);
+    N_Vector y = nullptr;
+    Real gamma = 0;
+    if (ARKStepGetCurrentState(c.arkode_memory, &y) != ARK_SUCCESS ||
+        ARKStepGetCurrentGamma(c.arkode_memory, &gamma) != ARK_SUCCESS) {
+      c.last_flag = SUNLS_MEM_NULL;
+      return SUNLS_MEM_NULL;
+    }
+    const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
+    c.x = yy.head(n);
+    c.v = yy.tail(n);
+    c.system->assemble(model, c.x, c.v);
+    ++c.statistics.factorizations;
+    std::string why;
+    if (!c.system->factorize(model, gamma, &why)) {
+      // Recoverable: ARKODE retries the step with a smaller h (smaller gamma).
+      ++c.statistics.not_positive_definite;
+      c.last_flag = SUNLS_PACKAGE_FAIL_REC;
+      return SUNLS_PACKAGE_FAIL_REC;
+    }
+    c.gamma = gamma;
+    c.last_flag = SUNLS_SUCCESS;
+    return SUNLS_SUCCESS;
+  } catch (const std::bad_alloc&) {
+    c.last_flag = SUNLS_MEM_FAIL;
+    return SUNLS_MEM_FAIL;
+  } catch (const std::exception&) {
+    c.last_flag = SUNLS_PACKAGE_FAIL_UNREC;
+    return SUNLS_PACKAGE_FAIL_UNREC;
+  }
+}
+
+// x = (I - gamma J)^-1 b by the Schur reduction (formula in the header).
+int solve(SUNLinearSolver s, SUNMatrix /*unused*/, N_Vector x, N_Vector b, realtype /*tol*/) {
+  SchurContent& c = content(s);
+  if (!c.system) return SUNLS_MEM_NULL;
+  const Model& model = c.data->dynamics->model();
+  const Eigen::Index n = c.system->size();
+  const Eigen::Map<const VecX> bb(N_VGetArrayPointer(b), 2 * n);
+  Eigen::Map<VecX> xx(N_VGetArrayPointer(x), 2 * n);
+  const Real g = c.gamma;
+  // r = M bv + gamma K bx.
+  c.r.noalias() = g * (c.system->k() * bb.head(n));
+  for (int i = 0; i < model.num_particles(); ++i)
+    c.r.segment<3>(3 * i) += model.mass[i] * bb.segment<3>(n + 3 * i);
+  c.system->solve(c.r, c.dv);
+  xx.head(n) = bb.head(n) + g * c.dv;
+  xx.tail(n) = c.dv;
+  // ARKODE scales the corrections of its own direct solvers when gamma changed since the
+  // factorization; do the same: x *= 2 / (1 + gamma / gamma_factorized).
+  Real gamma_now = g;
+  if (ARKStepGetCurrentGamma(c.arkode_memory, &gamma_now) == ARK_SUCCESS && gamma_now != g)
+    xx *= 2.0 / (1.0 + gamma_now / g);
+  ++c.statistics.solves;
+  c.last_flag = SUNLS_SUCCESS;
+  return SUNLS_SUCCESS;
+}
+
+int free_solver(SUNLinearSolver s) {
+  if (s == nullptr) return SUNLS_SUCCESS;
+  delete static_cast<SchurContent*>(s->content);
+  s->content = nullptr;
+  SUNLinSolFreeEmpty(s);
+  return SUNLS_SUCCESS;
+}
+
+}  // namespace
+
+LinearSolverPtr make_schur_solver(SUNContext context, void* arkode_memory, const RhsData* data) {
+  auto c = std::make_unique<SchurContent>();
+  c->arkode_memory = arkode_memory;
+  c->data = data;
+  SUNLinearSolver s = SUNLinSolNewEmpty(context);
+  if (s == nullptr) return nullptr;
+  s->content = c.release();
+  s->ops->gettype = get_type;
+  s->ops->getid = get_id;
+  s->ops->initialize = initialize;
+  s->ops->setatimes = set_atimes;
+  s->ops->setpreconditioner = set_preconditioner;
+  s->ops->numiters = num_iterations;
+  s->ops->resnorm = residual_norm;
+  s->ops->setup = setup;
+  s->ops->solve = solve;
+  s->ops->lastflag = last_flag;
+  s->ops->free = free_solver;
+  return LinearSolverPtr(s);
+}
+
+namespace {
+int no_preconditioner_setup(realtype, N_Vector, N_Vector, booleantype, booleantype* jcur, realtype,
+                            void*) {
+  *jcur = SUNTRUE;
+  return 0;
+}
+int no_preconditioner_solve(realtype, N_Vector, N_Vector, N_Vector r, N_Vector z, realtype,
+                            realtype, int, void*) {
+  N_VScale(1.0, r, z);
+  return 0;
+}
+}  // namespace
+
+int attach_schur_solver(void* arkode_memory, SUNLinearSolver solver) {
+  int flag = ARKStepSetLinearSolver(arkode_memory, solver, nullptr);
+  // ARKODE 6.4 disables the linear solver setup when there is neither a matrix nor a
+  // preconditioner setup; a no-op preconditioner keeps it, so that setup() factorizes.
+  if (flag >= 0)
+    flag =
+        ARKStepSetPreconditioner(arkode_memory, no_preconditioner_setup, no_preconditioner_solve);
+  return flag;
+}
+
+const SchurStatistics& schur_statistics(SUNLinearSolver solver) {
+  return content(solver).statistics;
+}
+
+}  // namespace jelly::arkode
