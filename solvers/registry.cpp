@@ -7,6 +7,7 @@
 #include <jelly/solvers/arkode_dirk.hpp>
 #include <jelly/solvers/arkode_erk.hpp>
 #include <jelly/solvers/explicit_euler.hpp>
+#include <jelly/solvers/implicit_euler.hpp>
 #include <jelly/solvers/midpoint.hpp>
 #include <jelly/solvers/rk4.hpp>
 #include <jelly/solvers/symplectic_euler.hpp>
@@ -36,6 +37,9 @@ const std::vector<Entry>& table() {
         {{"arkode_erk", "SUNDIALS ARKODE adaptive explicit Runge-Kutta (default 5(4) pair)"},
          [](const IntegratorOptions& o) { return std::make_unique<ArkodeErk>(o.arkode); }},
         {{"explicit_euler", "forward Euler, order 1, explicit"}, plain<ExplicitEuler>()},
+        {{"implicit_euler",
+          "backward Euler on a sparse Cholesky/CG solver, order 1, implicit (stable at any dt)"},
+         [](const IntegratorOptions& o) { return std::make_unique<ImplicitEuler>(o.implicit); }},
         {{"midpoint", "explicit midpoint (the report's midpoint Euler), order 2"},
          plain<Midpoint>()},
         {{"rk4", "classical Runge-Kutta, order 4, explicit"}, plain<RungeKutta4>()},

@@ -1,0 +1,70 @@
+#pragma once
+// Sparse Jacobians df/dx (K) and df/dv (D) of the spring and damper forces on one fixed 3x3-block
+// sparsity pattern, built once with a scatter map; each assembly only refills the values.
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/SparseCore>
+
+#include <jelly/core/model.hpp>
+
+namespace jelly {
+
+using SparseMatrix = Eigen::SparseMatrix<Real, Eigen::ColMajor, int>;
+
+// How the geometric (transverse) stiffness of a spring is kept from making -K indefinite
+// (docs/implicit.md). Per spring, the symmetric part of -df_a/dxa is ks u u^T + s P, with
+// P = I - u u^T, s = ks (1 - l0/L) + kd c / L (c = (va - vb).u); it is negative for a compressed
+// (or a closing) spring.
+enum class DefinitenessFix {
+  kClampCompressed,  // Choi & Ko 2002: ks (1 - l0/L) and kd c/L each clamped to >= 0 (default)
+  kProjectPsd,       // the spring's 3x3 block projected to PSD: s clamped to >= 0
+  kNone,             // the exact symmetric Jacobian; M - h D - h^2 K may be indefinite
+};
+std::string_view definiteness_name(DefinitenessFix fix);
+// "clamp", "project" or "none"; false for anything else.
+bool parse_definiteness(std::string_view text, DefinitenessFix* fix);
+
+struct JacobianOptions {
+  DefinitenessFix definiteness = DefinitenessFix::kClampCompressed;
+  // The damper force -kd c u has a non-symmetric df/dx term -kd/L u (P w)^T, w = va - vb.
+  // false (used by the solvers) drops it, so K is symmetric; true keeps it, so that with kNone K
+  // is the exact df/dx (tests).
+  bool exact_damper = false;
+};
+
+class SpringJacobian {
+ public:
+  // Builds the pattern of the 3N x 3N matrices for the springs of `model`: one dense 3x3 block
+  // per particle on the diagonal and per spring (a, b) at (a, b) and (b, a). Full storage (both
+  // triangles), compressed column, sorted row indices.
+  explicit SpringJacobian(const Model& model);
+
+  int rows() const { return 3 * num_particles_; }
+  int non_zeros() const { return static_cast<int>(row_index_.size()); }
+  int num_springs() const { return static_cast<int>(spring_base_.size() / 4); }
+  // A matrix with this pattern and zero values (allocates; call once).
+  SparseMatrix make_matrix() const;
+  // True when `m` has this pattern's size (the matrices passed below must come from make_matrix).
+  bool matches(const SparseMatrix& m) const;
+
+  // K = df/dx and D = df/dv of the spring and damper forces at (x, v). No allocation.
+  void assemble(const Model& model, const VecX& x, const VecX& v, const JacobianOptions& options,
+                SparseMatrix& k, SparseMatrix& d) const;
+  // The backward-Euler matrix A = M - alpha D - beta K and kw = K w, in one pass over the
+  // springs (K as assembled with `options`, which must not set exact_damper). No allocation.
+  void assemble_system(const Model& model, const VecX& x, const VecX& v,
+                       const JacobianOptions& options, Real alpha, Real beta, SparseMatrix& a,
+                       const VecX& w, VecX& kw) const;
+
+ private:
+  int num_particles_ = 0;
+  std::vector<int> col_start_;    // [3N + 1]
+  std::vector<int> row_index_;    // [nnz]
+  std::vector<int> spring_base_;  // [4 M]: value index of entry (0, 0) of blocks aa, ab, ba, bb
+  std::vector<int> column_stride_;  // [N]: distance between columns 3j and 3j + 1 of particle j
+  std::vector<int> diagonal_;       // [3N]: value index of entry (i, i)
+};
+
+}  // namespace jelly

@@ -1,0 +1,206 @@
+#include <jelly/solvers/implicit_euler.hpp>
+
+#include <chrono>
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/solvers/cg_solver.hpp>
+#include <jelly/solvers/cholmod_solver.hpp>
+#include <jelly/solvers/ldlt_solver.hpp>
+
+namespace jelly {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+CholmodOrdering ordering_of(const std::string& name) {
+  if (name == "amd") return CholmodOrdering::kAmd;
+  if (name == "nesdis") return CholmodOrdering::kNesdis;
+  if (name == "best") return CholmodOrdering::kBest;
+  return CholmodOrdering::kMetis;
+}
+
+// Below this many unknowns a fresh CHOLMOD factorization every step is cheap (well under a
+// millisecond at 1000 unknowns) and exact; above it a lagged factor preconditioning CG is
+// faster (docs/implicit.md, bench/implicit_benchmark.cpp).
+constexpr int kAutoDirectMaxDofs = 1000;
+
+}  // namespace
+
+std::string auto_linear_solver(int dofs) {
+  return dofs <= kAutoDirectMaxDofs ? "cholmod" : "cg_lagged_cholmod";
+}
+
+ImplicitEuler::ImplicitEuler(ImplicitEulerOptions options) : options_(std::move(options)) {
+  std::string why;
+  if (!options_.is_valid(&why)) throw InputError("integrator." + why);
+  jacobian_options_.definiteness = options_.definiteness;
+  residuals_.reserve(options_.newton_iterations + 1);
+}
+
+std::string_view ImplicitEuler::linear_solver_name() const {
+  return solver_ ? solver_->name() : std::string_view();
+}
+
+Statistics ImplicitEuler::statistics() const {
+  Statistics s = Integrator::statistics();
+  const LinearSolverCounters c = solver_ ? solver_->counters() : LinearSolverCounters{};
+  s["symbolic_analyses"] = static_cast<double>(c.analyses);
+  s["numeric_factorizations"] = static_cast<double>(c.factorizations);
+  s["linear_solves"] = static_cast<double>(c.solves);
+  s["cg_iterations"] = static_cast<double>(c.cg_iterations);
+  s["newton_iterations"] = static_cast<double>(newton_iterations_);
+  s["newton_not_converged"] = static_cast<double>(newton_not_converged_);
+  s["assembly_seconds"] = assembly_seconds_;
+  s["factorization_seconds"] = factorization_seconds_;
+  s["solve_seconds"] = solve_seconds_;
+  return s;
+}
+
+StepResult ImplicitEuler::prepare(const Model& model, Real h) {
+  const int n = model.num_dofs();
+  if (!jacobian_ || jacobian_->rows() != n || jacobian_->num_springs() != model.springs.size()) {
+    const auto start = Clock::now();
+    jacobian_.emplace(model);
+    a_ = jacobian_->make_matrix();
+    std::string kind = options_.linear_solver;
+    if (kind == "auto") kind = auto_linear_solver(n);
+    CholmodOptions cholmod;
+    cholmod.ordering = ordering_of(options_.ordering);
+    if (kind == "cholmod") {
+      solver_ = std::make_unique<CholmodSolver>(cholmod);
+    } else if (kind == "ldlt") {
+      solver_ = std::make_unique<LdltSolver>();
+    } else {
+      CgOptions cg;
+      cg.preconditioner = kind == "cg_lagged_cholmod" || options_.cg_preconditioner == "cholmod"
+                              ? CgPreconditioner::kLaggedCholesky
+                              : CgPreconditioner::kJacobi;
+      cg.tolerance = options_.cg_tolerance;
+      cg.max_iterations = options_.cg_max_iterations;
+      cg.refactor_iterations = options_.refactor_iterations;
+      cg.cholmod = cholmod;
+      solver_ = std::make_unique<CgSolver>(cg);
+    }
+    const LinearResult r = solver_->analyze(a_);
+    factorization_seconds_ += seconds_since(start);
+    if (!r.ok()) return StepResult::failure("implicit_euler: " + r.message);
+    f_.setZero(n);
+    kw_.setZero(n);
+    b_.setZero(n);
+    dv_.setZero(n);
+    v1_.setZero(n);
+    x1_.setZero(n);
+    g_.setZero(n);
+    delta_.setZero(n);
+    have_dv_ = false;
+  }
+  if (h != last_h_) solver_->invalidate();
+  last_h_ = h;
+  return StepResult::success();
+}
+
+StepResult ImplicitEuler::solve(const Model& model, const VecX& x, const VecX& v, Real h,
+                                const VecX& w, VecX* kw, const VecX& b, VecX& y) {
+  auto start = Clock::now();
+  jacobian_->assemble_system(model, x, v, jacobian_options_, h, h * h, a_, w, kw ? *kw : kw_);
+  assembly_seconds_ += seconds_since(start);
+  start = Clock::now();
+  LinearResult r = solver_->factorize(a_);
+  factorization_seconds_ += seconds_since(start);
+  if (r.ok()) {
+    start = Clock::now();
+    r = solver_->solve(b, y);
+    solve_seconds_ += seconds_since(start);
+  }
+  if (!r.ok()) return StepResult::failure("implicit_euler: linear solve failed (" +
+                                          std::string(linear_status_name(r.status)) +
+                                          "): " + r.message);
+  if (!y.allFinite())
+    return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
+  return StepResult::success();
+}
+
+StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
+  const Model& model = dynamics.model();
+  if (StepResult r = prepare(model, h); !r.ok) return r;
+  const int np = model.num_particles();
+  const Real* m = model.mass.data();
+
+  // Linearized step: (M - h D - h^2 K) dv = h (f + h K v).
+  auto start = Clock::now();
+  dynamics.forces(s.x, s.v, f_);
+  assembly_seconds_ += seconds_since(start);
+  if (!have_dv_) {  // first guess for CG: the explicit step h M^-1 f; later the last dv
+    for (int i = 0; i < np; ++i) dv_.segment<3>(3 * i) = (h / m[i]) * f_.segment<3>(3 * i);
+  }
+  // b = h (f + h K v); K v comes out of the assembly, so b is formed after it (in solve()).
+  // Assemble first with kw_, then build b, then factorize and solve.
+  start = Clock::now();
+  jacobian_->assemble_system(model, s.x, s.v, jacobian_options_, h, h * h, a_, s.v, kw_);
+  b_ = h * (f_ + h * kw_);
+  assembly_seconds_ += seconds_since(start);
+  start = Clock::now();
+  LinearResult lr = solver_->factorize(a_);
+  factorization_seconds_ += seconds_since(start);
+  if (lr.ok()) {
+    start = Clock::now();
+    lr = solver_->solve(b_, dv_);
+    solve_seconds_ += seconds_since(start);
+  }
+  if (!lr.ok()) {
+    have_dv_ = false;
+    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(s.t) +
+                               " (" + std::string(linear_status_name(lr.status)) +
+                               "): " + lr.message);
+  }
+  if (!dv_.allFinite()) {
+    have_dv_ = false;
+    return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
+  }
+  have_dv_ = true;
+  ++newton_iterations_;
+  v1_ = s.v + dv_;
+
+  residuals_.clear();
+  converged_ = true;
+  if (options_.newton_iterations > 1) {
+    // Newton on g(v1) = M (v1 - v0) - h f(x0 + h v1, v1) = 0, dg/dv1 = M - h D - h^2 K.
+    Real scale = h * f_.norm();
+    if (!(scale > 0)) scale = 1;
+    converged_ = false;
+    for (int k = 1;; ++k) {
+      x1_ = s.x + h * v1_;
+      dynamics.forces(x1_, v1_, f_);
+      for (int i = 0; i < np; ++i)
+        g_.segment<3>(3 * i) =
+            m[i] * (v1_.segment<3>(3 * i) - s.v.segment<3>(3 * i)) - h * f_.segment<3>(3 * i);
+      const Real residual = g_.norm();
+      residuals_.push_back(residual);
+      if (!std::isfinite(residual))
+        return StepResult::failure("implicit_euler: Newton residual is not finite");
+      if (residual <= options_.newton_tolerance * scale) {
+        converged_ = true;
+        break;
+      }
+      if (k >= options_.newton_iterations) break;
+      g_ = -g_;
+      delta_.setZero();
+      if (StepResult r = solve(model, x1_, v1_, h, v1_, nullptr, g_, delta_); !r.ok) return r;
+      ++newton_iterations_;
+      v1_ += delta_;
+    }
+    if (!converged_) ++newton_not_converged_;
+    dv_ = v1_ - s.v;
+  }
+  s.v = v1_;
+  s.x += h * s.v;
+  s.t += h;
+  return StepResult::success();
+}
+
+}  // namespace jelly

@@ -1,0 +1,35 @@
+#pragma once
+// Options of the implicit Euler integrator (docs/implicit.md), with a validity check that names
+// the offending field.
+#include <string>
+
+#include <jelly/core/jacobian.hpp>
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+struct ImplicitEulerOptions {
+  // 1 = linearized backward Euler (Baraff & Witkin 1998), one linear solve per step;
+  // > 1 = fully nonlinear backward Euler by Newton, at most this many linear solves per step.
+  int newton_iterations = 1;
+  // Newton stops when |M (v1 - v0) - h f(x0 + h v1, v1)| <= newton_tolerance |h f(x0, v0)|.
+  Real newton_tolerance = 1e-8;
+  DefinitenessFix definiteness = DefinitenessFix::kClampCompressed;
+  // "cholmod" (factor every step), "ldlt" (Eigen, factor every step), "cg", or "auto":
+  // direct CHOLMOD for small systems, CG preconditioned by a lagged CHOLMOD factor otherwise.
+  std::string linear_solver = "auto";
+  // For "cg": "jacobi" or "cholmod" (a CHOLMOD factor of an earlier matrix, refreshed when CG
+  // needs more than refactor_iterations with it, or when dt changes).
+  std::string cg_preconditioner = "jacobi";
+  Real cg_tolerance = 1e-10;  // relative residual |b - A x| / |b|
+  int cg_max_iterations = 1000;
+  int refactor_iterations = 6;
+  // Fill-reducing ordering of CHOLMOD: "metis", "amd", "nesdis" or "best" (CHOLMOD's default).
+  std::string ordering = "metis";
+
+  // False, with "implicit.<field> = <value> is invalid: <allowed>" in *why, for the first
+  // invalid field.
+  bool is_valid(std::string* why) const;
+};
+
+}  // namespace jelly
