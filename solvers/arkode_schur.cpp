@@ -1,8 +1,66 @@
 #include <jelly/solvers/arkode_schur.hpp>
 
+#include <algorithm>
+
 #include <arkode/arkode_arkstep.h>
 
 namespace jelly::arkode {
+
+namespace {
+// Small systems (the 4x4x4 test cubes) factorize fastest simplicial with AMD; larger ones with
+// the CHOLMOD wrapper's default (supernodal, METIS).
+CholmodOptions cholmod_options(const Model& model) {
+  CholmodOptions options;
+  if (model.num_dofs() < SchurSystem::kSupernodalFromDofs) {
+    options.ordering = CholmodOrdering::kAmd;
+    options.supernodal = false;
+  }
+  return options;
+}
+}  // namespace
+
+SchurSystem::SchurSystem(const Model& model)
+    : jacobian_(model),
+      k_(jacobian_.make_matrix()),
+      d_(jacobian_.make_matrix()),
+      s_(jacobian_.make_matrix()),
+      cholmod_(cholmod_options(model)) {
+  diagonal_.resize(static_cast<size_t>(s_.cols()));
+  for (int j = 0; j < s_.cols(); ++j) {
+    const int* begin = s_.innerIndexPtr() + s_.outerIndexPtr()[j];
+    const int* end = s_.innerIndexPtr() + s_.outerIndexPtr()[j + 1];
+    diagonal_[j] = static_cast<int>(std::lower_bound(begin, end, j) - s_.innerIndexPtr());
+  }
+}
+
+SchurSystem::~SchurSystem() = default;
+
+void SchurSystem::assemble(const Model& model, const VecX& x, const VecX& v) {
+  jacobian_.assemble(model, x, v, JacobianOptions{}, k_, d_);
+}
+
+LinearResult SchurSystem::factorize(const Model& model, Real gamma) {
+  const Real* kv = k_.valuePtr();
+  const Real* dv = d_.valuePtr();
+  Real* sv = s_.valuePtr();
+  // S = M - gamma D - gamma^2 K on the shared pattern.
+  for (Eigen::Index p = 0; p < s_.nonZeros(); ++p) sv[p] = -gamma * dv[p] - gamma * gamma * kv[p];
+  for (int j = 0; j < static_cast<int>(diagonal_.size()); ++j)
+    sv[diagonal_[j]] += model.mass[j / 3];
+  if (!analysed_) {
+    const LinearResult r = cholmod_.analyze(s_);
+    if (!r.ok()) return r;
+    analysed_ = true;
+  }
+  return cholmod_.factorize(s_);
+}
+
+bool SchurSystem::solve(const VecX& r, VecX& out, std::string* why) {
+  ensure_size(out, r.size());
+  const LinearResult result = cholmod_.solve(r, out);
+  if (!result.ok()) *why = result.message;
+  return result.ok();
+}
 
 namespace {
 
@@ -13,6 +71,7 @@ struct SchurContent {
   Real gamma = 0;  // of the last factorization
   VecX x, v, r, dv;
   SchurStatistics statistics;
+  std::string error;  // the reason of the last failure
   long last_flag = 0;
 };
 
@@ -51,12 +110,15 @@ int setup(SUNLinearSolver s, SUNMatrix /*unused: the matrix is embedded*/) {
     c.v = yy.tail(n);
     c.system->assemble(model, c.x, c.v);
     ++c.statistics.factorizations;
-    std::string why;
-    if (!c.system->factorize(model, gamma, &why)) {
-      // Recoverable: ARKODE retries the step with a smaller h (smaller gamma).
-      ++c.statistics.not_positive_definite;
-      c.last_flag = SUNLS_PACKAGE_FAIL_REC;
-      return SUNLS_PACKAGE_FAIL_REC;
+    const LinearResult r = c.system->factorize(model, gamma);
+    if (!r.ok()) {
+      c.error = std::string(linear_status_name(r.status)) + ": " + r.message;
+      // Not positive definite is recoverable: ARKODE retries with a smaller h (smaller gamma),
+      // and M - gamma D - gamma^2 K tends to M.
+      const bool recoverable = r.status == LinearStatus::kNotPositiveDefinite;
+      if (recoverable) ++c.statistics.not_positive_definite;
+      c.last_flag = recoverable ? SUNLS_PACKAGE_FAIL_REC : SUNLS_PACKAGE_FAIL_UNREC;
+      return static_cast<int>(c.last_flag);
     }
     c.gamma = gamma;
     c.last_flag = SUNLS_SUCCESS;
@@ -83,7 +145,10 @@ int solve(SUNLinearSolver s, SUNMatrix /*unused*/, N_Vector x, N_Vector b, realt
   c.r.noalias() = g * (c.system->k() * bb.head(n));
   for (int i = 0; i < model.num_particles(); ++i)
     c.r.segment<3>(3 * i) += model.mass[i] * bb.segment<3>(n + 3 * i);
-  c.system->solve(c.r, c.dv);
+  if (!c.system->solve(c.r, c.dv, &c.error)) {
+    c.last_flag = SUNLS_PACKAGE_FAIL_UNREC;
+    return SUNLS_PACKAGE_FAIL_UNREC;
+  }
   xx.head(n) = bb.head(n) + g * c.dv;
   xx.tail(n) = c.dv;
   // ARKODE scales the corrections of its own direct solvers when gamma changed since the
@@ -149,6 +214,8 @@ int attach_schur_solver(void* arkode_memory, SUNLinearSolver solver) {
         ARKStepSetPreconditioner(arkode_memory, no_preconditioner_setup, no_preconditioner_solve);
   return flag;
 }
+
+const std::string& schur_error(SUNLinearSolver solver) { return content(solver).error; }
 
 const SchurStatistics& schur_statistics(SUNLinearSolver solver) {
   return content(solver).statistics;

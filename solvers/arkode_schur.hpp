@@ -7,47 +7,46 @@
 #include <memory>
 #include <string>
 
-#include <Eigen/SparseCore>
-
+#include <jelly/core/jacobian.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/arkode_support.hpp>
+#include <jelly/solvers/cholmod_solver.hpp>
 
 namespace jelly::arkode {
 
-using SparseMatrix = Eigen::SparseMatrix<Real>;  // column-major (CSC), compressed
-
-// The spring Jacobians K, D on one fixed pattern (every 3x3 block a spring touches, and the
-// whole diagonal) and the Cholesky factorization of S = M - gamma D - gamma^2 K, whose symbolic
-// analysis is done once per pattern.
+// The spring Jacobians K, D (core/jacobian: one fixed pattern, every diagonal block present)
+// and the CHOLMOD factorization of S = M - gamma D - gamma^2 K, analysed once per pattern.
 class SchurSystem {
  public:
+  // Below this many unknowns, a simplicial AMD factorization (measured in docs/arkode.md).
+  static constexpr int kSupernodalFromDofs = 1000;
+
   explicit SchurSystem(const Model& model);
   ~SchurSystem();
   SchurSystem(const SchurSystem&) = delete;
   SchurSystem& operator=(const SchurSystem&) = delete;
 
-  // Refills K and D at (x, v). The geometric term of compressed springs is clamped to zero
-  // (Choi and Ko 2002) and the damper's position derivative left out, so that both stay
-  // symmetric negative semi-definite: a Newton matrix, not the exact Jacobian.
+  // Refills K and D at (x, v) with the default definiteness fix (compressed springs' geometric
+  // term clamped, Choi and Ko 2002) and without the damper's non-symmetric df/dx term: a
+  // symmetric Newton matrix, not the exact Jacobian.
   void assemble(const Model& model, const VecX& x, const VecX& v);
-  // Factorizes S = M - gamma D - gamma^2 K; false, with the reason, unless S is positive
-  // definite.
-  bool factorize(const Model& model, Real gamma, std::string* why);
-  // out = S^-1 r with the last factorization.
-  void solve(const VecX& r, VecX& out) const;
+  // Factorizes S = M - gamma D - gamma^2 K (CHOLMOD's status and reason on failure:
+  // kNotPositiveDefinite, kOutOfMemory, ...).
+  LinearResult factorize(const Model& model, Real gamma);
+  // out = S^-1 r with the last factorization; false with the reason on failure.
+  bool solve(const VecX& r, VecX& out, std::string* why);
 
   const SparseMatrix& k() const { return k_; }
   const SparseMatrix& d() const { return d_; }
   Eigen::Index size() const { return k_.rows(); }
+  const LinearSolverCounters& counters() const { return cholmod_.counters(); }
 
  private:
-  struct Factorization;
+  SpringJacobian jacobian_;
   SparseMatrix k_, d_, s_;
-  // For spring i, offsets into the value arrays of its 4 blocks, column-major within a block:
-  // blocks (a, a), (b, b), (a, b), (b, a), 9 entries each.
-  std::vector<int> scatter_;
-  std::vector<int> diagonal_;  // offset of entry (j, j) for every column j
-  std::unique_ptr<Factorization> factorization_;
+  std::vector<int> diagonal_;  // value index of entry (j, j) for every column j
+  CholmodSolver cholmod_;
+  bool analysed_ = false;
 };
 
 // The custom linear solver. `arkode_memory` is the ARKStep memory (for gamma and the state to
@@ -59,5 +58,7 @@ LinearSolverPtr make_schur_solver(SUNContext context, void* arkode_memory, const
 // ARKStepSetLinearSolver with no matrix, keeping ARKODE's calls to setup(); a SUNDIALS flag.
 int attach_schur_solver(void* arkode_memory, SUNLinearSolver solver);
 const SchurStatistics& schur_statistics(SUNLinearSolver solver);
+// CHOLMOD's reason for the last failed factorization or solve ("" if none).
+const std::string& schur_error(SUNLinearSolver solver);
 
 }  // namespace jelly::arkode

@@ -84,6 +84,8 @@ std::string Driver::failure(const char* call, int flag) const {
   std::string why = name_ + ": " + call + " returned " + (flag_name ? flag_name : "?");
   std::free(flag_name);
   if (!data_.error.empty()) why += " (" + data_.error + ")";
+  const std::string detail = failure_detail();
+  if (!detail.empty()) why += "; " + detail;
   return why;
 }
 

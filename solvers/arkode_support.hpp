@@ -113,6 +113,8 @@ class Driver {
   virtual int create(realtype t0, N_Vector y0) = 0;
   virtual Counters read_counters() const;
   virtual void add_statistics(Statistics& /*stats*/) const {}
+  // More about a failure than ARKODE's message (e.g. the linear solver's reason).
+  virtual std::string failure_detail() const { return {}; }
   // A failure message: what failed, SUNDIALS' flag name and its last message.
   std::string failure(const char* call, int flag) const;
   const Counters& total() const { return total_; }
