@@ -52,7 +52,7 @@ class SchurSystem {
 // The custom linear solver. `arkode_memory` is the ARKStep memory (for gamma and the state to
 // linearize about), `data` the right-hand side data (for the model).
 struct SchurStatistics {
-  long factorizations = 0, not_positive_definite = 0, solves = 0;
+  long factorizations = 0, not_positive_definite = 0, solves = 0, refinements = 0;
 };
 LinearSolverPtr make_schur_solver(SUNContext context, void* arkode_memory, const RhsData* data);
 // ARKStepSetLinearSolver with no matrix, keeping ARKODE's calls to setup(); a SUNDIALS flag.
