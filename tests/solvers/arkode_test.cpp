@@ -231,6 +231,10 @@ struct SeedScene {
   Real dt;
   bool elevator;
 };
+// Without it GoogleTest prints the parameter's bytes, padding included (valgrind: uninitialised).
+void PrintTo(const SeedScene& scene, std::ostream* out) {
+  *out << scene.integrator << (scene.elevator ? " elevator" : " slope") << " dt " << scene.dt;
+}
 class SeedScenes : public ::testing::TestWithParam<SeedScene> {};
 INSTANTIATE_TEST_SUITE_P(Arkode, SeedScenes,
                          ::testing::Values(SeedScene{"arkode_erk", 1e-3, false},
