@@ -14,15 +14,24 @@ void add_spring_forces(const Model& model, const VecX& x, const VecX& v, VecX& f
   const Real* kd = s.kd.data();
   const Real* px = x.data();
   const Real* pv = v.data();
+  const Real* pr = model.rest_position.data();
   Real* pf = f.data();
   for (int k = 0; k < count; ++k) {
     const int ia = 3 * a[k];
     const int ib = 3 * b[k];
-    const Real dx = px[ia] - px[ib];
-    const Real dy = px[ia + 1] - px[ib + 1];
-    const Real dz = px[ia + 2] - px[ib + 2];
+    Real dx = px[ia] - px[ib];
+    Real dy = px[ia + 1] - px[ib + 1];
+    Real dz = px[ia + 2] - px[ib + 2];
     const Real length = std::sqrt(dx * dx + dy * dy + dz * dz);
-    const Real inv = 1.0 / length;
+    Real inv = 1.0 / length;
+    if (!(length > kDegenerateLength * rest[k])) {
+      // Coincident particles (e.g. two projected onto one contact point): no direction, so the
+      // spring pushes along its rest direction instead of producing NaN.
+      dx = pr[ia] - pr[ib];
+      dy = pr[ia + 1] - pr[ib + 1];
+      dz = pr[ia + 2] - pr[ib + 2];
+      inv = 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
+    }
     const Real ux = dx * inv, uy = dy * inv, uz = dz * inv;
     const Real closing =
         (pv[ia] - pv[ib]) * ux + (pv[ia + 1] - pv[ib + 1]) * uy + (pv[ia + 2] - pv[ib + 2]) * uz;

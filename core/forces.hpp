@@ -4,6 +4,10 @@
 
 namespace jelly {
 
+// A spring shorter than this fraction of its rest length is degenerate: its direction is taken
+// from the rest positions (forces and Jacobians alike).
+inline constexpr Real kDegenerateLength = 1e-9;
+
 // f = m g + sum over springs of the spring and damper forces. f must have size 3N.
 // For a spring (a, b), with d = (xa - xb) / |xa - xb|:
 //   spring force on a  = -ks (|xa - xb| - l0) d

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/forces.hpp>
 
 namespace jelly {
 
@@ -43,11 +44,19 @@ struct SpringBlocks {
   Real d[9];
 };
 
-inline void spring_blocks(const Real* px, const Real* pv, int ia, int ib, Real rest, Real ks,
-                          Real kd, const JacobianOptions& options, SpringBlocks& out) {
-  const Real dx[3] = {px[ia] - px[ib], px[ia + 1] - px[ib + 1], px[ia + 2] - px[ib + 2]};
+inline void spring_blocks(const Real* px, const Real* pv, const Real* pr, int ia, int ib,
+                          Real rest, Real ks, Real kd, const JacobianOptions& options,
+                          SpringBlocks& out) {
+  Real dx[3] = {px[ia] - px[ib], px[ia + 1] - px[ib + 1], px[ia + 2] - px[ib + 2]};
   const Real w[3] = {pv[ia] - pv[ib], pv[ia + 1] - pv[ib + 1], pv[ia + 2] - pv[ib + 2]};
-  const Real length = std::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
+  Real length = std::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
+  if (!(length > kDegenerateLength * rest)) {
+    // Coincident particles: the direction of the rest positions, as in compute_forces.
+    for (int c = 0; c < 3; ++c) dx[c] = pr[ia + c] - pr[ib + c];
+    const Real scale = kDegenerateLength * rest / std::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
+    for (Real& c : dx) c *= scale;
+    length = kDegenerateLength * rest;
+  }
   const Real inv = 1.0 / length;
   const Real u[3] = {dx[0] * inv, dx[1] * inv, dx[2] * inv};
   const Real c = w[0] * u[0] + w[1] * u[1] + w[2] * u[2];
@@ -167,7 +176,7 @@ void SpringJacobian::assemble(const Model& model, const VecX& x, const VecX& v,
   SpringBlocks blocks;
   for (int sp = 0; sp < s.size(); ++sp) {
     const int a = s.a[sp], b = s.b[sp];
-    spring_blocks(x.data(), v.data(), 3 * a, 3 * b, s.rest_length[sp], s.ks[sp], s.kd[sp], options,
+    spring_blocks(x.data(), v.data(), model.rest_position.data(), 3 * a, 3 * b, s.rest_length[sp], s.ks[sp], s.kd[sp], options,
                   blocks);
     const int* base = &spring_base_[4 * sp];
     const int stride[4] = {column_stride_[a], column_stride_[b], column_stride_[a],
@@ -205,7 +214,7 @@ void SpringJacobian::assemble_system(const Model& model, const VecX& x, const Ve
   for (int sp = 0; sp < s.size(); ++sp) {
     const int a = s.a[sp], b = s.b[sp];
     const int ia = 3 * a, ib = 3 * b;
-    spring_blocks(x.data(), v.data(), ia, ib, s.rest_length[sp], s.ks[sp], s.kd[sp], options,
+    spring_blocks(x.data(), v.data(), model.rest_position.data(), ia, ib, s.rest_length[sp], s.ks[sp], s.kd[sp], options,
                   blocks);
     // Block of A = -alpha D - beta K; kw_a += K (wa - wb), kw_b -= K (wa - wb).
     const Real dw[3] = {pw[ia] - pw[ib], pw[ia + 1] - pw[ib + 1], pw[ia + 2] - pw[ib + 2]};

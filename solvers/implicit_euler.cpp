@@ -24,15 +24,29 @@ CholmodOrdering ordering_of(const std::string& name) {
   return CholmodOrdering::kMetis;
 }
 
-// Below this many unknowns a fresh CHOLMOD factorization every step is cheap (well under a
-// millisecond at 1000 unknowns) and exact; above it a lagged factor preconditioning CG is
-// faster (docs/implicit.md, bench/implicit_benchmark.cpp).
+// Below this many unknowns a fresh CHOLMOD factorization every step is cheap and exact; above
+// it block-Jacobi CG was the fastest backend measured at every size and stiffness of the
+// benchmark (docs/implicit.md, bench/implicit_benchmark.cpp), ahead of CG preconditioned by a
+// lagged CHOLMOD factor (whose triangular solves cost ~6 CG iterations each) and far ahead of a
+// factorization per step.
 constexpr int kAutoDirectMaxDofs = 1000;
+
+// Uniform translations are in the null space of K and D, so 1^T A = 1^T M and an exact solve
+// of A y = b changes the momentum by sum(b). An iterative solve misses by the sum of its
+// residual; this shifts y uniformly (which changes nothing else) to restore that identity.
+void restore_momentum(const VecX& mass, const VecX& b, VecX& y) {
+  const Eigen::Index np = mass.size();
+  Vec3 missing = Vec3::Zero();
+  for (Eigen::Index i = 0; i < np; ++i)
+    missing += b.segment<3>(3 * i) - mass[i] * y.segment<3>(3 * i);
+  const Vec3 shift = missing / mass.sum();
+  for (Eigen::Index i = 0; i < np; ++i) y.segment<3>(3 * i) += shift;
+}
 
 }  // namespace
 
 std::string auto_linear_solver(int dofs) {
-  return dofs <= kAutoDirectMaxDofs ? "cholmod" : "cg_lagged_cholmod";
+  return dofs <= kAutoDirectMaxDofs ? "cholmod" : "cg_jacobi";
 }
 
 ImplicitEuler::ImplicitEuler(ImplicitEulerOptions options) : options_(std::move(options)) {
@@ -77,7 +91,8 @@ StepResult ImplicitEuler::prepare(const Model& model, Real h) {
       solver_ = std::make_unique<LdltSolver>();
     } else {
       CgOptions cg;
-      cg.preconditioner = kind == "cg_lagged_cholmod" || options_.cg_preconditioner == "cholmod"
+      cg.preconditioner = kind == "cg_lagged_cholmod" ||
+                                  (kind == "cg" && options_.cg_preconditioner == "cholmod")
                               ? CgPreconditioner::kLaggedCholesky
                               : CgPreconditioner::kJacobi;
       cg.tolerance = options_.cg_tolerance;
@@ -122,6 +137,7 @@ StepResult ImplicitEuler::solve(const Model& model, const VecX& x, const VecX& v
                                           "): " + r.message);
   if (!y.allFinite())
     return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
+  if (r.iterations > 0) restore_momentum(model.mass, b, y);
   return StepResult::success();
 }
 
@@ -162,6 +178,7 @@ StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
     have_dv_ = false;
     return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
   }
+  if (lr.iterations > 0) restore_momentum(model.mass, b_, dv_);
   have_dv_ = true;
   ++newton_iterations_;
   v1_ = s.v + dv_;

@@ -1,0 +1,215 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <Eigen/Dense>
+
+#include <jelly/core/cube.hpp>
+#include <jelly/core/forces.hpp>
+#include <jelly/core/jacobian.hpp>
+
+namespace jelly {
+namespace {
+
+using Dense = Eigen::MatrixXd;
+
+Model cube_model(Real ks, Real kd) {
+  CubeSpec spec;
+  spec.n = 3;
+  spec.edge_length = 1;
+  for (auto& c : spec.springs) c = SpringCoefficients{ks, kd};
+  return build_cube(spec);
+}
+
+// Positions displaced by up to `amplitude` (a fraction of the spacing 0.5), random velocities:
+// some springs stretched, some compressed, some closing, some separating.
+State random_state(const Model& model, int seed, Real amplitude = 0.15) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  State s = rest_state(model);
+  for (Eigen::Index i = 0; i < s.x.size(); ++i) {
+    s.x[i] += amplitude * 0.5 * u(rng);
+    s.v[i] = 2 * u(rng);
+  }
+  return s;
+}
+
+// Central differences of the full force f(x, v) with respect to x (wrt_x) or v.
+Dense central_difference(const Model& model, const State& s, bool wrt_x) {
+  const int n = model.num_dofs();
+  Dense j(n, n);
+  VecX fp(n), fm(n);
+  const Real step = 1e-6;
+  for (int c = 0; c < n; ++c) {
+    VecX x = s.x, v = s.v;
+    (wrt_x ? x : v)[c] += step;
+    compute_forces(model, x, v, fp);
+    (wrt_x ? x : v)[c] -= 2 * step;
+    compute_forces(model, x, v, fm);
+    j.col(c) = (fp - fm) / (2 * step);
+  }
+  return j;
+}
+
+struct Jacobians {
+  Dense k, d;
+};
+Jacobians assembled(const Model& model, const State& s, JacobianOptions options) {
+  SpringJacobian jacobian(model);
+  SparseMatrix k = jacobian.make_matrix(), d = jacobian.make_matrix();
+  jacobian.assemble(model, s.x, s.v, options, k, d);
+  return {Dense(k), Dense(d)};
+}
+
+Real relative_error(const Dense& a, const Dense& b) { return (a - b).norm() / b.norm(); }
+
+// With no definiteness fix and the exact damper term, K and D are the exact df/dx and df/dv.
+TEST(SpringJacobian, ExactJacobiansMatchCentralDifferences) {
+  for (const auto& [ks, kd] : {std::pair<Real, Real>{1400, 50}, {100000, 50}, {10, 20}, {2400, 120}}) {
+    const Model model = cube_model(ks, kd);
+    for (int seed : {1, 2, 3}) {
+      const State s = random_state(model, seed);
+      JacobianOptions exact;
+      exact.definiteness = DefinitenessFix::kNone;
+      exact.exact_damper = true;
+      const Jacobians j = assembled(model, s, exact);
+      EXPECT_LT(relative_error(j.k, central_difference(model, s, true)), 1e-7)
+          << "ks " << ks << " kd " << kd << " seed " << seed;
+      EXPECT_LT(relative_error(j.d, central_difference(model, s, false)), 1e-7);
+      EXPECT_LT((j.d - j.d.transpose()).norm(), 1e-12 * j.d.norm());
+    }
+  }
+}
+
+// Without dampers the symmetric K (the solvers' K) is the exact df/dx; with dampers it differs
+// from it exactly by the dropped non-symmetric term, and is symmetric.
+TEST(SpringJacobian, SymmetricJacobianDropsOnlyTheDamperAsymmetry) {
+  const Model undamped = cube_model(1400, 0);
+  const State s = random_state(undamped, 4);
+  JacobianOptions none;
+  none.definiteness = DefinitenessFix::kNone;
+  const Jacobians j = assembled(undamped, s, none);
+  EXPECT_LT(relative_error(j.k, central_difference(undamped, s, true)), 1e-7);
+
+  const Model damped = cube_model(1400, 50);
+  const Jacobians sym = assembled(damped, s, none);
+  JacobianOptions exact = none;
+  exact.exact_damper = true;
+  const Jacobians full = assembled(damped, s, exact);
+  EXPECT_LT((sym.k - sym.k.transpose()).norm(), 1e-12 * sym.k.norm());
+  EXPECT_GT((full.k - full.k.transpose()).norm(), 1e-6 * full.k.norm());
+  // The symmetric part of the dropped term is what the exact K keeps beyond sym.k.
+  EXPECT_LT(relative_error(sym.k, full.k), 0.2);
+}
+
+// A uniformly stretched, uniformly expanding cube has no compressed or closing spring: every
+// policy gives the exact Jacobian.
+TEST(SpringJacobian, PoliciesAgreeWhenNothingIsCompressed) {
+  const Model model = cube_model(1400, 50);
+  State s = rest_state(model);
+  const Vec3 c(0.5, 1.0, 0.5);
+  for (int i = 0; i < model.num_particles(); ++i) {
+    particle(s.x, i) = c + 1.05 * (Vec3(particle(s.x, i)) - c);
+    particle(s.v, i) = 0.3 * (Vec3(particle(s.x, i)) - c);
+  }
+  JacobianOptions none;
+  none.definiteness = DefinitenessFix::kNone;
+  const Dense exact = assembled(model, s, none).k;
+  for (DefinitenessFix fix : {DefinitenessFix::kClampCompressed, DefinitenessFix::kProjectPsd}) {
+    JacobianOptions o;
+    o.definiteness = fix;
+    EXPECT_LT(relative_error(assembled(model, s, o).k, exact), 1e-14) << definiteness_name(fix);
+  }
+  // ... and the exact one matches central differences of the forces without dampers.
+  const Model undamped = cube_model(1400, 0);
+  EXPECT_LT(relative_error(assembled(undamped, s, none).k, central_difference(undamped, s, true)),
+            1e-7);
+}
+
+Real min_eigenvalue(const Dense& m) {
+  return Eigen::SelfAdjointEigenSolver<Dense>(0.5 * (m + m.transpose())).eigenvalues().minCoeff();
+}
+
+// A crushed cube: -K is indefinite without a fix; clamp and project make it PSD.
+TEST(SpringJacobian, DefinitenessFixesMakeMinusKPositiveSemidefinite) {
+  const Model model = cube_model(1400, 50);
+  State s = random_state(model, 5, 0.05);
+  const Vec3 c(0.5, 1.0, 0.5);
+  for (int i = 0; i < model.num_particles(); ++i)
+    particle(s.x, i) = c + 0.5 * (Vec3(particle(s.x, i)) - c);
+  JacobianOptions o;
+  o.definiteness = DefinitenessFix::kNone;
+  const Dense k_none = assembled(model, s, o).k;
+  EXPECT_LT(min_eigenvalue(-k_none), -1.0);
+  for (DefinitenessFix fix : {DefinitenessFix::kClampCompressed, DefinitenessFix::kProjectPsd}) {
+    o.definiteness = fix;
+    const Dense k = assembled(model, s, o).k;
+    EXPECT_GT(min_eigenvalue(-k), -1e-9 * k.norm()) << definiteness_name(fix);
+  }
+}
+
+// kProjectPsd equals the eigenvalue projection of each spring's exact symmetric 3x3 block.
+TEST(SpringJacobian, ProjectionEqualsEigenvalueClampOfTheBlock) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  for (int trial = 0; trial < 20; ++trial) {
+    Model m;
+    m.mass = VecX::Ones(2);
+    m.rest_position = VecX::Zero(6);
+    m.springs.add(0, 1, 1.0, {1400, 50}, SpringType::kStructural);
+    State s;
+    s.x = VecX::Zero(6);
+    s.v = VecX::Zero(6);
+    const Vec3 d = Vec3(u(rng), u(rng), u(rng)).normalized() * (0.5 + u(rng) * 0.4 + 0.5);
+    s.x.segment<3>(3) = -d;
+    s.v.segment<3>(0) = Vec3(u(rng), u(rng), u(rng)) * 3;
+    JacobianOptions o;
+    o.definiteness = DefinitenessFix::kNone;
+    const Eigen::Matrix3d block = assembled(m, s, o).k.block<3, 3>(0, 0);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(-block);
+    const Eigen::Matrix3d projected = eig.eigenvectors() *
+                                      eig.eigenvalues().cwiseMax(0).asDiagonal() *
+                                      eig.eigenvectors().transpose();
+    o.definiteness = DefinitenessFix::kProjectPsd;
+    const Eigen::Matrix3d fixed = assembled(m, s, o).k.block<3, 3>(0, 0);
+    EXPECT_LT((-fixed - projected).norm(), 1e-10 * projected.norm() + 1e-12) << trial;
+  }
+}
+
+// The one-pass system assembly equals M - alpha D - beta K and returns K w.
+TEST(SpringJacobian, SystemAssemblyMatchesItsDefinition) {
+  const Model model = cube_model(2400, 120);
+  const State s = random_state(model, 6);
+  SpringJacobian jacobian(model);
+  // One 3x3 diagonal block per particle and four per spring, minus the shared diagonals.
+  EXPECT_EQ(jacobian.non_zeros(), 9 * (model.num_particles() + 2 * model.springs.size()));
+  SparseMatrix a = jacobian.make_matrix();
+  const VecX w = VecX::Random(model.num_dofs());
+  VecX kw(model.num_dofs());
+  const Real alpha = 0.01, beta = 1e-4;
+  JacobianOptions o;
+  jacobian.assemble_system(model, s.x, s.v, o, alpha, beta, a, w, kw);
+  const Jacobians j = assembled(model, s, o);
+  Dense expected = -alpha * j.d - beta * j.k;
+  for (int i = 0; i < model.num_dofs(); ++i) expected(i, i) += model.mass[i / 3];
+  EXPECT_LT(relative_error(Dense(a), expected), 1e-14);
+  EXPECT_LT((kw - j.k * w).norm(), 1e-12 * (j.k * w).norm());
+  // Assembling again only refills the same pattern.
+  const int* rows = a.innerIndexPtr();
+  jacobian.assemble_system(model, s.x, s.v, o, alpha, beta, a, w, kw);
+  EXPECT_EQ(rows, a.innerIndexPtr());
+}
+
+TEST(SpringJacobian, DefinitenessNamesRoundTrip) {
+  for (DefinitenessFix f :
+       {DefinitenessFix::kClampCompressed, DefinitenessFix::kProjectPsd, DefinitenessFix::kNone}) {
+    DefinitenessFix parsed;
+    ASSERT_TRUE(parse_definiteness(definiteness_name(f), &parsed));
+    EXPECT_EQ(parsed, f);
+  }
+  DefinitenessFix parsed;
+  EXPECT_FALSE(parse_definiteness("psd", &parsed));
+}
+
+}  // namespace
+}  // namespace jelly
