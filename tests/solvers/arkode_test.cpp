@@ -235,8 +235,8 @@ struct SeedScene {
 void PrintTo(const SeedScene& scene, std::ostream* out) {
   *out << scene.integrator << (scene.elevator ? " elevator" : " slope") << " dt " << scene.dt;
 }
-class SeedScenes : public ::testing::TestWithParam<SeedScene> {};
-INSTANTIATE_TEST_SUITE_P(Arkode, SeedScenes,
+class ArkodeSeedScenes : public ::testing::TestWithParam<SeedScene> {};
+INSTANTIATE_TEST_SUITE_P(Arkode, ArkodeSeedScenes,
                          ::testing::Values(SeedScene{"arkode_erk", 1e-3, false},
                                            SeedScene{"arkode_erk", 1e-3, true},
                                            SeedScene{"arkode_dirk", 1.0 / 60, false},
@@ -245,7 +245,7 @@ INSTANTIATE_TEST_SUITE_P(Arkode, SeedScenes,
                            return p.param.integrator + (p.param.elevator ? "_elevator" : "_slope");
                          });
 
-TEST_P(SeedScenes, RunsWithoutDivergence) {
+TEST_P(ArkodeSeedScenes, RunsWithoutDivergence) {
   const SeedScene& scene = GetParam();
   const Model model = build_cube(CubeSpec{});
   State s0 = rest_state(model);
