@@ -32,6 +32,9 @@ class Integrator {
   virtual std::string_view name() const = 0;
   virtual int order() const = 0;
   virtual bool is_implicit() const { return false; }
+  // True when the method chooses its own internal steps within each step(h) (error control):
+  // the h-convergence of fixed-step methods does not apply to it.
+  virtual bool is_adaptive() const { return false; }
   // Counters of this integrator (steps, and whatever the method adds).
   virtual Statistics statistics() const;
 

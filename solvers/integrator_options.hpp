@@ -4,17 +4,21 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/types.hpp>
+#include <jelly/solvers/arkode_options.hpp>
 #include <jelly/solvers/implicit_euler_options.hpp>
 
 namespace jelly {
 
 struct IntegratorOptions {
   ImplicitEulerOptions implicit;  // implicit_euler
+  ArkodeOptions arkode;           // arkode_erk, arkode_dirk
 
-  // Throws InputError naming the first invalid option ("integrator.implicit.<field> = ...").
+  // Throws InputError naming the first invalid option ("integrator.implicit.<field> = ...",
+  // "integrator.options.<field> = ..." for arkode).
   void validate() const {
     std::string why;
     if (!implicit.is_valid(&why)) throw InputError("integrator." + why);
+    arkode.validate();
   }
 };
 

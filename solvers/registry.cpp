@@ -4,6 +4,8 @@
 #include <functional>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/arkode_dirk.hpp>
+#include <jelly/solvers/arkode_erk.hpp>
 #include <jelly/solvers/explicit_euler.hpp>
 #include <jelly/solvers/implicit_euler.hpp>
 #include <jelly/solvers/midpoint.hpp>
@@ -29,6 +31,11 @@ Factory plain() {
 const std::vector<Entry>& table() {
   static const std::vector<Entry> entries = [] {
     std::vector<Entry> e{
+        {{"arkode_dirk",
+          "SUNDIALS ARKODE adaptive implicit DIRK (Newton, Schur or KLU linear solves)"},
+         [](const IntegratorOptions& o) { return std::make_unique<ArkodeDirk>(o.arkode); }},
+        {{"arkode_erk", "SUNDIALS ARKODE adaptive explicit Runge-Kutta (default 5(4) pair)"},
+         [](const IntegratorOptions& o) { return std::make_unique<ArkodeErk>(o.arkode); }},
         {{"explicit_euler", "forward Euler, order 1, explicit"}, plain<ExplicitEuler>()},
         {{"implicit_euler",
           "backward Euler on a sparse Cholesky/CG solver, order 1, implicit (stable at any dt)"},
