@@ -153,6 +153,7 @@ int main(int argc, char** argv) {
       }
       stability.integrators = common.integrators;
       stability.shard = shard;
+      stability.progress = &std::cerr;
       tables = {run_stability(stability)};
     } else if (accuracy_cmd->parsed()) {
       command = "accuracy";
@@ -183,6 +184,7 @@ int main(int argc, char** argv) {
       }
       seed.integrators = common.integrators;
       seed.shard = shard;
+      seed.progress = &std::cerr;
       tables = {run_seed(seed)};
     }
     if (shard.count == 1) {

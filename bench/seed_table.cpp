@@ -76,6 +76,10 @@ Table run_seed(const SeedOptions& o) {
         row.insert(row.end(), {std::string(run_status_name(report.status)),
                                report.ok() ? NAN : report.t, report.reason});
         table.add_row(row);
+        if (o.progress) {
+          *o.progress << "seed item " << this_item << ": " << c.name << " " << scene << " "
+                      << integrator << ": " << report.brief() << std::endl;
+        }
       }
     }
   }

@@ -3,6 +3,7 @@
 // integrators stay stable on the slope and the elevator with the report's own contact model, at
 // the seed parameters and dt = 0.001, 0.0027 and 1/60, and at ks = 2400, kd = 120; the time of
 // divergence of those that do not; and a verdict on each claim.
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@ struct SeedOptions {
   Real horizon = 6;  // s: the elevator's first cycle and the start of the second
   Real energy_tolerance = 1;
   Shard shard;
+  std::ostream* progress = nullptr;  // one line per finished work item, when set
   void validate() const;
 };
 

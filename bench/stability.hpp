@@ -3,6 +3,7 @@
 // stopped by the divergence guard, and the `stability` sweep over integrators, stiffnesses and
 // scenes with the spectral prediction beside each measured limit.
 #include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,7 @@ struct StabilityOptions {
   Real energy_tolerance = 1;  // see energy_cap (scenes.hpp)
   BracketOptions bracket;
   Shard shard;
+  std::ostream* progress = nullptr;  // one line per finished work item, when set
   void validate() const;
 };
 
