@@ -155,9 +155,9 @@ Table convergence_orders(const Table& accuracy, const Table& reference) {
   Table orders(
       "order",
       "measured order of convergence: slope of log(error) against log(dt) over completed "
-      "runs with error > 10 x the reference's error estimate",
+      "runs with error > 100 x the reference's error estimate",
       {"integrator:s", "points", "order_finest", "order_fit", "dt_min_used", "error_at_dt_min"});
-  const Real floor = reference.rows() > 0 ? 10 * reference.number(0, "error_estimate") : 0;
+  const Real floor = reference.rows() > 0 ? 100 * reference.number(0, "error_estimate") : 0;
   std::vector<std::string> names;
   std::map<std::string, std::vector<std::pair<Real, Real>>> points;
   for (int r = 0; r < accuracy.rows(); ++r) {

@@ -40,7 +40,7 @@ Reference make_reference(const AccuracyOptions& options);
 std::vector<Table> run_accuracy(const AccuracyOptions& options);
 
 // Table "order": per integrator, the slope of log(error) against log(dt) between the two smallest
-// completed dts whose error is above 10 times the reference's error estimate ("order_finest"),
+// completed dts whose error is above 100 times the reference's error estimate ("order_finest"),
 // and the least-squares slope over all such dts ("order_fit").
 Table convergence_orders(const Table& accuracy, const Table& reference);
 
