@@ -94,9 +94,9 @@ Table run_stability(const StabilityOptions& o) {
   Table table("stability",
               "largest stable dt (measured by bisection over the horizon, and predicted from the "
               "spectral radius of M^-1 K with D = (kd/ks) K)",
-              {"item", "integrator:s", "scene:s", "contact:s", "n", "ks", "kd", "horizon",
-               "status:s", "dt_stable", "dt_unstable", "dt_predicted", "rho_k", "rho_d", "runs",
-               "diverged_at", "reason:s"});
+              {"item", "integrator:s", "implicit", "scene:s", "contact:s", "n", "ks", "kd",
+               "horizon", "status:s", "dt_stable", "dt_unstable", "dt_predicted", "rho_k", "rho_d",
+               "runs", "diverged_at", "reason:s"});
   std::map<std::size_t, SpectralEstimate> spectra;
   long item = 0;
   for (const std::string& integrator : integrators) {
@@ -111,8 +111,10 @@ Table run_stability(const StabilityOptions& o) {
         spec.contact = o.contact;
         if (!spectra.count(k)) spectra[k] = estimate_spectrum(build_scene(spec).model);
         const SpectralEstimate& e = spectra[k];
+        const double implicit = make_integrator(integrator)->is_implicit() ? 1.0 : 0.0;
         const std::vector<Cell> head{static_cast<double>(item),
                                      integrator,
+                                     implicit,
                                      scene,
                                      std::string(contact_model_name(o.contact)),
                                      static_cast<double>(o.n),

@@ -272,6 +272,25 @@ TEST(Scenes, ElevatorCapAllowsThePlatformWorkAndGuardUsesIt) {
   EXPECT_FALSE(guard.check(a.model, a.state).has_value());
 }
 
+TEST(Scenes, SimulatorStopsOnTheEnergyCap) {
+  SceneSpec spec;
+  spec.n = 3;
+  spec.name = "free";
+  SceneParts parts = build_scene(spec);
+  SimulatorOptions options;
+  options.dt = 1e-3;
+  // Without gravity the energy is >= 0: a negative cap stops the run at the first check.
+  options.divergence.max_energy = -1;
+  Simulator capped(parts.model, parts.state, make_integrator("rk4"), options);
+  const RunReport stopped = capped.run_until(1);
+  EXPECT_EQ(stopped.status, RunStatus::kDiverged);
+  EXPECT_EQ(stopped.steps, 1);
+  EXPECT_NE(stopped.reason.find("energy"), std::string::npos) << stopped.reason;
+  // The free jelly is damped: under the documented cap it completes.
+  Simulator normal = make_scene_simulator(spec, "rk4", 1e-3, 1, 1);
+  EXPECT_TRUE(normal.run_until(1).ok());
+}
+
 TEST(SeedTable, ClaimsHaveVerdictsForEveryScene) {
   SeedOptions o;
   o.n = 3;
