@@ -2,6 +2,7 @@
 // speed, seed and merge; see docs/benchmarks.md.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <iostream>
 #include <sstream>
 
@@ -132,7 +133,14 @@ int main(int argc, char** argv) {
       const MergedRun run = merge_csv(merge_inputs);
       std::vector<Table> tables;
       for (const auto& [name, table] : run.tables) tables.push_back(table);
-      for (Table& t : summary_tables(run.command, tables)) tables.push_back(std::move(t));
+      // Summaries are recomputed from the merged rows (and replace any read back).
+      std::vector<Table> summaries = summary_tables(run.command, tables);
+      for (const Table& summary : summaries) {
+        tables.erase(std::remove_if(tables.begin(), tables.end(),
+                                    [&](const Table& t) { return t.name() == summary.name(); }),
+                     tables.end());
+      }
+      for (Table& t : summaries) tables.push_back(std::move(t));
       Metadata merged = run.metadata;
       merged["merge_command_line"] = metadata.at("command_line");
       write_outputs(run.command, tables, merged, merge_out, Shard{}, std::cout);

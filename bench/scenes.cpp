@@ -64,17 +64,30 @@ Real energy_cap(const SceneParts& parts, Real horizon, Real tolerance) {
   const Real size = (hi - lo).norm();
   Real work = 0;
   const Vec3 up = g > 0 ? Vec3(-m.gravity / g) : Vec3::Zero();
+  Real top = -INFINITY, fastest = 0;
+  for (int i = 0; i < m.num_particles(); ++i) {
+    top = std::max(top, up.dot(particle(s.x, i)));
+    fastest = std::max(fastest, particle(s.v, i).norm());
+  }
   for (const auto& terrain : parts.terrains) {
     const Vec3 start = terrain->position(s.t);
-    Real rise = 0, speed = 0;
+    Real rise = 0, speed = 0, lowest = INFINITY;
     const int samples = static_cast<int>(std::ceil(horizon / 1e-3)) + 1;
     for (int k = 0; k <= samples; ++k) {
       const Real t = s.t + horizon * k / samples;
       const Vec3 p = terrain->position(t);
       rise = std::max(rise, (p - start).dot(up));
+      lowest = std::min(lowest, p.dot(up));
       speed = std::max(speed, terrain->surface_velocity(p, t).norm());
     }
-    work += mass * (g * rise + 0.5 * (2 * speed) * (2 * speed));
+    if (speed == 0) continue;  // a fixed terrain does no work
+    // An impact (restitution <= 1) on a surface moving at speed <= V leaves the relative speed no
+    // larger, so a particle arriving at speed u leaves at most at u + 2V: its kinetic energy per
+    // unit mass grows by at most 2 V u + 2 V^2, with u bounded by a fall from the jelly's top to
+    // the terrain's lowest point.
+    const Real drop = std::max<Real>(0, top - lowest);
+    const Real arrival = std::sqrt(fastest * fastest + 2 * g * drop);
+    work += mass * (g * rise + 2 * speed * arrival + 2 * speed * speed);
   }
   const Real scale = kinetic_energy(m, s) + elastic_energy(m, s) + mass * g * size;
   return total_energy(m, s) + work + tolerance * scale;

@@ -34,9 +34,11 @@ SceneParts build_scene(const SceneSpec& spec);
 // Cap on the total energy (J) over [state.t, state.t + horizon]:
 //   E0 + W + tolerance * (K0 + U0 + M |g| L)
 // with E0, K0, U0 the initial total, kinetic and elastic energies, M the total mass, L the
-// diagonal of the jelly's bounding box, and W = M (|g| dh + (2 V)^2 / 2) a bound on the work the
-// terrains can do: dh the largest rise of a terrain against gravity, V its largest speed over the
-// horizon (both sampled at 1 ms). W = 0 for fixed planes.
+// diagonal of the jelly's bounding box, and W = M (|g| dh + 2 V u + 2 V^2) a bound on the work a
+// moving terrain does in one impact per particle: dh its largest rise against gravity, V its
+// largest speed over the horizon (both sampled at 1 ms), u = sqrt(v0^2 + 2 |g| H) the largest
+// arrival speed (v0 the fastest initial particle, H the drop from the jelly's top to the
+// terrain's lowest point). W = 0 for fixed terrains.
 Real energy_cap(const SceneParts& parts, Real horizon, Real tolerance);
 
 // A simulator of the scene with `integrator`, time step dt and the divergence guard whose energy
