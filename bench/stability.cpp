@@ -146,6 +146,11 @@ Table run_stability(const StabilityOptions& o) {
                                static_cast<double>(r.runs), r.diverged_at, r.reason})
           row.push_back(c);
         table.add_row(row);
+        if (o.progress) {
+          *o.progress << "stability item " << item << ": " << integrator << " " << scene << " ks "
+                      << spec.ks << ": " << r.status << ", dt " << r.dt_stable << " s (" << r.runs
+                      << " runs)" << std::endl;
+        }
       }
     }
   }
