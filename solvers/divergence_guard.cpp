@@ -3,12 +3,15 @@
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
 
 namespace jelly {
 
 void DivergenceGuard::validate() const {
   require(max_speed > 0, "divergence.max_speed", max_speed, "a speed > 0 m/s");
   require(max_distance > 0, "divergence.max_distance", max_distance, "a distance > 0 m");
+  require(!std::isnan(max_energy), "divergence.max_energy", max_energy,
+          "an energy in J (infinite = not checked)");
 }
 
 std::optional<std::string> DivergenceGuard::check(const State& s) const {
@@ -28,6 +31,17 @@ std::optional<std::string> DivergenceGuard::check(const State& s) const {
     if (x.squaredNorm() > dist2) {
       return "particle " + std::to_string(i) + " is " + to_text(x.norm()) +
              " m from the origin, beyond the limit of " + to_text(max_distance) + " m";
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> DivergenceGuard::check(const Model& model, const State& s) const {
+  if (auto why = check(s)) return why;
+  if (std::isfinite(max_energy)) {
+    const Real e = total_energy(model, s);
+    if (!(e <= max_energy)) {
+      return "total energy " + to_text(e) + " J is above the cap of " + to_text(max_energy) + " J";
     }
   }
   return std::nullopt;

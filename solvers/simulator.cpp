@@ -103,7 +103,7 @@ RunReport Simulator::run_until(Real t_end) {
       break;
     }
     ++report.steps;
-    if (auto why = options_.divergence.check(state_)) {
+    if (auto why = options_.divergence.check(model_, state_)) {
       report.status = RunStatus::kDiverged;
       report.reason = *why;
       break;

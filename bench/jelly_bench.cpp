@@ -1,0 +1,213 @@
+// jelly-bench: which integrator to use for which jelly, and why. Subcommands stability, accuracy,
+// speed, seed and merge; see docs/benchmarks.md.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <iostream>
+#include <sstream>
+
+#include <jelly/bench/accuracy.hpp>
+#include <jelly/bench/output.hpp>
+#include <jelly/bench/run_info.hpp>
+#include <jelly/bench/seed_table.hpp>
+#include <jelly/bench/shard.hpp>
+#include <jelly/bench/speed.hpp>
+#include <jelly/bench/stability.hpp>
+#include <jelly/core/errors.hpp>
+#include <jelly/solvers/registry.hpp>
+
+namespace {
+
+using namespace jelly;
+using namespace jelly::bench;
+
+struct Common {
+  std::string out = "out/bench";
+  bool quick = false;
+  std::string shard = "0/1";
+  std::vector<std::string> integrators;
+};
+
+void add_common(CLI::App* app, Common& c) {
+  app->add_option("--out", c.out, "output directory for CSV and HDF5")->capture_default_str();
+  app->add_flag("--quick", c.quick, "small cubes, short horizons, few points (CI)");
+  app->add_option("--shard", c.shard, "run only work items k with k mod N == i")
+      ->capture_default_str();
+  app->add_option("--integrators", c.integrators, "comma-separated names (default: all registered)")
+      ->delimiter(',');
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"jelly-bench: stability, accuracy and cost of jelly's integrators"};
+  app.require_subcommand(1);
+  const std::vector<std::string> arguments(argv, argv + argc);
+
+  Common common;
+  StabilityOptions stability;
+  std::string contact = "coulomb";
+  bool kd_given = false, ratio_given = false;
+  CLI::App* stability_cmd =
+      app.add_subcommand("stability", "largest stable dt, measured and predicted");
+  add_common(stability_cmd, common);
+  stability_cmd->add_option("--ks", stability.ks, "spring stiffnesses (N/m)")
+      ->delimiter(',')
+      ->capture_default_str();
+  stability_cmd
+      ->add_option_function<std::vector<double>>(
+          "--kd",
+          [&](const std::vector<double>& v) {
+            stability.kd = v;
+            kd_given = true;
+          },
+          "damping per ks (N s/m); default kd = ratio * ks")
+      ->delimiter(',');
+  stability_cmd->add_option_function<double>(
+      "--kd-ratio",
+      [&](double r) {
+        stability.kd_ratio = r;
+        ratio_given = true;
+      },
+      "kd / ks (s), default the seed's 50/1400");
+  stability_cmd->add_option("--scenes", stability.scenes, "slope, elevator")
+      ->delimiter(',')
+      ->capture_default_str();
+  stability_cmd->add_option("--n", stability.n, "particles per cube edge")->capture_default_str();
+  stability_cmd->add_option("--horizon", stability.horizon, "simulated time per run (s)")
+      ->capture_default_str();
+  stability_cmd->add_option("--contact", contact, "coulomb or seed")->capture_default_str();
+  stability_cmd
+      ->add_option("--energy-tolerance", stability.energy_tolerance,
+                   "energy cap tolerance (docs/benchmarks.md); < 0: no energy check")
+      ->capture_default_str();
+  stability_cmd->add_option("--dt-max", stability.bracket.dt_max, "largest dt tried (s)")
+      ->capture_default_str();
+  stability_cmd
+      ->add_option("--tolerance", stability.bracket.tolerance,
+                   "relative width of the final bracket")
+      ->capture_default_str();
+
+  AccuracyOptions accuracy;
+  CLI::App* accuracy_cmd = app.add_subcommand("accuracy", "work-precision, orders, energy drift");
+  add_common(accuracy_cmd, common);
+  accuracy_cmd->add_option("--n", accuracy.n, "particles per cube edge")->capture_default_str();
+  accuracy_cmd->add_option("--t-end", accuracy.t_end, "final time (s)")->capture_default_str();
+  accuracy_cmd->add_option("--dt", accuracy.dts, "time steps")
+      ->delimiter(',')
+      ->capture_default_str();
+  accuracy_cmd->add_option("--reference-dt", accuracy.reference_dt, "0: smallest dt / 8")
+      ->capture_default_str();
+  accuracy_cmd->add_option("--drift-dt", accuracy.drift_dt, "time step of the drift runs (s)")
+      ->capture_default_str();
+  accuracy_cmd->add_option("--drift-t-end", accuracy.drift_t_end, "length of the drift runs (s)")
+      ->capture_default_str();
+
+  SpeedOptions speed;
+  CLI::App* speed_cmd = app.add_subcommand("speed", "cost per step against cube size");
+  add_common(speed_cmd, common);
+  speed_cmd->add_option("--sizes", speed.sizes, "cube sizes n")
+      ->delimiter(',')
+      ->capture_default_str();
+  speed_cmd->add_option("--dt", speed.dt, "time step (s)")->capture_default_str();
+  speed_cmd->add_option("--steps", speed.steps, "timed steps per configuration")
+      ->capture_default_str();
+
+  SeedOptions seed;
+  CLI::App* seed_cmd = app.add_subcommand("seed", "the seed report's stability claims");
+  add_common(seed_cmd, common);
+  seed_cmd->add_option("--n", seed.n, "particles per cube edge")->capture_default_str();
+  seed_cmd->add_option("--horizon", seed.horizon, "simulated time per run (s)")
+      ->capture_default_str();
+
+  std::vector<std::string> merge_inputs;
+  std::string merge_out = "out/bench";
+  CLI::App* merge_cmd = app.add_subcommand("merge", "merge the CSV files of shards");
+  merge_cmd->add_option("inputs", merge_inputs, "directories or CSV files")->required();
+  merge_cmd->add_option("--out", merge_out, "output directory")->capture_default_str();
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const Metadata metadata = run_metadata(arguments);
+    if (merge_cmd->parsed()) {
+      const MergedRun run = merge_csv(merge_inputs);
+      std::vector<Table> tables;
+      for (const auto& [name, table] : run.tables) tables.push_back(table);
+      // Summaries are recomputed from the merged rows (and replace any read back).
+      std::vector<Table> summaries = summary_tables(run.command, tables);
+      for (const Table& summary : summaries) {
+        tables.erase(std::remove_if(tables.begin(), tables.end(),
+                                    [&](const Table& t) { return t.name() == summary.name(); }),
+                     tables.end());
+      }
+      for (Table& t : summaries) tables.push_back(std::move(t));
+      Metadata merged = run.metadata;
+      merged["merge_command_line"] = metadata.at("command_line");
+      write_outputs(run.command, tables, merged, merge_out, Shard{}, std::cout);
+      return 0;
+    }
+    const Shard shard = Shard::parse(common.shard);
+    std::string command;
+    std::vector<Table> tables;
+    if (stability_cmd->parsed()) {
+      command = "stability";
+      require(!(kd_given && ratio_given), "--kd", "given with --kd-ratio", "one of the two");
+      stability.contact = contact_model_from_name(contact, "--contact");
+      if (common.quick) {
+        stability.n = 4;
+        stability.horizon = 1;
+        if (stability_cmd->count("--ks") == 0) stability.ks = {1400, 5600};
+        stability.bracket.tolerance = std::max(stability.bracket.tolerance, 0.1);
+      }
+      stability.integrators = common.integrators;
+      stability.shard = shard;
+      stability.progress = &std::cerr;
+      tables = {run_stability(stability)};
+    } else if (accuracy_cmd->parsed()) {
+      command = "accuracy";
+      if (common.quick) {
+        accuracy.n = 3;
+        accuracy.t_end = 0.2;
+        if (accuracy_cmd->count("--dt") == 0) accuracy.dts = {1e-3, 5e-4, 2.5e-4};
+        accuracy.drift_t_end = 1;
+      }
+      accuracy.integrators = common.integrators;
+      accuracy.shard = shard;
+      tables = run_accuracy(accuracy);
+    } else if (speed_cmd->parsed()) {
+      command = "speed";
+      if (common.quick) {
+        if (speed_cmd->count("--sizes") == 0) speed.sizes = {3, 5};
+        speed.steps = 20;
+        speed.warmup_steps = 5;
+      }
+      speed.integrators = common.integrators;
+      speed.shard = shard;
+      tables = run_speed(speed);
+    } else if (seed_cmd->parsed()) {
+      command = "seed";
+      if (common.quick) {
+        seed.n = 4;
+        seed.horizon = 0.5;
+      }
+      seed.integrators = common.integrators;
+      seed.shard = shard;
+      seed.progress = &std::cerr;
+      tables = {run_seed(seed)};
+    }
+    if (shard.count == 1) {
+      for (Table& t : summary_tables(command, tables)) tables.push_back(std::move(t));
+    } else {
+      std::cout << "shard " << shard.text()
+                << ": summaries are computed by `jelly-bench merge` over all shards\n";
+    }
+    write_outputs(command, tables, metadata, common.out, shard, std::cout);
+  } catch (const InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

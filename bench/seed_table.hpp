@@ -1,0 +1,35 @@
+#pragma once
+// The seed report's stability claims (section 4 of seed/hw1-report.txt) as a table: which
+// integrators stay stable on the slope and the elevator with the report's own contact model, at
+// the seed parameters and dt = 0.001, 0.0027 and 1/60, and at ks = 2400, kd = 120; the time of
+// divergence of those that do not; and a verdict on each claim.
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <jelly/bench/shard.hpp>
+#include <jelly/bench/table.hpp>
+#include <jelly/core/types.hpp>
+
+namespace jelly::bench {
+
+struct SeedOptions {
+  std::vector<std::string> integrators;  // empty: every registered integrator
+  int n = 10;
+  Real horizon = 6;  // s: the elevator's first cycle and the start of the second
+  Real energy_tolerance = 1;
+  Shard shard;
+  std::ostream* progress = nullptr;  // one line per finished work item, when set
+  void validate() const;
+};
+
+// Table "seed": one row per (configuration, scene, integrator).
+Table run_seed(const SeedOptions& options);
+
+// Table "seed_claims": each claim of the report per scene, the survivors among the report's four
+// methods (explicit_euler, midpoint, rk4, symplectic_euler = the report's "implicit Euler"), any
+// other integrator that survives, and the verdict (confirmed, refuted, or incomplete when a
+// needed run is missing).
+Table seed_claims(const Table& seed);
+
+}  // namespace jelly::bench

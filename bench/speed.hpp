@@ -1,0 +1,29 @@
+#pragma once
+// Cost per step against the cube size for each integrator, on the seed slope with every contact
+// active: the step split into the integrator (of which force evaluations) and contact, the
+// integrator's own statistics (assembly, factorisation, solve when it reports them), springs per
+// second and the peak resident memory of each configuration (memory.hpp).
+#include <string>
+#include <vector>
+
+#include <jelly/bench/shard.hpp>
+#include <jelly/bench/table.hpp>
+#include <jelly/core/types.hpp>
+
+namespace jelly::bench {
+
+struct SpeedOptions {
+  std::vector<std::string> integrators;  // empty: every registered integrator
+  std::vector<int> sizes{5, 10, 20, 30};
+  Real dt = 1e-3;
+  int warmup_steps = 20;
+  int steps = 200;
+  Shard shard;
+  void validate() const;
+};
+
+// Tables "speed" (one row per integrator and size) and "speed_statistics" (every counter of the
+// integrator's statistics() after the timed steps, long format: one row per key).
+std::vector<Table> run_speed(const SpeedOptions& options);
+
+}  // namespace jelly::bench

@@ -1,0 +1,170 @@
+#!/usr/bin/python3
+"""Plots of jelly-bench results (the CSV files under out/bench) as PNG files.
+
+    scripts/plot_bench.py [--in out/bench] [--out docs/img]
+
+Writes bench_stability.png (largest stable dt against ks, measured and predicted, log-log),
+bench_work_precision.png (error against wall time and against force evaluations) and
+bench_speed.png (cost per step against the number of springs), for whichever of the tables
+stability.csv, accuracy.csv and speed.csv exist.
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_table(path):
+    """Rows of a jelly-bench CSV as dicts (numbers converted), and its metadata."""
+    meta, types, rows, header = {}, None, [], None
+    with open(path, newline="") as f:
+        lines = []
+        for line in f:
+            if line.startswith("# "):
+                key, _, value = line[2:].rstrip("\n").partition(": ")
+                if key == "types":
+                    types = value.split(",")
+                else:
+                    meta[key] = value
+            else:
+                lines.append(line)
+    reader = csv.reader(lines)
+    header = next(reader)
+    for cells in reader:
+        row = {}
+        for name, kind, cell in zip(header, types, cells):
+            row[name] = cell if kind == "s" else float(cell)
+        rows.append(row)
+    return rows, meta
+
+
+def finite(x):
+    return isinstance(x, float) and math.isfinite(x)
+
+
+def footer(fig, meta):
+    text = "jelly %s, %s build, %s, %s cores; %s" % (
+        meta.get("jelly_version", "?"), meta.get("build_type", "?"), meta.get("cpu", "?"),
+        meta.get("cores", "?"), meta.get("date_utc", "?"))
+    fig.text(0.01, 0.005, text, fontsize=6, color="0.4")
+
+
+def plot_stability(rows, meta, out):
+    scenes = sorted({r["scene"] for r in rows})
+    fig, axes = plt.subplots(1, len(scenes), figsize=(5 * len(scenes), 4), squeeze=False)
+    for ax, scene in zip(axes[0], scenes):
+        names = sorted({r["integrator"] for r in rows if r["scene"] == scene})
+        for i, name in enumerate(names):
+            sel = sorted((r for r in rows if r["scene"] == scene and r["integrator"] == name),
+                         key=lambda r: r["ks"])
+            color = "C%d" % i
+            ks = [r["ks"] for r in sel if finite(r["dt_stable"])]
+            dt = [r["dt_stable"] for r in sel if finite(r["dt_stable"])]
+            if ks:
+                ax.loglog(ks, dt, "o-", color=color, label=name + " measured (stable)")
+                ku = [r["ks"] for r in sel if finite(r["dt_unstable"])]
+                du = [r["dt_unstable"] for r in sel if finite(r["dt_unstable"])]
+                ax.loglog(ku, du, "v", color=color, alpha=0.5, markersize=4)
+            kp = [r["ks"] for r in sel if finite(r["dt_predicted"]) and r["dt_predicted"] > 0]
+            dp = [r["dt_predicted"] for r in sel if finite(r["dt_predicted"]) and r["dt_predicted"] > 0]
+            if kp:
+                ax.loglog(kp, dp, "--", color=color, alpha=0.7, label=name + " predicted")
+        contact = rows[0].get("contact", "")
+        ax.set_title("%s (%s contact, n = %d, %g s); triangles: smallest unstable dt" %
+                     (scene, contact, rows[0]["n"], rows[0]["horizon"]), fontsize=8)
+        ax.set_xlabel("ks (N/m), kd = ratio x ks")
+        ax.set_ylabel("largest stable dt (s)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=6)
+    footer(fig, meta)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+
+
+def plot_work_precision(rows, meta, out):
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    names = sorted({r["integrator"] for r in rows})
+    for i, name in enumerate(names):
+        sel = [r for r in rows if r["integrator"] == name and r["status"] == "completed"
+               and finite(r["error"]) and r["error"] > 0]
+        sel.sort(key=lambda r: r["dt"])
+        if not sel:
+            continue
+        err = [r["error"] for r in sel]
+        axes[0].loglog([r["wall_seconds"] for r in sel], err, "o-", color="C%d" % i, label=name)
+        axes[1].loglog([r["force_evaluations"] for r in sel], err, "o-", color="C%d" % i,
+                       label=name)
+    axes[0].set_xlabel("wall time (s, indicative: shared CPU)")
+    axes[1].set_xlabel("force evaluations")
+    for ax in axes:
+        ax.set_ylabel("RMS position error at t_end (m)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    n = rows[0]["n"] if rows else 0
+    fig.suptitle("work-precision: free spinning jelly, n = %d, t_end = %g s" %
+                 (n, rows[0]["t_end"] if rows else 0), fontsize=9)
+    footer(fig, meta)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+
+
+def plot_speed(rows, meta, out):
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    names = sorted({r["integrator"] for r in rows})
+    for i, name in enumerate(names):
+        sel = sorted((r for r in rows if r["integrator"] == name and r["status"] == "completed"),
+                     key=lambda r: r["springs"])
+        if not sel:
+            continue
+        springs = [r["springs"] for r in sel]
+        axes[0].loglog(springs, [r["step_seconds"] for r in sel], "o-", color="C%d" % i,
+                       label=name)
+        axes[1].semilogx(springs, [r["springs_per_second"] / 1e6 for r in sel], "o-",
+                         color="C%d" % i, label=name)
+    axes[0].set_ylabel("seconds per step (indicative: shared CPU)")
+    axes[1].set_ylabel("force kernel: million springs per second")
+    for ax in axes:
+        ax.set_xlabel("springs")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle("cost per step on the seed slope, dt = %g s" % (rows[0]["dt"] if rows else 0),
+                 fontsize=9)
+    footer(fig, meta)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--in", dest="input", default="out/bench", help="directory of the CSVs")
+    parser.add_argument("--out", default="docs/img", help="directory for the PNG files")
+    args = parser.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    jobs = [("stability.csv", plot_stability, "bench_stability.png"),
+            ("accuracy.csv", plot_work_precision, "bench_work_precision.png"),
+            ("speed.csv", plot_speed, "bench_speed.png")]
+    written = 0
+    for table, plot, png in jobs:
+        path = os.path.join(args.input, table)
+        if not os.path.exists(path):
+            print("skipped %s: no %s" % (png, path))
+            continue
+        rows, meta = read_table(path)
+        plot(rows, meta, os.path.join(args.out, png))
+        print("wrote " + os.path.join(args.out, png))
+        written += 1
+    if written == 0:
+        sys.exit("no jelly-bench table found in " + args.input)
+
+
+if __name__ == "__main__":
+    main()
