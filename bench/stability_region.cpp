@@ -81,7 +81,7 @@ Real predicted_max_dt(const std::string& integrator, Real rho, Real c, Real h_ca
 }
 
 bool is_adaptive_integrator(const std::string& integrator) {
-  return integrator.rfind("arkode_", 0) == 0;
+  return make_integrator(integrator)->is_adaptive();
 }
 
 }  // namespace jelly::bench

@@ -28,8 +28,8 @@ Real amplification(const std::string& integrator, Real h, Real w2, Real c);
 Real predicted_max_dt(const std::string& integrator, Real rho, Real c, Real h_cap,
                       Real h_min = 1e-7);
 
-// Whether `integrator` is adaptive (reported by tolerance rather than dt). Until the registry
-// exposes Integrator::is_adaptive(), this is the name prefix "arkode_".
+// Whether `integrator` is adaptive (Integrator::is_adaptive(): its accuracy is set by a
+// tolerance, and the scene's dt is only its contact-check interval).
 bool is_adaptive_integrator(const std::string& integrator);
 
 }  // namespace jelly::bench

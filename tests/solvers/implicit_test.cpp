@@ -357,9 +357,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Combine(::testing::Values(1.0 / 60, 1.0 / 30),
                        ::testing::Values(Material{1400, 50}, Material{2400, 120},
                                          Material{100000, 50})),
-    [](const auto& info) {
-      return "dt1_" + std::to_string(static_cast<int>(std::round(1 / std::get<0>(info.param)))) +
-             "_" + material_name(std::get<1>(info.param));
+    [](const ::testing::TestParamInfo<std::tuple<Real, Material>>& p) {
+      return "dt1_" + std::to_string(static_cast<int>(std::round(1 / std::get<0>(p.param)))) +
+             "_" + material_name(std::get<1>(p.param));
     });
 
 // Without terrain nothing does work on the jelly but gravity, whose work is in the energy:
