@@ -23,6 +23,17 @@ struct RunArgs {
 int run_command(const RunArgs& args);
 // jelly info FILE.h5: what a recording holds.
 int info_command(const std::string& path);
+struct FitArgs {
+  std::string recording;             // HDF5 file written by `jelly run -o`
+  std::string free = "ks,kd";        // --free: the coefficients to fit
+  double window = 0.1;               // --window: multiple-shooting window (s), 0 = whole run
+  std::vector<std::string> initial;  // --initial name=value: starting values
+  int max_iterations = 50;           // --max-iterations
+  std::string write_scene;           // --write-scene: the scene with the fitted values
+};
+
+// jelly fit RECORDING.h5: the spring and damper coefficients that replay the recording best.
+int fit_command(const FitArgs& args);
 // jelly list: integrators, terrain kinds and contact models, one line each.
 int list_command();
 

@@ -1,4 +1,5 @@
-// jelly: simulate scenes (run), describe recordings (info), list what a scene can name (list).
+// jelly: simulate scenes (run), describe recordings (info), fit coefficients to a recording
+// (fit), list what a scene can name (list).
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -51,6 +52,28 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "Describe an HDF5 file written by `jelly run -o`");
   info->add_option("file", info_path, "HDF5 file")->required();
 
+  FitArgs fit_args;
+  CLI::App* fit = app.add_subcommand(
+      "fit", "Fit spring and damper coefficients to a recording (HDF5 from `jelly run -o`)");
+  fit->add_option("recording", fit_args.recording, "HDF5 file")->required();
+  fit->add_option("--free", fit_args.free,
+                  "Coefficients to fit: ks,kd (all types together) or per type, e.g. "
+                  "ks.structural,ks.shear,ks.bending,kd")
+      ->capture_default_str();
+  fit->add_option("--window", fit_args.window,
+                  "Multiple-shooting window in s, each replayed from a recorded state; 0 = one "
+                  "window")
+      ->capture_default_str();
+  fit->add_option("--initial", fit_args.initial,
+                  "Starting value, e.g. --initial ks=1400 (repeatable; default: the recording's "
+                  "coefficients)")
+      ->type_name("NAME=VALUE")
+      ->allow_extra_args(false);
+  fit->add_option("--max-iterations", fit_args.max_iterations, "Ceres iterations at most")
+      ->capture_default_str();
+  fit->add_option("--write-scene", fit_args.write_scene,
+                  "Write the recording's scene with the fitted coefficients to this JSON file");
+
   CLI::App* list = app.add_subcommand(
       "list", "List the integrators, terrain kinds and contact models, one per line");
 
@@ -66,6 +89,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(run_args);
     if (info->parsed()) return info_command(info_path);
+    if (fit->parsed()) return fit_command(fit_args);
     if (list->parsed()) return list_command();
   } catch (const jelly::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -243,6 +243,51 @@ TEST(Cli, ADivergentRunKeepsItsFile) {
   EXPECT_EQ(r.code, 0) << r.err;
 }
 
+// A 3x3x3 jelly dropped 0.3 m onto the floor (coulomb contact) with ks = 1000 and kd = 20 for
+// every spring type, recorded every 10 ms for 0.5 s.
+const std::string kFitScene =
+    "'" + scene("drop_coulomb.json") +
+    "' --set cube.n=3 --set cube.origin=[-1,0.3,-1] --set springs.structural.ks=1000 "
+    "--set springs.shear.ks=1000 --set springs.bending.ks=1000 --set springs.bending.kd=20 "
+    "--set output_interval=0.01 --set integrator.name=rk4 -q";
+
+// jelly fit recovers the coefficients of a recording from other starting values, and writes
+// a scene with them that loads.
+TEST(Cli, FitRecoversTheCoefficientsOfARecording) {
+  const std::string file = temp_path(".h5");
+  Result r = jelly("run " + kFitScene + " --duration 0.5 -o '" + file + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string fitted = temp_path(".json");
+  r = jelly("fit '" + file + "' --initial ks=1400 --initial kd=30 --write-scene '" + fitted + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Scene s = load_scene(fitted);
+  for (const SpringCoefficients& c : s.cube.springs) {
+    EXPECT_NEAR(c.ks, 1000, 10);  // within 1 %
+    EXPECT_NEAR(c.kd, 20, 0.2);
+  }
+  EXPECT_THAT(r.out, HasSubstr("ks = "));
+  EXPECT_THAT(r.out, HasSubstr("(start 1400"));
+}
+
+TEST(Cli, FitErrorsExitTwo) {
+  Result r = jelly("fit /nonexistent/run.h5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: "));
+  const std::string file = temp_path(".h5");
+  ASSERT_EQ(jelly("run " + kFitScene + " --duration 0.5 -o '" + file + "'").code, 0);
+  r = jelly("fit '" + file + "' --free ks,foo");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: free = ks,foo is invalid"));
+  r = jelly("fit '" + file + "' --initial kq=3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: --initial = kq=3 is invalid"));
+  const std::string short_file = temp_path(".h5");
+  ASSERT_EQ(jelly("run " + kFitScene + " --duration 0.001 -o '" + short_file + "'").code, 0);
+  r = jelly("fit '" + short_file + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: recording.frames = 1 is invalid: at least 3 frames"));
+}
+
 #else
 
 TEST(Cli, HdfOptionsSayTheyAreNotAvailableInThisBuild) {
