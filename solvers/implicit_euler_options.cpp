@@ -16,7 +16,7 @@ bool one_of(const std::string& value, std::initializer_list<const char*> allowed
 
 template <typename T>
 bool fail(std::string* why, const char* field, const T& value, const char* allowed) {
-  if (why) *why = InputError(std::string("implicit.") + field, to_text(value), allowed).what();
+  if (why) *why = InputError(std::string("options.") + field, to_text(value), allowed).what();
   return false;
 }
 

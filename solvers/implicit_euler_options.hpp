@@ -28,7 +28,7 @@ struct ImplicitEulerOptions {
   // Fill-reducing ordering of CHOLMOD: "metis", "amd", "nesdis" or "best" (CHOLMOD's default).
   std::string ordering = "metis";
 
-  // False, with "implicit.<field> = <value> is invalid: <allowed>" in *why, for the first
+  // False, with "options.<field> = <value> is invalid: <allowed>" in *why, for the first
   // invalid field.
   bool is_valid(std::string* why) const;
 };

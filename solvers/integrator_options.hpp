@@ -13,8 +13,8 @@ struct IntegratorOptions {
   ImplicitEulerOptions implicit;  // implicit_euler
   ArkodeOptions arkode;           // arkode_erk, arkode_dirk
 
-  // Throws InputError naming the first invalid option ("integrator.implicit.<field> = ...",
-  // "integrator.options.<field> = ..." for arkode).
+  // Throws InputError naming the first invalid option as the scene path
+  // "integrator.options.<field>" (docs/scenes.md).
   void validate() const {
     std::string why;
     if (!implicit.is_valid(&why)) throw InputError("integrator." + why);

@@ -379,3 +379,47 @@ TEST(MakeSimulator, RejectsAnInvalidSceneBuiltInCode) {
 
 }  // namespace
 }  // namespace jelly
+
+namespace jelly {
+namespace {
+
+// integrator.options holds the options of the named integrator: they round-trip, and a bad one
+// is an error naming its scene path.
+TEST(SceneIntegratorOptions, ImplicitAndArkodeOptionsRoundTrip) {
+  const Scene implicit = parse_scene(
+      kGood, {"integrator.name=implicit_euler", "integrator.options.newton_iterations=4",
+              "integrator.options.linear_solver=cholmod", "integrator.options.definiteness=project",
+              "integrator.options.ordering=amd"});
+  EXPECT_EQ(implicit.integrator.options.implicit.newton_iterations, 4);
+  EXPECT_EQ(implicit.integrator.options.implicit.linear_solver, "cholmod");
+  EXPECT_EQ(implicit.integrator.options.implicit.definiteness, DefinitenessFix::kProjectPsd);
+  const Scene again = parse_scene(scene_to_json(implicit));
+  EXPECT_EQ(again.integrator.options.implicit.newton_iterations, 4);
+  EXPECT_EQ(again.integrator.options.implicit.ordering, "amd");
+  EXPECT_EQ(again.integrator.options.implicit.definiteness, DefinitenessFix::kProjectPsd);
+
+  const Scene arkode =
+      parse_scene(kGood, {"integrator.name=arkode_dirk", "integrator.options.rtol=1e-4",
+                          "integrator.options.linear_solver=klu"});
+  EXPECT_EQ(arkode.integrator.options.arkode.rtol, 1e-4);
+  EXPECT_EQ(parse_scene(scene_to_json(arkode)).integrator.options.arkode.linear_solver, "klu");
+  EXPECT_NO_THROW(make_simulator(arkode));
+}
+
+TEST(SceneIntegratorOptions, BadOptionsNameTheirPath) {
+  EXPECT_EQ(
+      error_of(kGood, {"integrator.name=implicit_euler", "integrator.options.newton_iterations=0"}),
+      "integrator.options.newton_iterations = 0 is invalid: an integer in [1, 100] (1 = "
+      "linearized backward Euler)");
+  EXPECT_THAT(error_of(kGood, {"integrator.name=arkode_erk", "integrator.options.rtol=-1"}),
+              StartsWith("integrator.options.rtol = -1 is invalid"));
+  EXPECT_THAT(error_of(kGood, {"integrator.name=implicit_euler",
+                               "integrator.options.definiteness=\"soft\""}),
+              StartsWith("integrator.options.definiteness = \"soft\" is invalid"));
+  // rtol belongs to the ARKODE integrators, not to implicit_euler.
+  EXPECT_THAT(error_of(kGood, {"integrator.name=implicit_euler", "integrator.options.rtol=1e-3"}),
+              StartsWith("integrator.options.rtol = 0.001 is invalid: unknown key"));
+}
+
+}  // namespace
+}  // namespace jelly

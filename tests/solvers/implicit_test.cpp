@@ -273,8 +273,7 @@ TEST(ImplicitEuler, InvalidOptionsNameTheField) {
     make_integrator("implicit_euler", o);
     FAIL() << "no InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("integrator.implicit.newton_iterations"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("integrator.options.newton_iterations"), std::string::npos)
         << e.what();
   }
   o = {};
@@ -358,8 +357,8 @@ INSTANTIATE_TEST_SUITE_P(
                        ::testing::Values(Material{1400, 50}, Material{2400, 120},
                                          Material{100000, 50})),
     [](const ::testing::TestParamInfo<std::tuple<Real, Material>>& p) {
-      return "dt1_" + std::to_string(static_cast<int>(std::round(1 / std::get<0>(p.param)))) +
-             "_" + material_name(std::get<1>(p.param));
+      return "dt1_" + std::to_string(static_cast<int>(std::round(1 / std::get<0>(p.param)))) + "_" +
+             material_name(std::get<1>(p.param));
     });
 
 // Without terrain nothing does work on the jelly but gravity, whose work is in the energy:
