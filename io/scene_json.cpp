@@ -140,7 +140,8 @@ Scene scene_from_json(const Json& j) {
     s.integrator.name = f.string("name");
     s.integrator.dt = f.number_or("dt", s.integrator.dt);
     if (const Json* o = f.value("options")) {
-      s.integrator.options = detail::parse_integrator_options(*o, f.path("options"), s.integrator.name);
+      s.integrator.options =
+          detail::parse_integrator_options(*o, f.path("options"), s.integrator.name);
     }
     f.reject_unknown();
   }
@@ -236,9 +237,10 @@ std::string scene_to_json(const Scene& s) {
   j["gravity"] = vec3_json(s.cube.gravity);
   j["terrains"] = Json::array();
   for (const TerrainSpec& t : s.terrains) j["terrains"].push_back(terrain_json(t));
-  j["integrator"] = {{"name", s.integrator.name},
-                     {"dt", s.integrator.dt},
-                     {"options", detail::integrator_options_to_json(s.integrator.options, s.integrator.name)}};
+  j["integrator"] = {
+      {"name", s.integrator.name},
+      {"dt", s.integrator.dt},
+      {"options", detail::integrator_options_to_json(s.integrator.options, s.integrator.name)}};
   j["duration"] = s.duration;
   j["output_interval"] = s.output_interval;
   j["divergence"] = {{"max_speed", s.divergence.max_speed},
