@@ -9,8 +9,8 @@
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/solvers/arkode_schur.hpp>
-#include <jelly/solvers/arkode_support.hpp>
+#include <jelly/solvers/detail/arkode_schur.hpp>
+#include <jelly/solvers/detail/arkode_support.hpp>
 
 namespace jelly {
 

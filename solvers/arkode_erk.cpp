@@ -4,7 +4,7 @@
 #include <arkode/arkode_erkstep.h>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/solvers/arkode_support.hpp>
+#include <jelly/solvers/detail/arkode_support.hpp>
 
 namespace jelly {
 

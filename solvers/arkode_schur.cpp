@@ -1,4 +1,4 @@
-#include <jelly/solvers/arkode_schur.hpp>
+#include <jelly/solvers/detail/arkode_schur.hpp>
 
 #include <algorithm>
 

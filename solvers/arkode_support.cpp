@@ -1,4 +1,4 @@
-#include <jelly/solvers/arkode_support.hpp>
+#include <jelly/solvers/detail/arkode_support.hpp>
 
 #include <algorithm>
 #include <cstdlib>

@@ -9,8 +9,8 @@
 
 #include <jelly/core/jacobian.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/solvers/arkode_support.hpp>
 #include <jelly/solvers/cholmod_solver.hpp>
+#include <jelly/solvers/detail/arkode_support.hpp>
 
 namespace jelly::arkode {
 
