@@ -24,6 +24,8 @@ void parse_implicit(JsonFields& f, ImplicitEulerOptions& o) {
   o.cg_max_iterations = f.integer_or("cg_max_iterations", o.cg_max_iterations);
   o.refactor_iterations = f.integer_or("refactor_iterations", o.refactor_iterations);
   o.ordering = f.string_or("ordering", o.ordering);
+  o.contact = f.string_or("contact", o.contact);
+  o.contact_iterations = f.integer_or("contact_iterations", o.contact_iterations);
 }
 
 void parse_arkode(JsonFields& f, ArkodeOptions& o) {
@@ -61,6 +63,8 @@ Json integrator_options_to_json(const IntegratorOptions& options, const std::str
     out["cg_max_iterations"] = o.cg_max_iterations;
     out["refactor_iterations"] = o.refactor_iterations;
     out["ordering"] = o.ordering;
+    out["contact"] = o.contact;
+    out["contact_iterations"] = o.contact_iterations;
   }
   if (uses_arkode_options(integrator)) {
     const ArkodeOptions& o = options.arkode;

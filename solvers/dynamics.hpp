@@ -8,8 +8,9 @@ namespace jelly {
 
 class Dynamics {
  public:
-  Dynamics(const Model& model, const ContactSolver& contacts)
-      : model_(&model), contacts_(&contacts) {}
+  // `terrains` (may be null) is for integrators that resolve contact inside their step.
+  Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains = nullptr)
+      : model_(&model), contacts_(&contacts), terrains_(terrains) {}
 
   // f(x, v): size 3N, no allocation.
   void forces(const VecX& x, const VecX& v, VecX& f) const;
@@ -18,11 +19,14 @@ class Dynamics {
 
   const Model& model() const { return *model_; }
   const ContactSolver& contacts() const { return *contacts_; }
+  // The terrains of the scene, or null.
+  const Terrains* terrains() const { return terrains_; }
   long force_evaluations() const { return evaluations_; }
 
  private:
   const Model* model_;
   const ContactSolver* contacts_;
+  const Terrains* terrains_;
   mutable long evaluations_ = 0;
 };
 

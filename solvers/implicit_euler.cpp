@@ -72,6 +72,12 @@ Statistics ImplicitEuler::statistics() const {
   s["assembly_seconds"] = assembly_seconds_;
   s["factorization_seconds"] = factorization_seconds_;
   s["solve_seconds"] = solve_seconds_;
+  if (resolves_contact()) {
+    const ImplicitContact::Counters& cc = contact_.counters();
+    s["contact_extra_solves"] = static_cast<double>(cc.extra_solves);
+    s["contact_not_converged"] = static_cast<double>(cc.not_converged);
+    s["contact_restitution_limited"] = static_cast<double>(cc.restitution_limited);
+  }
   return s;
 }
 
@@ -112,6 +118,8 @@ StepResult ImplicitEuler::prepare(const Model& model, Real h) {
     x1_.setZero(n);
     g_.setZero(n);
     delta_.setZero(n);
+    rhs_.setZero(n);
+    z_.setZero(n);
     have_dv_ = false;
   }
   if (h != last_h_) solver_->invalidate();
@@ -119,12 +127,9 @@ StepResult ImplicitEuler::prepare(const Model& model, Real h) {
   return StepResult::success();
 }
 
-StepResult ImplicitEuler::solve(const Model& model, const VecX& x, const VecX& v, Real h,
-                                const VecX& w, VecX* kw, const VecX& b, VecX& y) {
+StepResult ImplicitEuler::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
+                                              bool constrained, Real t) {
   auto start = Clock::now();
-  jacobian_->assemble_system(model, x, v, jacobian_options_, h, h * h, a_, w, kw ? *kw : kw_);
-  assembly_seconds_ += seconds_since(start);
-  start = Clock::now();
   LinearResult r = solver_->factorize(a_);
   factorization_seconds_ += seconds_since(start);
   if (r.ok()) {
@@ -133,89 +138,111 @@ StepResult ImplicitEuler::solve(const Model& model, const VecX& x, const VecX& v
     solve_seconds_ += seconds_since(start);
   }
   if (!r.ok())
-    return StepResult::failure("implicit_euler: linear solve failed (" +
+    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(t) + " (" +
                                std::string(linear_status_name(r.status)) + "): " + r.message);
   if (!y.allFinite())
     return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
-  if (r.iterations > 0) restore_momentum(model.mass, b, y);
+  // With contact constraints momentum is not conserved (the terrain pushes).
+  if (r.iterations > 0 && !constrained) restore_momentum(model.mass, b, y);
+  return StepResult::success();
+}
+
+StepResult ImplicitEuler::linearized_solve(const Dynamics& dynamics, const State& s, Real h) {
+  const Model& model = dynamics.model();
+  const int np = model.num_particles();
+  const Real* m = model.mass.data();
+  // (M - h D - h^2 K) dv = h (f + h K v); K v comes out of the assembly.
+  const auto start = Clock::now();
+  dynamics.forces(s.x, s.v, f_);
+  if (!have_dv_) {  // first guess for CG: the explicit step h M^-1 f; later the last dv
+    for (int i = 0; i < np; ++i) dv_.segment<3>(3 * i) = (h / m[i]) * f_.segment<3>(3 * i);
+  }
+  jacobian_->assemble_system(model, s.x, s.v, jacobian_options_, h, h * h, a_, s.v, kw_);
+  b_ = h * (f_ + h * kw_);
+  assembly_seconds_ += seconds_since(start);
+  const Terrains* terrains = dynamics.terrains();
+  contact_active_ =
+      resolves_contact() && terrains != nullptr && contact_.begin_step(model, *terrains, s, f_, h);
+  // Solve; with contacts, again while their active set changes.
+  for (int round = 1;; ++round) {
+    const bool constrained = contact_active_ && contact_.has_constraints();
+    if (constrained) contact_.constrain(a_, b_, true, rhs_, z_, dv_);
+    if (StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t);
+        !r.ok) {
+      have_dv_ = false;
+      return r;
+    }
+    if (constrained) dv_ += z_;
+    ++newton_iterations_;
+    if (!contact_active_) break;
+    const bool last = round >= options_.contact_iterations;
+    if (!contact_.update(*terrains, b_, dv_, !last, a_) || last) break;
+  }
+  have_dv_ = true;
+  return StepResult::success();
+}
+
+StepResult ImplicitEuler::newton(const Dynamics& dynamics, const State& s, Real h) {
+  // Newton on g(v1) = M (v1 - v0) - h f(x0 + h v1, v1) = 0, dg/dv1 = M - h D - h^2 K; with
+  // contacts, g is projected onto the free directions (the constraints hold already) and the
+  // sliding friction impulses are part of it.
+  const Model& model = dynamics.model();
+  const int np = model.num_particles();
+  const Real* m = model.mass.data();
+  Real scale = h * f_.norm();
+  if (!(scale > 0)) scale = 1;
+  const bool constrained = contact_active_ && contact_.has_constraints();
+  converged_ = false;
+  for (int k = 1;; ++k) {
+    x1_ = s.x + h * v1_;
+    dynamics.forces(x1_, v1_, f_);
+    for (int i = 0; i < np; ++i)
+      g_.segment<3>(3 * i) =
+          m[i] * (v1_.segment<3>(3 * i) - s.v.segment<3>(3 * i)) - h * f_.segment<3>(3 * i);
+    if (constrained) {
+      contact_.subtract_friction(v1_, g_);
+      contact_.project(g_);
+    }
+    const Real residual = g_.norm();
+    residuals_.push_back(residual);
+    if (!std::isfinite(residual))
+      return StepResult::failure("implicit_euler: Newton residual is not finite");
+    if (residual <= options_.newton_tolerance * scale) {
+      converged_ = true;
+      break;
+    }
+    if (k >= options_.newton_iterations) break;
+    g_ = -g_;
+    delta_.setZero();
+    const auto start = Clock::now();
+    jacobian_->assemble_system(model, x1_, v1_, jacobian_options_, h, h * h, a_, v1_, kw_);
+    assembly_seconds_ += seconds_since(start);
+    if (constrained) contact_.constrain(a_, g_, false, rhs_, z_, delta_);
+    if (StepResult r =
+            factorize_and_solve(model, constrained ? rhs_ : g_, delta_, constrained, s.t);
+        !r.ok)
+      return r;
+    ++newton_iterations_;
+    v1_ += delta_;
+  }
+  if (!converged_) ++newton_not_converged_;
+  dv_ = v1_ - s.v;
   return StepResult::success();
 }
 
 StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
-  const Model& model = dynamics.model();
-  if (StepResult r = prepare(model, h); !r.ok) return r;
-  const int np = model.num_particles();
-  const Real* m = model.mass.data();
-
-  // Linearized step: (M - h D - h^2 K) dv = h (f + h K v).
-  auto start = Clock::now();
-  dynamics.forces(s.x, s.v, f_);
-  assembly_seconds_ += seconds_since(start);
-  if (!have_dv_) {  // first guess for CG: the explicit step h M^-1 f; later the last dv
-    for (int i = 0; i < np; ++i) dv_.segment<3>(3 * i) = (h / m[i]) * f_.segment<3>(3 * i);
-  }
-  // b = h (f + h K v); K v comes out of the assembly, so b is formed after it (in solve()).
-  // Assemble first with kw_, then build b, then factorize and solve.
-  start = Clock::now();
-  jacobian_->assemble_system(model, s.x, s.v, jacobian_options_, h, h * h, a_, s.v, kw_);
-  b_ = h * (f_ + h * kw_);
-  assembly_seconds_ += seconds_since(start);
-  start = Clock::now();
-  LinearResult lr = solver_->factorize(a_);
-  factorization_seconds_ += seconds_since(start);
-  if (lr.ok()) {
-    start = Clock::now();
-    lr = solver_->solve(b_, dv_);
-    solve_seconds_ += seconds_since(start);
-  }
-  if (!lr.ok()) {
-    have_dv_ = false;
-    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(s.t) + " (" +
-                               std::string(linear_status_name(lr.status)) + "): " + lr.message);
-  }
-  if (!dv_.allFinite()) {
-    have_dv_ = false;
-    return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
-  }
-  if (lr.iterations > 0) restore_momentum(model.mass, b_, dv_);
-  have_dv_ = true;
-  ++newton_iterations_;
+  if (StepResult r = prepare(dynamics.model(), h); !r.ok) return r;
+  if (StepResult r = linearized_solve(dynamics, s, h); !r.ok) return r;
   v1_ = s.v + dv_;
-
   residuals_.clear();
   converged_ = true;
   if (options_.newton_iterations > 1) {
-    // Newton on g(v1) = M (v1 - v0) - h f(x0 + h v1, v1) = 0, dg/dv1 = M - h D - h^2 K.
-    Real scale = h * f_.norm();
-    if (!(scale > 0)) scale = 1;
-    converged_ = false;
-    for (int k = 1;; ++k) {
-      x1_ = s.x + h * v1_;
-      dynamics.forces(x1_, v1_, f_);
-      for (int i = 0; i < np; ++i)
-        g_.segment<3>(3 * i) =
-            m[i] * (v1_.segment<3>(3 * i) - s.v.segment<3>(3 * i)) - h * f_.segment<3>(3 * i);
-      const Real residual = g_.norm();
-      residuals_.push_back(residual);
-      if (!std::isfinite(residual))
-        return StepResult::failure("implicit_euler: Newton residual is not finite");
-      if (residual <= options_.newton_tolerance * scale) {
-        converged_ = true;
-        break;
-      }
-      if (k >= options_.newton_iterations) break;
-      g_ = -g_;
-      delta_.setZero();
-      if (StepResult r = solve(model, x1_, v1_, h, v1_, nullptr, g_, delta_); !r.ok) return r;
-      ++newton_iterations_;
-      v1_ += delta_;
-    }
-    if (!converged_) ++newton_not_converged_;
-    dv_ = v1_ - s.v;
+    if (StepResult r = newton(dynamics, s, h); !r.ok) return r;
   }
   s.v = v1_;
   s.x += h * s.v;
   s.t += h;
+  if (contact_active_) contact_.finish(dynamics.model(), *dynamics.terrains(), s);
   return StepResult::success();
 }
 

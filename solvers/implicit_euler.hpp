@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <jelly/core/jacobian.hpp>
+#include <jelly/solvers/implicit_contact.hpp>
 #include <jelly/solvers/implicit_euler_options.hpp>
 #include <jelly/solvers/integrator.hpp>
 #include <jelly/solvers/linear_solver.hpp>
@@ -22,9 +23,12 @@ class ImplicitEuler final : public Integrator {
   std::string_view name() const override { return "implicit_euler"; }
   int order() const override { return 1; }
   bool is_implicit() const override { return true; }
+  bool resolves_contact() const override { return options_.contact == "implicit"; }
+  int contacts_resolved() const override { return contact_active_ ? contact_.count() : 0; }
   // steps, symbolic_analyses, numeric_factorizations, linear_solves, cg_iterations,
   // newton_iterations, newton_not_converged, assembly_seconds, factorization_seconds,
-  // solve_seconds.
+  // solve_seconds, and for contact inside the solve contact_extra_solves,
+  // contact_not_converged, contact_restitution_limited.
   Statistics statistics() const override;
 
   const ImplicitEulerOptions& options() const { return options_; }
@@ -41,16 +45,23 @@ class ImplicitEuler final : public Integrator {
 
  private:
   StepResult prepare(const Model& model, Real h);
-  // Assembles A = M - h D - h^2 K at (x, v) (and kw = K w), factorizes and solves A y = b.
-  StepResult solve(const Model& model, const VecX& x, const VecX& v, Real h, const VecX& w,
-                   VecX* kw, const VecX& b, VecX& y);
+  // Factorizes A (filtered by the contact constraints, if any) and solves for dv_: the
+  // linearized step, repeated while the contacts' active set changes.
+  StepResult linearized_solve(const Dynamics& dynamics, const State& s, Real h);
+  // Factorizes a_ and solves a_ y = b (constrained: a_ is filtered by contacts).
+  StepResult factorize_and_solve(const Model& model, const VecX& b, VecX& y, bool constrained,
+                                 Real t);
+  // Newton corrections on the nonlinear backward-Euler equations from v1_.
+  StepResult newton(const Dynamics& dynamics, const State& s, Real h);
 
   ImplicitEulerOptions options_;
   JacobianOptions jacobian_options_;
   std::optional<SpringJacobian> jacobian_;
   std::unique_ptr<LinearSolver> solver_;
   SparseMatrix a_;
-  VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_;
+  VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_;
+  ImplicitContact contact_;
+  bool contact_active_ = false;  // the current step constrains contacts
   Real last_h_ = 0;
   bool have_dv_ = false;
   std::vector<Real> residuals_;

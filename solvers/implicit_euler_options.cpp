@@ -43,6 +43,10 @@ bool ImplicitEulerOptions::is_valid(std::string* why) const {
     return fail(why, "refactor_iterations", refactor_iterations, "an integer >= 1");
   if (!one_of(ordering, {"metis", "amd", "nesdis", "best"}))
     return fail(why, "ordering", ordering, "metis, amd, nesdis or best");
+  if (!one_of(contact, {"implicit", "after_step"}))
+    return fail(why, "contact", contact, "implicit or after_step");
+  if (contact_iterations < 1 || contact_iterations > 100)
+    return fail(why, "contact_iterations", contact_iterations, "an integer in [1, 100]");
   return true;
 }
 

@@ -27,6 +27,12 @@ struct ImplicitEulerOptions {
   int refactor_iterations = 20;
   // Fill-reducing ordering of CHOLMOD: "metis", "amd", "nesdis" or "best" (CHOLMOD's default).
   std::string ordering = "metis";
+  // How coulomb terrains enter the step: "implicit" (constraints inside the linear solve, with
+  // friction and restitution; solvers/implicit_contact.hpp) or "after_step" (the resolve after
+  // the step that the explicit integrators use; it crushes the springs at large steps).
+  std::string contact = "implicit";
+  // "implicit": at most this many linear solves per step while the active set changes.
+  int contact_iterations = 10;
 
   // False, with "options.<field> = <value> is invalid: <allowed>" in *why, for the first
   // invalid field.

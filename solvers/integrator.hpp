@@ -35,6 +35,11 @@ class Integrator {
   // True when the method chooses its own internal steps within each step(h) (error control):
   // the h-convergence of fixed-step methods does not apply to it.
   virtual bool is_adaptive() const { return false; }
+  // True when do_step() already applied the contact of the coulomb terrains (inside its solve);
+  // the Simulator then applies only the seed model's contact after the step.
+  virtual bool resolves_contact() const { return false; }
+  // When resolves_contact(): the particles in coulomb contact at the end of the last step.
+  virtual int contacts_resolved() const { return 0; }
   // Counters of this integrator (steps, and whatever the method adds).
   virtual Statistics statistics() const;
 

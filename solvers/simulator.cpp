@@ -69,13 +69,19 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
 }
 
 StepResult Simulator::step() {
-  const Dynamics dynamics(model_, contacts_);
+  const Dynamics dynamics(model_, contacts_, &terrains_);
   before_.x = state_.x;
   before_.v = state_.v;
   StepResult result = integrator_->step(dynamics, state_, options_.dt);
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
-  contacts_.resolve(model_, terrains_, before_, state_, options_.dt);
+  if (integrator_->resolves_contact()) {
+    contacts_.resolve(model_, terrains_, before_, state_, options_.dt,
+                      ContactSolver::Scope::kSeedOnly);
+    contacts_.add_resolved(integrator_->contacts_resolved());
+  } else {
+    contacts_.resolve(model_, terrains_, before_, state_, options_.dt);
+  }
   ++total_steps_;
   return result;
 }

@@ -66,11 +66,12 @@ bool resolve_seed(const Terrain& terrain, const ContactParams& c, Real m1, Real 
 }  // namespace
 
 void ContactSolver::resolve(const Model& model, const Terrains& terrains, const State& before,
-                            State& state, Real h) {
+                            State& state, Real h, Scope scope) {
   seed_contacts_.clear();
   contact_count_ = 0;
   for (const auto& terrain : terrains) {
     const ContactParams& c = terrain->contact();
+    if (scope == Scope::kSeedOnly && c.model == ContactModel::kCoulomb) continue;
     for (int i = 0; i < model.num_particles(); ++i) {
       auto x = particle(state.x, i);
       auto v = particle(state.v, i);

@@ -2,7 +2,8 @@
 // Contact between particles and terrains, the same for every integrator (docs/contact.md):
 //  1. after each integrator step, resolve() applies each terrain's contact model to the new
 //     state: velocity impulses (restitution, friction) and, for coulomb, projection out of the
-//     surface and the tangential displacement that friction removed during the step;
+//     surface and the tangential displacement that friction removed during the step (an
+//     implicit integrator may resolve the coulomb terrains inside its solve instead);
 //  2. during the next step, every force evaluation calls add_forces(), which applies the seed
 //     model's contact and friction forces to the particles that collided in step 1.
 #include <memory>
@@ -26,10 +27,16 @@ class ContactSolver {
     Real friction;
   };
 
+  // Which terrains resolve() answers: all, or only those with the seed model (when the
+  // integrator resolved the coulomb ones inside its step).
+  enum class Scope { kAll, kSeedOnly };
+
   // Applies every terrain's contact response to `state` (time state.t) after a step of size h
   // from the state `before`.
   void resolve(const Model& model, const Terrains& terrains, const State& before, State& state,
-               Real h);
+               Real h, Scope scope = Scope::kAll);
+  // Adds contacts resolved elsewhere (inside an implicit step) to contact_count().
+  void add_resolved(int count) { contact_count_ += count; }
   // Seed model: for each particle that collided at the last resolve() and whose force f pushes
   // into the surface, cancels the inward normal force N and adds the friction -mu N v_t.
   void add_forces(const VecX& v, VecX& f) const;

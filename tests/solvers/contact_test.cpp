@@ -13,6 +13,7 @@
 namespace jelly {
 namespace {
 
+using testing::cube_on_slope;
 using testing::make_sim;
 
 // Contact is applied after each step the same way for every integrator (docs/contact.md), so
@@ -90,16 +91,6 @@ TEST_P(ContactEveryIntegrator, BounceWithRestitution) {
   sim.add_observer(probe);
   ASSERT_TRUE(sim.run_until(1.2).ok());
   EXPECT_NEAR(apex, 0.36, 0.36 * 0.01);
-}
-
-// The seed cube turned to lie flat on a slope of `degrees`, just above it.
-State cube_on_slope(const Model& m, Real degrees) {
-  State s = rest_state(m);
-  // Corner at the origin, rotated so that its bottom face lies in the slope.
-  const Vec3 corner = particle(s.x, 0);
-  for (int i = 0; i < m.num_particles(); ++i) particle(s.x, i) -= corner - Vec3(0, 1e-3, 0);
-  testing::rotate_about_z(s, -degrees, Vec3::Zero());
-  return s;
 }
 
 // mu > tan(20 deg): the jelly sticks.

@@ -164,7 +164,8 @@ TEST(ImplicitEuler, SimulatorReportsSolverFailure) {
   EXPECT_EQ(sim.state().x, s.x);  // the failed step left the state alone
 }
 
-// The symbolic analysis runs once over a whole run; each step factorizes and solves once.
+// The symbolic analysis runs once over a whole run; each step factorizes and solves once, plus
+// once more for each change of the set of particles in contact.
 TEST(ImplicitEuler, AnalysesThePatternOnce) {
   for (const char* backend : {"cholmod", "ldlt", "cg"}) {
     const Model model = build_cube(testing::small_cube(4, 1.0, Vec3(0, 0.3, 0)));
@@ -179,14 +180,16 @@ TEST(ImplicitEuler, AnalysesThePatternOnce) {
     const Statistics& st = report.statistics;
     EXPECT_EQ(st.at("steps"), 200) << backend;
     EXPECT_EQ(st.at("symbolic_analyses"), 1) << backend;
-    EXPECT_EQ(st.at("linear_solves"), 200) << backend;
-    EXPECT_EQ(st.at("newton_iterations"), 200) << backend;
+    const double solves = 200 + st.at("contact_extra_solves");
+    EXPECT_LT(st.at("contact_extra_solves"), 20) << backend;
+    EXPECT_EQ(st.at("linear_solves"), solves) << backend;
+    EXPECT_EQ(st.at("newton_iterations"), solves) << backend;
     if (std::string(backend) == "cg") {
       EXPECT_GE(st.at("numeric_factorizations"), 1);
-      EXPECT_LT(st.at("numeric_factorizations"), 200);  // the factor is reused
+      EXPECT_LT(st.at("numeric_factorizations"), solves);  // the factor is reused
       EXPECT_GT(st.at("cg_iterations"), 0);
     } else {
-      EXPECT_EQ(st.at("numeric_factorizations"), 200) << backend;
+      EXPECT_EQ(st.at("numeric_factorizations"), solves) << backend;
     }
     EXPECT_GT(st.at("assembly_seconds"), 0);
     EXPECT_GT(st.at("factorization_seconds"), 0);
@@ -370,28 +373,19 @@ TEST_P(SeedScenes, FreeJellyNeverGainsEnergy) {
   EXPECT_LE(out.worst_growth, 1e-9 * out.energy_scale);
 }
 
-// The slope: no divergence, never more than 5 cm into the slope, and at the end (the jelly has
-// fallen 6 m and come to rest) less energy than at the start.
-TEST_P(SeedScenes, SlopeIsStable) {
+// The slope: no divergence, never more than 5 cm into the slope (with contact inside the solve
+// it is never inside at all), and, since nothing does work on the jelly on the fixed slope but
+// gravity, whose work is in the energy, the energy never grows from one frame to the next,
+// through the fall, the impact and the rest, at these large steps. (With contact after the
+// step, "after_step", it grew up to 1.65x at dt = 1/30 and 50x at ks = 1e5: the projection
+// crushed the springs above the bottom layer.)
+TEST_P(SeedScenes, SlopeIsStableAndNeverGainsEnergy) {
   const auto [dt, material] = GetParam();
   const SceneOutcome out = run_seed_scene(Scene::kSlope, dt, material);
   ASSERT_TRUE(out.report.ok()) << out.report.brief();
-  EXPECT_GT(out.deepest, -0.05);
-  EXPECT_LT(out.final_energy, out.initial);
-}
-
-// NOT MET YET (docs/implicit.md, "Contact"): at these large steps the energy grows from one
-// frame to the next while the jelly hits the slope. The coulomb contact, applied after the
-// implicit step, projects the particles that the step moved into the slope (up to 0.37 m at
-// dt = 1/30) back onto it, which crushes the springs to the next layer and stores elastic
-// energy (at ks = 1e5 the energy peaks at 50 times its initial value). The implicit step itself
-// never adds energy (FreeJellyNeverGainsEnergy) and at dt = 1e-3 the slope scene never gains
-// energy either. Enable when contact enters the implicit solve.
-TEST_P(SeedScenes, DISABLED_SlopeEnergyNeverGrows) {
-  const auto [dt, material] = GetParam();
-  const SceneOutcome out = run_seed_scene(Scene::kSlope, dt, material);
-  ASSERT_TRUE(out.report.ok()) << out.report.brief();
+  EXPECT_GT(out.deepest, -1e-9);
   EXPECT_LE(out.worst_growth, 1e-9 * out.energy_scale);
+  EXPECT_LT(out.final_energy, out.initial);
 }
 
 // The elevator does work on the jelly, so only stability and contact are checked: no

@@ -67,6 +67,16 @@ inline void rotate_about_z(State& s, Real degrees, const Vec3& pivot) {
     particle(s.x, i) = pivot + r * (particle(s.x, i) - pivot);
 }
 
+// A cube state turned to lie flat on a slope of `degrees` through the origin, 1 mm above it.
+inline State cube_on_slope(const Model& m, Real degrees) {
+  State s = rest_state(m);
+  // Corner at the origin, rotated so that its bottom face lies in the slope.
+  const Vec3 corner = particle(s.x, 0);
+  for (int i = 0; i < m.num_particles(); ++i) particle(s.x, i) -= corner - Vec3(0, 1e-3, 0);
+  rotate_about_z(s, -degrees, Vec3::Zero());
+  return s;
+}
+
 inline Simulator make_sim(const Model& model, const State& state, const std::string& integrator,
                           Real dt, Real output_interval = 0) {
   SimulatorOptions options;
