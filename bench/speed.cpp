@@ -88,12 +88,13 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
         if (k == o.warmup_steps) before_timing = method->statistics();
         before.x = state.x;
         before.v = state.v;
-        const Dynamics dynamics(model, contacts);
+        const Dynamics dynamics(model, contacts, &parts.terrains);
         auto start = Clock::now();
         const StepResult result = method->step(dynamics, state, o.dt);
         const double step_time = seconds_since(start);
         start = Clock::now();
-        if (result.ok) contacts.resolve(model, parts.terrains, before, state, o.dt);
+        if (result.ok)
+          resolve_contact_after_step(*method, contacts, model, parts.terrains, before, state, o.dt);
         const double contact_time = seconds_since(start);
         if (timing) {
           integrator_seconds += step_time;

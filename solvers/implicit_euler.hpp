@@ -2,7 +2,9 @@
 // Backward (implicit) Euler on a sparse linear solver: per step
 //   (M - h D - h^2 K) dv = h (f + h K v),  v += dv,  x += h v      (Baraff & Witkin 1998)
 // with K = df/dx and D = df/dv of the springs and dampers, or, with newton_iterations > 1,
-// Newton's method on the nonlinear backward-Euler equations. Order 1, stable at any dt.
+// Newton's method on the nonlinear backward-Euler equations. Order 1, stable at any dt. With
+// the option contact = "implicit" (default) the coulomb terrains' contact and friction are
+// constraints of the same solve (implicit_contact.hpp).
 #include <memory>
 #include <optional>
 #include <vector>

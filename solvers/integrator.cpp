@@ -18,4 +18,15 @@ StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
 
 Statistics Integrator::statistics() const { return {{"steps", static_cast<double>(steps_)}}; }
 
+void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,
+                                const Model& model, const Terrains& terrains, const State& before,
+                                State& state, Real h) {
+  if (!integrator.resolves_contact()) {
+    contacts.resolve(model, terrains, before, state, h);
+    return;
+  }
+  contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kSeedOnly);
+  contacts.add_resolved(integrator.contacts_resolved());
+}
+
 }  // namespace jelly

@@ -52,6 +52,13 @@ class Integrator {
   long steps_ = 0;
 };
 
+// The contact after a step of `integrator` from `before` to `state` (as the Simulator does it):
+// every terrain's, or, when the integrator resolved the coulomb terrains inside its step, only
+// the seed model's, with the integrator's contacts added to the count.
+void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,
+                                const Model& model, const Terrains& terrains, const State& before,
+                                State& state, Real h);
+
 // Resizes v to n entries only when its size differs (no allocation in steady state).
 inline void ensure_size(VecX& v, Eigen::Index n) {
   if (v.size() != n) v.setZero(n);

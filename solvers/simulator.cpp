@@ -75,13 +75,8 @@ StepResult Simulator::step() {
   StepResult result = integrator_->step(dynamics, state_, options_.dt);
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
-  if (integrator_->resolves_contact()) {
-    contacts_.resolve(model_, terrains_, before_, state_, options_.dt,
-                      ContactSolver::Scope::kSeedOnly);
-    contacts_.add_resolved(integrator_->contacts_resolved());
-  } else {
-    contacts_.resolve(model_, terrains_, before_, state_, options_.dt);
-  }
+  resolve_contact_after_step(*integrator_, contacts_, model_, terrains_, before_, state_,
+                             options_.dt);
   ++total_steps_;
   return result;
 }

@@ -1,6 +1,7 @@
 #pragma once
-// Steps a model among terrains with an integrator: contact after every step, observers at a
-// chosen output interval, and a divergence guard that stops the run with a report.
+// Steps a model among terrains with an integrator: contact after every step (or inside it, for
+// an integrator that resolves contact itself), observers at a chosen output interval, and a
+// divergence guard that stops the run with a report.
 #include <memory>
 #include <vector>
 
