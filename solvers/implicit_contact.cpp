@@ -15,6 +15,8 @@ using Mat3 = Eigen::Matrix3d;
 // at the start of a step (and not separating) it stays constrained.
 constexpr Real kPenetrationTolerance = 1e-9;  // m
 constexpr Real kTouchTolerance = 1e-6;        // m
+// A prescribed normal velocity above -this is "not moving towards the surface" (round-off).
+constexpr Real kTouchSpeed = 1e-9;  // m/s
 // A sliding contact whose friction viscosity reaches this many times its mass has all but
 // stopped (its tangential speed is under 1 % of the free one): it sticks.
 constexpr Real kStickViscosity = 100;
@@ -137,32 +139,36 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
   v0_ = s0.v;
   mass_ = model.mass;
   slot_.resize(np);
-  // Last step's contacts that still touch and do not move away from their surface.
+  // The explicit prediction x0 + h v1, v1 = v0 + h f / m: last step's contacts (unless let go)
+  // that it keeps on their surface, and the particles it carries into a terrain.
+  std::fill(slot_.begin(), slot_.end(), -1);
+  for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
+    const Contact& old = contacts_[ci];
+    if (old.release || old.particle >= np || old.terrain >= static_cast<int>(terrains.size()))
+      continue;
+    slot_[old.particle] = ci;
+  }
   next_.clear();
-  for (const Contact& old : contacts_) {
-    if (old.particle >= np || old.terrain >= static_cast<int>(terrains.size())) continue;
-    const Terrain& terrain = *terrains[old.terrain];
-    const Vec3 x0 = particle(x0_, old.particle);
-    if (!uses_coulomb(terrain) || !terrain.can_contact(x0, t1_)) continue;
-    Contact c = make_contact(terrains, old.particle, old.terrain, particle(v0_, old.particle),
-                             model.mass[old.particle]);
-    if (terrain.signed_distance(x0, t1_) > kTouchTolerance || c.approach < 0) continue;
-    c.mode = old.mode;
-    c.viscosity = old.viscosity;
-    next_.push_back(c);
+  for (int i = 0; i < np; ++i) {
+    const Vec3 v1 = particle(v0_, i) + (h / model.mass[i]) * particle(f, i);
+    const Vec3 predicted = particle(x0_, i) + h * v1;
+    if (slot_[i] >= 0) {
+      const Contact& old = contacts_[slot_[i]];
+      const Terrain& terrain = *terrains[old.terrain];
+      if (uses_coulomb(terrain) && terrain.can_contact(predicted, t1_) &&
+          terrain.signed_distance(predicted, t1_) <= kTouchTolerance) {
+        Contact c = make_contact(terrains, i, old.terrain, v1, model.mass[i]);
+        c.mode = old.mode;
+        c.viscosity = old.viscosity;
+        next_.push_back(c);
+        continue;
+      }
+    }
+    const int k = penetrated_terrain(terrains, predicted, 0);
+    if (k >= 0) next_.push_back(make_contact(terrains, i, k, v1, model.mass[i]));
   }
   contacts_.swap(next_);
   index_contacts();
-  // Particles the explicit prediction carries into a terrain.
-  for (int i = 0; i < np; ++i) {
-    if (slot_[i] >= 0) continue;
-    const Vec3 v1 = particle(v0_, i) + (h / model.mass[i]) * particle(f, i);
-    const int k = penetrated_terrain(terrains, particle(x0_, i) + h * v1, 0);
-    if (k >= 0) {
-      slot_[i] = static_cast<int>(contacts_.size());
-      contacts_.push_back(make_contact(terrains, i, k, v1, model.mass[i]));
-    }
-  }
   return true;
 }
 
@@ -280,7 +286,15 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
     const Real pn = p.dot(n);
     c.normal_impulse = pn;
     if (pn < 0) {  // the surface would have to pull: let go
-      changed = true;
+      // A particle that does not move towards its surface (n.v1 >= 0 prescribed) is pulled
+      // without work: it is held for this step and let go at the next (no solve again).
+      // Otherwise the pull would do work: solve again without it.
+      if (c.target_normal >= -kTouchSpeed) {
+        c.release = true;
+        next_.push_back(c);
+      } else {
+        changed = true;
+      }
       continue;
     }
     const ContactParams& params = terrains[c.terrain]->contact();

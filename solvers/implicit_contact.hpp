@@ -11,7 +11,10 @@
 // constraint impulse p_i = (A dv - b)_i then decides which particles touch, solving again while
 // that changes (at most contact_iterations solves):
 //   free -> contact  when the solve carries the particle below the surface;
-//   contact -> free  when p_n < 0 (the surface would have to pull).
+//   contact -> free  when p_n < 0 (the surface would have to pull); a particle whose
+//                    prescribed normal velocity is >= 0 (touching, not landing) is pulled
+//                    without work, so it is held for this step and let go at the next,
+//                    without another solve.
 // Friction follows each solve, for the next solve or step (a change of friction alone is no
 // reason to solve again):
 //   stick -> slide   when |p_t| > mu_s p_n (outside Coulomb's cone);
@@ -51,6 +54,7 @@ class ImplicitContact {
     // viscosity = mu p_n / |(v1 - u)_t| iterated; always against the sliding.
     Real viscosity = 0;
     Real normal_impulse = 0;  // p_n of the last solve
+    bool release = false;     // held for this step (pulled without work), free at the next
     Real approach = 0;        // -(v0 - u).n at the start of the step
   };
 
