@@ -84,6 +84,44 @@ TEST(ImplicitContact, FilteredSystemKeepsTheConstraintsAndUnfiltersExactly) {
   for (int e = 0; e < a.nonZeros(); ++e) ASSERT_EQ(a.valuePtr()[e], original.valuePtr()[e]) << e;
 }
 
+// Restitution never adds energy: when the step lost less than the bounce would give back (here
+// the step stored 0.4 of the 0.5 J in the spring), the bounce is scaled so that the energy at
+// the end equals the energy at the start; with enough loss it is the full e V.
+TEST(ImplicitContact, RestitutionIsBoundedByTheEnergyTheStepLost) {
+  testing::TwoParticleSpring pair;  // 1 kg each, ks 100, rest length 1, no gravity
+  pair.stretch = 0;
+  const Model m = pair.model();
+  Terrains wall;
+  ContactParams c;
+  c.restitution = 1.0;
+  wall.push_back(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitX(), c));
+  for (const Real stored : {0.4, 0.0}) {
+    State s0;
+    s0.x = VecX::Zero(6);
+    s0.x[0] = 1e-3;
+    s0.x[3] = 1 + 1e-3;
+    s0.v = VecX::Zero(6);
+    s0.v[0] = -1;  // particle 0 hits the wall at 1 m/s: 0.5 J
+    const Real h = 0.01;
+    ImplicitContact contact;
+    ASSERT_TRUE(contact.begin_step(m, wall, s0, VecX::Zero(6), h));
+    ASSERT_EQ(contact.contacts().size(), 1u);
+    // An end state (as a solve could give) with particle 0 on the wall and `stored` J in the
+    // spring.
+    State s1 = s0;
+    s1.t = h;
+    s1.x[0] = 0;
+    s1.x[3] = 1 + std::sqrt(2 * stored / pair.ks);
+    s1.v[0] = -0.1;
+    contact.finish(m, wall, s1);
+    const Real bounce = s1.v[0];
+    const Real expected = std::sqrt(2 * std::min(0.5 - stored, 0.5));  // e V = 1 if affordable
+    EXPECT_NEAR(bounce, expected, 1e-12) << stored;
+    EXPECT_LE(total_energy(m, s1), total_energy(m, s0) + 1e-12) << stored;
+    EXPECT_EQ(contact.counters().restitution_limited, stored > 0 ? 1 : 0);
+  }
+}
+
 // Total energy (kinetic + elastic + gravitational) at every step, and the deepest point below
 // the terrain.
 struct Trace {
