@@ -196,13 +196,20 @@ TEST_P(LargeSteps, DroppedJellyRestsOnTheFloor) {
   EXPECT_EQ(sim.contacts().contact_count(), 16);  // the bottom layer
 }
 
-// mu > tan(20 deg): the jelly sticks, without creeping.
-TEST_P(LargeSteps, SticksOnSlopeWhenFrictionHolds) {
+// A 4x4x4 jelly lying on a 20 degree slope with friction mu (static and kinetic).
+Simulator on_slope_with_friction(Real mu, Real dt) {
   const Model m = build_cube(testing::small_cube(4));
   ContactParams c;
-  c.friction = c.static_friction = 0.6;
-  Simulator sim = testing::make_sim(m, cube_on_slope(m, 20), "implicit_euler", GetParam());
+  c.friction = c.static_friction = mu;
+  Simulator sim = testing::make_sim(m, cube_on_slope(m, 20), "implicit_euler", dt);
   sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), c)));
+  return sim;
+}
+
+// mu > tan(20 deg): the jelly sticks, without creeping.
+TEST_P(LargeSteps, SticksOnSlopeWhenFrictionHolds) {
+  Simulator sim = on_slope_with_friction(0.6, GetParam());
+  const Model& m = sim.model();
   const Trace settle = run_traced(sim, 0.5);
   const Vec3 settled = center_of_mass(m, sim.state());
   const Trace rest = run_traced(sim, 2.0);
@@ -213,11 +220,8 @@ TEST_P(LargeSteps, SticksOnSlopeWhenFrictionHolds) {
 
 // mu < tan(20 deg): the jelly slides down with acceleration g (sin a - mu cos a), losing energy.
 TEST_P(LargeSteps, SlidesOnSlopeWithCoulombAcceleration) {
-  const Model m = build_cube(testing::small_cube(4));
-  ContactParams c;
-  c.friction = c.static_friction = 0.15;
-  Simulator sim = testing::make_sim(m, cube_on_slope(m, 20), "implicit_euler", GetParam());
-  sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), c)));
+  Simulator sim = on_slope_with_friction(0.15, GetParam());
+  const Model& m = sim.model();
   const Real a = 20 * M_PI / 180;
   const Vec3 down_slope(std::cos(a), -std::sin(a), 0);
   const auto speed_along = [&] {
