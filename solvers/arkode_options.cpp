@@ -14,7 +14,7 @@ void ArkodeOptions::validate() const {
   require(std::isfinite(max_step) && max_step >= 0, "integrator.options.max_step", max_step,
           "a finite step >= 0 s (0 = the contact interval dt)");
   require(linear_solver == "schur" || linear_solver == "klu", "integrator.options.linear_solver",
-          linear_solver, "\"schur\" or \"klu\"");
+          "\"" + linear_solver + "\"", "\"schur\" or \"klu\"");
   require(max_steps > 0, "integrator.options.max_steps", max_steps,
           "a number of internal steps per contact interval > 0");
 }

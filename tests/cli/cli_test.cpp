@@ -95,6 +95,24 @@ TEST(Cli, AShortGoodRunExitsZeroWithASummary) {
   EXPECT_THAT(r.out, HasSubstr("statistics      steps = 50"));
 }
 
+// Implicit Euler at a game's time step with contact inside its solve: it completes, and the
+// summary reports the contact statistics; a bad contact option names its path.
+TEST(Cli, ImplicitEulerResolvesContactInItsSolve) {
+  Result r = jelly("run '" + scene("drop_coulomb.json") +
+                   "' --set cube.n=3 --duration 1 --integrator implicit_euler --dt 0.0333333");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("integrator      implicit_euler, dt = 0.0333333 s"));
+  EXPECT_THAT(r.out, HasSubstr("contact_extra_solves = "));
+  EXPECT_THAT(r.out, HasSubstr("contact_not_converged = 0,"));
+
+  r = jelly("run '" + scene("drop_coulomb.json") +
+            "' --integrator implicit_euler --set integrator.options.contact=penalty");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "error: integrator.options.contact = \"penalty\" is invalid: \"implicit\" or "
+            "\"after_step\"\n");
+}
+
 TEST(Cli, ADivergentRunExitsThree) {
   const Result r = jelly("run " + kSmallSlope + " --integrator explicit_euler --dt 0.05 --quiet");
   EXPECT_EQ(r.code, 3) << r.out << r.err;

@@ -281,7 +281,7 @@ TEST(ImplicitContact, AfterStepOptionUsesTheSimulatorsResolve) {
   std::string why;
   EXPECT_FALSE(o.is_valid(&why));
   EXPECT_NE(why.find("options.contact"), std::string::npos) << why;
-  EXPECT_NE(why.find("implicit or after_step"), std::string::npos) << why;
+  EXPECT_NE(why.find("\"implicit\" or \"after_step\""), std::string::npos) << why;
 }
 
 }  // namespace
