@@ -161,8 +161,8 @@ StepResult ImplicitEuler::linearized_solve(const Dynamics& dynamics, const State
   b_ = h * (f_ + h * kw_);
   assembly_seconds_ += seconds_since(start);
   const Terrains* terrains = dynamics.terrains();
-  contact_active_ =
-      resolves_contact() && terrains != nullptr && contact_.begin_step(model, *terrains, s, f_, h);
+  terrains_seen_ = terrains != nullptr;
+  contact_active_ = resolves_contact() && contact_.begin_step(model, *terrains, s, f_, h);
   // Solve; with contacts, again while their active set changes.
   for (int round = 1;; ++round) {
     const bool constrained = contact_active_ && contact_.has_constraints();

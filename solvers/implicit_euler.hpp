@@ -25,7 +25,11 @@ class ImplicitEuler final : public Integrator {
   std::string_view name() const override { return "implicit_euler"; }
   int order() const override { return 1; }
   bool is_implicit() const override { return true; }
-  bool resolves_contact() const override { return options_.contact == "implicit"; }
+  // With contact = "implicit", unless the last step's Dynamics carried no terrains (then the
+  // caller's resolve after the step must handle them all).
+  bool resolves_contact() const override {
+    return options_.contact == "implicit" && terrains_seen_;
+  }
   int contacts_resolved() const override { return contact_active_ ? contact_.count() : 0; }
   // steps, symbolic_analyses, numeric_factorizations, linear_solves, cg_iterations,
   // newton_iterations, newton_not_converged, assembly_seconds, factorization_seconds,
@@ -64,6 +68,7 @@ class ImplicitEuler final : public Integrator {
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_;
   ImplicitContact contact_;
   bool contact_active_ = false;  // the current step constrains contacts
+  bool terrains_seen_ = true;    // the last step's Dynamics had terrains
   Real last_h_ = 0;
   bool have_dv_ = false;
   std::vector<Real> residuals_;

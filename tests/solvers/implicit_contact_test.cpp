@@ -277,6 +277,17 @@ TEST(ImplicitContact, AfterStepOptionUsesTheSimulatorsResolve) {
   o.contact = "after_step";
   EXPECT_FALSE(ImplicitEuler(o).resolves_contact());
   EXPECT_TRUE(ImplicitEuler().resolves_contact());
+  // Stepped with a Dynamics that has no terrains, it has resolved nothing: the caller's resolve
+  // after the step must handle every terrain.
+  ImplicitEuler alone;
+  const FallingCube c;
+  const ContactSolver contacts;
+  State s = c.s0;
+  ASSERT_TRUE(alone.step(Dynamics(c.model, contacts), s, c.h).ok);
+  EXPECT_FALSE(alone.resolves_contact());
+  ASSERT_TRUE(alone.step(Dynamics(c.model, contacts, &c.terrains), s, c.h).ok);
+  EXPECT_TRUE(alone.resolves_contact());
+
   o.contact = "penalty";
   std::string why;
   EXPECT_FALSE(o.is_valid(&why));
