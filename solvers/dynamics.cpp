@@ -6,7 +6,10 @@ namespace jelly {
 
 void Dynamics::forces(const VecX& x, const VecX& v, VecX& f) const {
   ++evaluations_;
-  compute_forces(*model_, x, v, f);
+  if (bands_)
+    bands_->compute_forces(*model_, x, v, f);
+  else
+    compute_forces(*model_, x, v, f);
   contacts_->add_forces(v, f);
 }
 

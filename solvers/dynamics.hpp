@@ -2,15 +2,18 @@
 // The right-hand side every integrator sees: the model's forces (gravity, springs, dampers) plus
 // the contact forces active during the current step, and the accelerations M^-1 f.
 #include <jelly/core/model.hpp>
+#include <jelly/core/spring_bands.hpp>
 #include <jelly/terrain/contact.hpp>
 
 namespace jelly {
 
 class Dynamics {
  public:
-  // `terrains` (may be null) is for integrators that resolve contact inside their step.
-  Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains = nullptr)
-      : model_(&model), contacts_(&contacts), terrains_(terrains) {}
+  // `terrains` (may be null) is for integrators that resolve contact inside their step;
+  // `bands` (may be null), built for `model`, evaluates the spring forces faster.
+  Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains = nullptr,
+           const SpringBands* bands = nullptr)
+      : model_(&model), contacts_(&contacts), terrains_(terrains), bands_(bands) {}
 
   // f(x, v): size 3N, no allocation.
   void forces(const VecX& x, const VecX& v, VecX& f) const;
@@ -27,6 +30,7 @@ class Dynamics {
   const Model* model_;
   const ContactSolver* contacts_;
   const Terrains* terrains_;
+  const SpringBands* bands_;
   mutable long evaluations_ = 0;
 };
 

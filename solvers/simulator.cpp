@@ -22,6 +22,7 @@ Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integ
       options_(options) {
   model_.validate();
   options_.validate();
+  bands_ = SpringBands(model_);
   require(integrator_ != nullptr, "integrator", "null", "an integrator");
   require(state_.x.size() == model_.num_dofs() && state_.v.size() == model_.num_dofs(),
           "state.x.size", state_.x.size(), "3 x the number of particles");
@@ -69,7 +70,14 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
 }
 
 StepResult Simulator::step() {
-  const Dynamics dynamics(model_, contacts_, &terrains_);
+  if (bands_stale_) {
+    if (bands_.fits(model_))
+      bands_.update_coefficients(model_);
+    else
+      bands_ = SpringBands(model_);
+    bands_stale_ = false;
+  }
+  const Dynamics dynamics(model_, contacts_, &terrains_, &bands_);
   before_.x = state_.x;
   before_.v = state_.v;
   StepResult result = integrator_->step(dynamics, state_, options_.dt);

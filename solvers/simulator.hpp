@@ -63,7 +63,11 @@ class Simulator {
 
   const Model& model() const { return model_; }
   // For changing coefficients between runs (fitting); the sparsity of springs must not change.
-  Model& mutable_model() { return model_; }
+  // The spring bands of the force loop are refreshed from it at the next step.
+  Model& mutable_model() {
+    bands_stale_ = true;
+    return model_;
+  }
   const State& state() const { return state_; }
   // Replaces the state (a restart); forgets the active contacts.
   void set_state(State state);
@@ -84,6 +88,8 @@ class Simulator {
   void emit_frame();
 
   Model model_;
+  SpringBands bands_;  // the vectorised force loop's grouping of model_'s springs
+  bool bands_stale_ = false;
   State state_;
   std::unique_ptr<Integrator> integrator_;
   SimulatorOptions options_;

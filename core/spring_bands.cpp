@@ -1,0 +1,198 @@
+#include <jelly/core/spring_bands.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <jelly/core/forces.hpp>
+
+// One copy of the band loops per instruction set, chosen when the library is loaded (GCC's
+// function multi-versioning): AVX2 where the CPU has it, the x86-64 baseline (SSE2) elsewhere.
+// AVX-512 measured no faster than AVX2 here.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define JELLY_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define JELLY_VECTOR_CLONES
+#endif
+
+namespace jelly {
+
+namespace {
+
+// Positions and velocities of the two ends of n consecutive springs of a band (a = slot,
+// b = slot + offset), one array per coordinate.
+struct BandEnds {
+  const Real *xa, *ya, *za, *ua, *va, *wa;
+  const Real *xb, *yb, *zb, *ub, *vb, *wb;
+};
+
+// Force on the first particle of each slot into fx, fy, fz. Returns the number of collapsed
+// springs (shorter than kDegenerateLength l0; then the caller falls back).
+JELLY_VECTOR_CLONES
+int band_forces(int n, BandEnds e, const Real* __restrict rest, const Real* __restrict ks,
+                 const Real* __restrict kd, Real* __restrict fx, Real* __restrict fy,
+                 Real* __restrict fz) {
+  const Real* __restrict xa = e.xa;
+  const Real* __restrict ya = e.ya;
+  const Real* __restrict za = e.za;
+  const Real* __restrict ua = e.ua;
+  const Real* __restrict va = e.va;
+  const Real* __restrict wa = e.wa;
+  const Real* __restrict xb = e.xb;
+  const Real* __restrict yb = e.yb;
+  const Real* __restrict zb = e.zb;
+  const Real* __restrict ub = e.ub;
+  const Real* __restrict vb = e.vb;
+  const Real* __restrict wb = e.wb;
+  int collapsed = 0;
+  for (int j = 0; j < n; ++j) {
+    const Real dx = xa[j] - xb[j], dy = ya[j] - yb[j], dz = za[j] - zb[j];
+    const Real length = std::sqrt(dx * dx + dy * dy + dz * dz);
+    // + tiny: a slot without a spring may join two coincident particles (its coefficients are 0).
+    const Real inv = 1.0 / (length + 1e-300);
+    const Real closing = ((ua[j] - ub[j]) * dx + (va[j] - vb[j]) * dy + (wa[j] - wb[j]) * dz) * inv;
+    const Real magnitude = (-ks[j] * (length - rest[j]) - kd[j] * closing) * inv;
+    fx[j] = magnitude * dx;
+    fy[j] = magnitude * dy;
+    fz[j] = magnitude * dz;
+    collapsed += length < kDegenerateLength * rest[j];
+  }
+  return collapsed;
+}
+
+// a[j] += f[j] and a[j + offset] -= f[j] for the three coordinates.
+JELLY_VECTOR_CLONES
+void scatter_band(int n, int offset, const Real* __restrict fx, const Real* __restrict fy,
+                  const Real* __restrict fz, Real* __restrict ax, Real* __restrict ay,
+                  Real* __restrict az) {
+  for (int j = 0; j < n; ++j) {
+    ax[j] += fx[j];
+    ay[j] += fy[j];
+    az[j] += fz[j];
+  }
+  for (int j = 0; j < n; ++j) {
+    ax[j + offset] -= fx[j];
+    ay[j + offset] -= fy[j];
+    az[j + offset] -= fz[j];
+  }
+}
+
+// A band is worth its empty slots when springs fill at least this fraction of them, and bands
+// are worth their loop overhead when they hold this many springs on average.
+constexpr Real kMinimumFill = 0.5;
+constexpr int kMinimumSpringsPerBand = 4;
+
+}  // namespace
+
+SpringBands::SpringBands(const Model& model)
+    : particles_(model.num_particles()), springs_(model.springs.size()) {
+  const Springs& s = model.springs;
+  std::map<int, std::vector<int>> by_offset;  // offset -> springs
+  for (int k = 0; k < s.size(); ++k) by_offset[std::abs(s.b[k] - s.a[k])].push_back(k);
+  dense_ = springs_ > 0 && by_offset.count(0) == 0 &&
+           springs_ >= kMinimumSpringsPerBand * static_cast<int>(by_offset.size());
+  size_t max_slots = 0;
+  for (const auto& [offset, springs] : by_offset) {
+    if (!dense_) break;
+    int lo = particles_, hi = -1;
+    for (int k : springs) {
+      lo = std::min(lo, std::min(s.a[k], s.b[k]));
+      hi = std::max(hi, std::min(s.a[k], s.b[k]));
+    }
+    Band band;
+    band.offset = offset;
+    band.first = lo;
+    const int slots = hi - lo + 1;
+    if (static_cast<Real>(springs.size()) < kMinimumFill * slots) dense_ = false;
+    band.spring.assign(slots, -1);
+    for (int k : springs) {
+      int& slot = band.spring[std::min(s.a[k], s.b[k]) - lo];
+      if (slot >= 0) dense_ = false;  // two springs on one pair
+      slot = k;
+    }
+    max_slots = std::max(max_slots, static_cast<size_t>(slots));
+    bands_.push_back(std::move(band));
+  }
+  if (!dense_) {
+    bands_.clear();
+    return;
+  }
+  update_coefficients(model);
+  scratch_.assign(9 * static_cast<size_t>(particles_), 0.0);
+  band_force_.assign(3 * max_slots, 0.0);
+}
+
+bool SpringBands::fits(const Model& model) const {
+  return model.num_particles() == particles_ && model.springs.size() == springs_;
+}
+
+void SpringBands::update_coefficients(const Model& model) {
+  const Springs& s = model.springs;
+  for (Band& band : bands_) {
+    const size_t slots = band.spring.size();
+    band.rest.assign(slots, 0.0);
+    band.ks.assign(slots, 0.0);
+    band.kd.assign(slots, 0.0);
+    for (size_t j = 0; j < slots; ++j) {
+      const int k = band.spring[j];
+      if (k < 0) continue;
+      band.rest[j] = s.rest_length[k];
+      band.ks[j] = s.ks[k];
+      band.kd[j] = s.kd[k];
+    }
+  }
+}
+
+void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& v,
+                                 VecX& f) const {
+  if (!dense_ || !fits(model)) {
+    ::jelly::compute_forces(model, x, v, f);
+    return;
+  }
+  const int n = particles_;
+  Real* px = scratch_.data();
+  Real* py = px + n;
+  Real* pz = py + n;
+  Real* pu = pz + n;
+  Real* pv = pu + n;
+  Real* pw = pv + n;
+  Real* ax = pw + n;
+  Real* ay = ax + n;
+  Real* az = ay + n;
+  const Real* m = model.mass.data();
+  const Vec3 g = model.gravity;
+  for (int i = 0; i < n; ++i) {
+    px[i] = x[3 * i];
+    py[i] = x[3 * i + 1];
+    pz[i] = x[3 * i + 2];
+    pu[i] = v[3 * i];
+    pv[i] = v[3 * i + 1];
+    pw[i] = v[3 * i + 2];
+    ax[i] = m[i] * g.x();
+    ay[i] = m[i] * g.y();
+    az[i] = m[i] * g.z();
+  }
+  const size_t max_slots = band_force_.size() / 3;
+  Real* fx = band_force_.data();
+  Real* fy = fx + max_slots;
+  Real* fz = fy + max_slots;
+  for (const Band& band : bands_) {
+    const int a = band.first, b = band.first + band.offset;
+    const int slots = static_cast<int>(band.spring.size());
+    const BandEnds ends{px + a, py + a, pz + a, pu + a, pv + a, pw + a,
+                        px + b, py + b, pz + b, pu + b, pv + b, pw + b};
+    if (band_forces(slots, ends, band.rest.data(), band.ks.data(), band.kd.data(), fx, fy, fz) >
+        0) {
+      ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: its rest direction
+      return;
+    }
+    scatter_band(slots, band.offset, fx, fy, fz, ax + a, ay + a, az + a);
+  }
+  for (int i = 0; i < n; ++i) {
+    f[3 * i] = ax[i];
+    f[3 * i + 1] = ay[i];
+    f[3 * i + 2] = az[i];
+  }
+}
+
+}  // namespace jelly
