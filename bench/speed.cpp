@@ -75,6 +75,7 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
       State& state = parts.state;
       auto method = make_integrator(integrator);
       ContactSolver contacts;
+      const SpringBands bands(model);  // the force loop the Simulator uses
       const DivergenceGuard guard;
       State before;
       double integrator_seconds = 0, contact_seconds = 0, force_probe_seconds = 0;
@@ -88,7 +89,7 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
         if (k == o.warmup_steps) before_timing = method->statistics();
         before.x = state.x;
         before.v = state.v;
-        const Dynamics dynamics(model, contacts, &parts.terrains);
+        const Dynamics dynamics(model, contacts, &parts.terrains, &bands);
         auto start = Clock::now();
         const StepResult result = method->step(dynamics, state, o.dt);
         const double step_time = seconds_since(start);
@@ -104,7 +105,7 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
           // One force evaluation (model forces and the seed contact terms), timed between the
           // steps so that it sees the same load and caches as the steps around it.
           start = Clock::now();
-          compute_forces(model, state.x, state.v, f);
+          bands.compute_forces(model, state.x, state.v, f);
           contacts.add_forces(state.v, f);
           force_probe_seconds += seconds_since(start);
         }
