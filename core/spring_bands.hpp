@@ -35,10 +35,10 @@ class SpringBands {
 
  private:
   struct Band {
-    int offset = 0;  // b - a
-    int first = 0;   // first particle a of slot 0
-    std::vector<int> spring;            // [slots]: spring index, or -1
-    std::vector<Real> rest, ks, kd;     // [slots]: 0 where no spring
+    int offset = 0;                  // b - a
+    int first = 0;                   // first particle a of slot 0
+    std::vector<int> spring;         // [slots]: spring index, or -1
+    std::vector<Real> rest, ks, kd;  // [slots]: 0 where no spring
   };
   std::vector<Band> bands_;
   int particles_ = 0;
