@@ -285,6 +285,7 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
     const Vec3& n = c.normal;
     const Real pn = p.dot(n);
     c.normal_impulse = pn;
+    c.release = false;  // decided again by this solve
     if (pn < 0) {  // the surface would have to pull: let go
       // A particle that does not move towards its surface (n.v1 >= 0 prescribed) is pulled
       // without work: it is held for this step and let go at the next (no solve again).
