@@ -40,6 +40,7 @@ CheckpointWriter::CheckpointWriter(hid_t file, int num_particles, const std::str
   seed_particle_ = resizable("seed_particle", H5T_STD_I32LE, 1);
   seed_normal_ = resizable("seed_normal", H5T_IEEE_F64LE, 3);
   seed_friction_ = resizable("seed_friction", H5T_IEEE_F64LE, 1);
+  integrator_state_ = resizable("integrator_state", H5T_IEEE_F64LE, 1);
 }
 
 namespace {
@@ -73,6 +74,8 @@ void CheckpointWriter::write(const SimulatorSnapshot& s) {
   overwrite(seed_particle_.get(), H5T_NATIVE_INT, {k}, particles_.data());
   overwrite(seed_normal_.get(), H5T_NATIVE_DOUBLE, {k, 3}, normals_.data());
   overwrite(seed_friction_.get(), H5T_NATIVE_DOUBLE, {k}, frictions_.data());
+  overwrite(integrator_state_.get(), H5T_NATIVE_DOUBLE, {s.integrator_state.size()},
+            s.integrator_state.data());
   write_attribute(group_.get(), "t", s.state.t);
   write_attribute(group_.get(), "total_steps", s.total_steps);
   write_attribute(group_.get(), "next_output", s.next_output);
@@ -82,7 +85,7 @@ void CheckpointWriter::write(const SimulatorSnapshot& s) {
 }  // namespace h5
 
 SimulatorSnapshot Checkpoint::snapshot() const {
-  return {state, seed_contacts, contact_count, total_steps, next_output};
+  return {state, seed_contacts, contact_count, total_steps, next_output, integrator_state};
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
@@ -114,6 +117,8 @@ Checkpoint read_checkpoint(const std::string& path) {
                                   Vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]),
                                   frictions[i]});
     }
+    if (h5::exists(g.get(), "integrator_state"))
+      cp.integrator_state = h5::read_doubles(g.get(), "integrator_state");
     cp.integrator = h5::read_string_attribute(g.get(), "integrator");
     cp.dt = h5::read_double_attribute(g.get(), "dt");
   } catch (const InputError&) {

@@ -14,8 +14,9 @@ struct Checkpoint {
   Real next_output = 0;  // time of the next observer frame
   std::vector<ContactSolver::SeedContact> seed_contacts;
   int contact_count = 0;
-  std::string integrator;  // of the run that wrote it
-  Real dt = 0;             // of the run that wrote it
+  std::vector<Real> integrator_state;  // empty in files written before it was stored
+  std::string integrator;              // of the run that wrote it
+  Real dt = 0;                         // of the run that wrote it
 
   SimulatorSnapshot snapshot() const;
 };

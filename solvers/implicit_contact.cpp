@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 
 namespace jelly {
@@ -258,6 +259,37 @@ void ImplicitContact::project(VecX& w) const {
     particle(w, c.particle) = free_projector(c) * particle(w, c.particle);
 }
 
+namespace {
+constexpr size_t kSavedPerContact = 5;
+}
+
+void ImplicitContact::save(std::vector<Real>& out) const {
+  for (const Contact& c : contacts_) {
+    out.push_back(c.particle);
+    out.push_back(c.terrain);
+    out.push_back(c.mode == Mode::kSlide ? 1 : 0);
+    out.push_back(c.viscosity);
+    out.push_back(c.release ? 1 : 0);
+  }
+}
+
+void ImplicitContact::restore(const Real* data, size_t size) {
+  require(size % kSavedPerContact == 0, "integrator state (contacts)", size,
+          "5 numbers per contact");
+  contacts_.clear();
+  for (size_t i = 0; i < size; i += kSavedPerContact) {
+    Contact c;
+    require(data[i] >= 0 && data[i] == std::floor(data[i]) && data[i + 1] >= 0,
+            "integrator state (contact particle)", data[i], "a particle and a terrain index");
+    c.particle = static_cast<int>(data[i]);
+    c.terrain = static_cast<int>(data[i + 1]);
+    c.mode = data[i + 2] != 0 ? Mode::kSlide : Mode::kStick;
+    c.viscosity = data[i + 3];
+    c.release = data[i + 4] != 0;
+    contacts_.push_back(c);
+  }
+}
+
 void ImplicitContact::subtract_friction(const VecX& v1, VecX& w) const {
   for (const Contact& c : contacts_) {
     if (c.mode != Mode::kSlide) continue;
@@ -286,7 +318,7 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
     const Real pn = p.dot(n);
     c.normal_impulse = pn;
     c.release = false;  // decided again by this solve
-    if (pn < 0) {  // the surface would have to pull: let go
+    if (pn < 0) {       // the surface would have to pull: let go
       // A particle that does not move towards its surface (n.v1 >= 0 prescribed) is pulled
       // without work: it is held for this step and let go at the next (no solve again).
       // Otherwise the pull would do work: solve again without it.

@@ -94,6 +94,11 @@ class ImplicitContact {
   // within the energy budget.
   void finish(const Model& model, const Terrains& terrains, State& s1);
 
+  // The contact set as numbers (what begin_step() carries over: particle, terrain, mode,
+  // viscosity, release per contact), appended to `out`; and back (InputError when malformed).
+  void save(std::vector<Real>& out) const;
+  void restore(const Real* data, size_t size);
+
   // Particles in contact at the end of the last step.
   int count() const { return static_cast<int>(contacts_.size()) + projected_; }
   const std::vector<Contact>& contacts() const { return contacts_; }

@@ -81,6 +81,30 @@ Statistics ImplicitEuler::statistics() const {
   return s;
 }
 
+std::vector<Real> ImplicitEuler::internal_state() const {
+  // [size of the warm start dv (0 if none), dv..., the contact set]
+  std::vector<Real> out;
+  out.push_back(have_dv_ ? static_cast<Real>(dv_.size()) : 0.0);
+  if (have_dv_) out.insert(out.end(), dv_.data(), dv_.data() + dv_.size());
+  contact_.save(out);
+  return out;
+}
+
+void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
+  if (data.empty()) {
+    have_dv_ = false;
+    contact_.restore(nullptr, 0);
+    return;
+  }
+  const Real n = data[0];
+  require(n >= 0 && n == std::floor(n) && n + 1 <= static_cast<Real>(data.size()),
+          "integrator state (warm start size)", n, "the size of a saved implicit_euler state");
+  const size_t size = static_cast<size_t>(n);
+  have_dv_ = size > 0;
+  dv_ = Eigen::Map<const VecX>(data.data() + 1, static_cast<Eigen::Index>(size));
+  contact_.restore(data.data() + 1 + size, data.size() - 1 - size);
+}
+
 StepResult ImplicitEuler::prepare(const Model& model, Real h) {
   const int n = model.num_dofs();
   if (!jacobian_ || jacobian_->rows() != n || jacobian_->num_springs() != model.springs.size()) {
@@ -113,14 +137,16 @@ StepResult ImplicitEuler::prepare(const Model& model, Real h) {
     f_.setZero(n);
     kw_.setZero(n);
     b_.setZero(n);
-    dv_.setZero(n);
+    if (dv_.size() != n) {  // (a restored warm start of the right size stays)
+      dv_.setZero(n);
+      have_dv_ = false;
+    }
     v1_.setZero(n);
     x1_.setZero(n);
     g_.setZero(n);
     delta_.setZero(n);
     rhs_.setZero(n);
     z_.setZero(n);
-    have_dv_ = false;
   }
   if (h != last_h_) solver_->invalidate();
   last_h_ = h;

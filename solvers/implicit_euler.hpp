@@ -36,6 +36,10 @@ class ImplicitEuler final : public Integrator {
   // solve_seconds, and for contact inside the solve contact_extra_solves,
   // contact_not_converged, contact_restitution_limited.
   Statistics statistics() const override;
+  // The CG warm start and the contact set (a lagged CHOLMOD preconditioner is not kept: it is
+  // rebuilt, so only the backends without one restart bit for bit).
+  std::vector<Real> internal_state() const override;
+  void restore_internal_state(const std::vector<Real>& data) override;
 
   const ImplicitEulerOptions& options() const { return options_; }
   // The backend chosen ("cholmod", "ldlt", "cg_jacobi", "cg_lagged_cholmod"); empty before the

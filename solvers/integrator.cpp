@@ -16,6 +16,8 @@ StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
   return result;
 }
 
+void Integrator::restore_internal_state(const std::vector<Real>& /*data*/) {}
+
 Statistics Integrator::statistics() const { return {{"steps", static_cast<double>(steps_)}}; }
 
 void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,

@@ -4,6 +4,7 @@
 #include <map>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/dynamics.hpp>
@@ -40,6 +41,13 @@ class Integrator {
   virtual bool resolves_contact() const { return false; }
   // When resolves_contact(): the particles in coulomb contact at the end of the last step.
   virtual int contacts_resolved() const { return 0; }
+  // What the next steps depend on besides the state (warm starts, contact sets), as numbers a
+  // checkpoint can store; empty for a method without such state. restore_internal_state() takes
+  // back what internal_state() gave (an empty vector: start afresh; a method without state
+  // ignores it, e.g. when a run continues with another integrator on purpose) and throws
+  // InputError for data it cannot read.
+  virtual std::vector<Real> internal_state() const { return {}; }
+  virtual void restore_internal_state(const std::vector<Real>& data);
   // Counters of this integrator (steps, and whatever the method adds).
   virtual Statistics statistics() const;
 

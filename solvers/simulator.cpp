@@ -47,7 +47,8 @@ void Simulator::set_state(State state) {
 }
 
 SimulatorSnapshot Simulator::snapshot() const {
-  return {state_, contacts_.seed_contacts(), contacts_.contact_count(), total_steps_, next_output_};
+  return {state_,       contacts_.seed_contacts(),    contacts_.contact_count(), total_steps_,
+          next_output_, integrator_->internal_state()};
 }
 
 void Simulator::restore(SimulatorSnapshot snapshot) {
@@ -62,6 +63,7 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
     require(c.particle >= 0 && c.particle < model_.num_particles(),
             "snapshot.seed_contacts.particle", c.particle, "a particle index of the model");
   }
+  integrator_->restore_internal_state(snapshot.integrator_state);
   state_ = std::move(s);
   contacts_.restore(std::move(snapshot.seed_contacts), snapshot.contact_count);
   total_steps_ = snapshot.total_steps;

@@ -42,6 +42,8 @@ struct SimulatorSnapshot {
   // Time of the next observer frame (taken inside on_frame: that frame's own time, which the
   // frame restore() emits first moves on as the original run did).
   Real next_output = 0;
+  // The integrator's internal_state() (warm starts, contact sets; empty for most methods).
+  std::vector<Real> integrator_state;
 };
 
 class Simulator {

@@ -14,7 +14,8 @@ class CheckpointWriter {
   void write(const SimulatorSnapshot& snapshot);
 
  private:
-  Handle group_, position_, velocity_, seed_particle_, seed_normal_, seed_friction_;
+  Handle group_, position_, velocity_, seed_particle_, seed_normal_, seed_friction_,
+      integrator_state_;
   std::vector<int> particles_;
   std::vector<double> normals_, frictions_;
 };
