@@ -43,6 +43,15 @@ void expect_identical(const Trajectory& a, const Trajectory& b) {
   }
 }
 
+// The frames of `whole` from index `cut` on equal those of `resumed`, bit for bit.
+void expect_tail_identical(const Trajectory& whole, size_t cut, const Trajectory& resumed) {
+  Trajectory tail;
+  tail.t.assign(whole.t.begin() + static_cast<std::ptrdiff_t>(cut), whole.t.end());
+  tail.x.assign(whole.x.begin() + static_cast<std::ptrdiff_t>(cut), whole.x.end());
+  tail.v.assign(whole.v.begin() + static_cast<std::ptrdiff_t>(cut), whole.v.end());
+  expect_identical(tail, resumed);
+}
+
 constexpr Real kEnd = 1.0;
 
 class Restart : public ::testing::TestWithParam<ContactModel> {};
@@ -88,11 +97,7 @@ TEST_P(Restart, FromFinalCheckpointIsBitForBit) {
   auto probe = collect(resumed, 0);
   sim.add_observer(probe);
   ASSERT_TRUE(sim.run_until(kEnd).ok());
-  Trajectory tail;
-  tail.t.assign(whole.t.begin() + cut, whole.t.end());
-  tail.x.assign(whole.x.begin() + cut, whole.x.end());
-  tail.v.assign(whole.v.begin() + cut, whole.v.end());
-  expect_identical(tail, resumed);
+  expect_tail_identical(whole, cut, resumed);
 }
 
 // The checkpoint written at a mid-run flush (copied when the recorder had just flushed) restarts
@@ -124,11 +129,7 @@ TEST_P(Restart, FromMidRunFlushIsBitForBit) {
   auto probe = collect(resumed, 0);
   sim.add_observer(probe);
   ASSERT_TRUE(sim.run_until(kEnd).ok());
-  Trajectory tail;
-  tail.t.assign(whole.t.begin() + 24, whole.t.end());
-  tail.x.assign(whole.x.begin() + 24, whole.x.end());
-  tail.v.assign(whole.v.begin() + 24, whole.v.end());
-  expect_identical(tail, resumed);
+  expect_tail_identical(whole, 24, resumed);
 }
 
 // implicit_euler keeps a CG warm start and its contact set (sticking or sliding, with its
@@ -160,11 +161,7 @@ TEST(Restart, ImplicitEulerWithContactIsBitForBit) {
   auto probe = collect(resumed, 0);
   sim.add_observer(probe);
   ASSERT_TRUE(sim.run_until(kEnd).ok());
-  Trajectory tail;
-  tail.t.assign(whole.t.begin() + cut, whole.t.end());
-  tail.x.assign(whole.x.begin() + cut, whole.x.end());
-  tail.v.assign(whole.v.begin() + cut, whole.v.end());
-  expect_identical(tail, resumed);
+  expect_tail_identical(whole, cut, resumed);
 }
 
 TEST(Restart, MismatchedSimulatorIsAnInputError) {
