@@ -30,8 +30,8 @@ struct BandEnds {
 // springs (shorter than kDegenerateLength l0; then the caller falls back).
 JELLY_VECTOR_CLONES
 int band_forces(int n, BandEnds e, const Real* __restrict rest, const Real* __restrict ks,
-                 const Real* __restrict kd, Real* __restrict fx, Real* __restrict fy,
-                 Real* __restrict fz) {
+                const Real* __restrict kd, Real* __restrict fx, Real* __restrict fy,
+                Real* __restrict fz) {
   const Real* __restrict xa = e.xa;
   const Real* __restrict ya = e.ya;
   const Real* __restrict za = e.za;
@@ -143,8 +143,7 @@ void SpringBands::update_coefficients(const Model& model) {
   }
 }
 
-void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& v,
-                                 VecX& f) const {
+void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f) const {
   if (!dense_ || !fits(model)) {
     ::jelly::compute_forces(model, x, v, f);
     return;
