@@ -100,8 +100,9 @@ void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
   require(n >= 0 && n == std::floor(n) && n + 1 <= static_cast<Real>(data.size()),
           "integrator state (warm start size)", n, "the size of a saved implicit_euler state");
   const size_t size = static_cast<size_t>(n);
-  have_dv_ = size > 0;
-  dv_ = Eigen::Map<const VecX>(data.data() + 1, static_cast<Eigen::Index>(size));
+  // A warm start of another size (another model) is dropped; prepare() sizes dv_ then.
+  have_dv_ = size > 0 && (!jacobian_ || static_cast<int>(size) == jacobian_->rows());
+  if (have_dv_) dv_ = Eigen::Map<const VecX>(data.data() + 1, static_cast<Eigen::Index>(size));
   contact_.restore(data.data() + 1 + size, data.size() - 1 - size);
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include <jelly/core/cube.hpp>
+#include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/core/jacobian.hpp>
 #include <jelly/core/measures.hpp>
@@ -268,6 +269,36 @@ TEST(ImplicitContact, NewtonConvergesInContact) {
   EXPECT_LE(trace.worst_growth, 1e-9 * trace.scale);
   const auto& ie = static_cast<const ImplicitEuler&>(sim.integrator());
   EXPECT_TRUE(ie.last_converged());
+}
+
+// The state a checkpoint stores round-trips; a state of another model is dropped (its warm
+// start) or filtered (contacts beyond the model), and a malformed one is an InputError.
+TEST(ImplicitContact, InternalStateRoundTripsAndIsChecked) {
+  const FallingCube c;
+  const ContactSolver contacts;
+  const Dynamics dynamics(c.model, contacts, &c.terrains);
+  ImplicitEuler first;
+  State s = c.s0;
+  ASSERT_TRUE(first.step(dynamics, s, c.h).ok);
+  const std::vector<Real> saved = first.internal_state();
+  ASSERT_EQ(saved[0], c.model.num_dofs());  // the warm start, then 5 numbers per contact
+  EXPECT_EQ(saved.size(), 1 + c.model.num_dofs() + 5 * 9u);
+  ImplicitEuler second;
+  second.restore_internal_state(saved);
+  EXPECT_EQ(second.internal_state(), saved);
+
+  const Model bigger = build_cube(testing::small_cube(4, 1.0, Vec3(0, 1e-3, 0)));
+  const Dynamics big(bigger, contacts, &c.terrains);
+  ImplicitEuler other;
+  State t = rest_state(bigger);
+  ASSERT_TRUE(other.step(big, t, c.h).ok);
+  other.restore_internal_state(saved);  // 3x3x3 warm start on a 4x4x4 cube
+  EXPECT_TRUE(other.step(big, t, c.h).ok);
+  EXPECT_TRUE(t.x.allFinite());
+
+  EXPECT_THROW(other.restore_internal_state({-1.0}), InputError);
+  EXPECT_THROW(other.restore_internal_state({2.5, 0, 0, 0}), InputError);
+  EXPECT_THROW(other.restore_internal_state({0, 1, 0, 0}), InputError);  // 3 numbers of a contact
 }
 
 // "after_step" keeps the operator split of the explicit integrators (the Simulator resolves
