@@ -12,8 +12,8 @@ namespace {
 
 using Mat3 = Eigen::Matrix3d;
 
-// A particle this far below a surface at the end of a solve is constrained; this far above it
-// at the start of a step (and not separating) it stays constrained.
+// A particle this far below a surface at the end of a solve becomes a contact; a contact whose
+// explicit prediction ends at most this far above its surface stays one.
 constexpr Real kPenetrationTolerance = 1e-9;  // m
 constexpr Real kTouchTolerance = 1e-6;        // m
 // A prescribed normal velocity above -this is "not moving towards the surface" (round-off).
@@ -56,6 +56,9 @@ void write_block(Real* values, const BlockColumn& col, int k, const Mat3& b) {
     for (int r = 0; r < 3; ++r) values[col.start + q * col.stride + 3 * k + r] = b(r, q);
 }
 
+// The part of w in the plane normal to the unit vector n.
+Vec3 tangential(const Vec3& w, const Vec3& n) { return w - w.dot(n) * n; }
+
 bool uses_coulomb(const Terrain& terrain) {
   return terrain.contact().model == ContactModel::kCoulomb;
 }
@@ -93,6 +96,11 @@ int ImplicitContact::penetrated_terrain(const Terrains& terrains, const Vec3& p,
   return best;
 }
 
+Real ImplicitContact::bounce_speed(const Contact& c, const Terrains& terrains) {
+  const ContactParams& params = terrains[c.terrain]->contact();
+  return c.approach > params.resting_speed ? params.restitution * c.approach : 0.0;
+}
+
 ImplicitContact::Contact ImplicitContact::make_contact(const Terrains& terrains, int i, int k,
                                                        const Vec3& v1, Real mass) const {
   const Terrain& terrain = *terrains[k];
@@ -109,7 +117,7 @@ ImplicitContact::Contact ImplicitContact::make_contact(const Terrains& terrains,
   const ContactParams& params = terrain.contact();
   const Vec3 w = v1 - c.surface_velocity;
   const Real dvn = std::max(c.target_normal - v1.dot(c.normal), 0.0);
-  const Vec3 wt = w - w.dot(c.normal) * c.normal;
+  const Vec3 wt = tangential(w, c.normal);
   const Real speed = wt.norm();
   if (speed > params.static_friction * dvn) {  // (mass speed > mu m dv_n: c > 0)
     c.mode = Mode::kSlide;
@@ -138,7 +146,7 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
   h_ = h;
   x0_ = s0.x;
   v0_ = s0.v;
-  mass_ = model.mass;
+  model_ = &model;
   slot_.resize(np);
   // The explicit prediction x0 + h v1, v1 = v0 + h f / m: last step's contacts (unless let go)
   // that it keeps on their surface, and the particles it carries into a terrain.
@@ -193,11 +201,10 @@ void ImplicitContact::constrain(SparseMatrix& a, const VecX& b, bool prescribe, 
     Vec3 dz;
     if (c.mode == Mode::kStick) {
       const Vec3 u = c.surface_velocity;
-      dz = u - u.dot(c.normal) * c.normal + c.target_normal * c.normal - v0;
+      dz = tangential(u, c.normal) + c.target_normal * c.normal - v0;
     } else {
       dz = (c.target_normal - v0.dot(c.normal)) * c.normal;
-      const Vec3 w0 = v0 - c.surface_velocity;
-      particle(rhs, c.particle) -= c.viscosity * (w0 - w0.dot(c.normal) * c.normal);
+      particle(rhs, c.particle) -= c.viscosity * tangential(v0 - c.surface_velocity, c.normal);
     }
     particle(z, c.particle) = dz;
     const BlockColumn col = block_column(a, c.particle);
@@ -293,8 +300,8 @@ void ImplicitContact::restore(const Real* data, size_t size) {
 void ImplicitContact::subtract_friction(const VecX& v1, VecX& w) const {
   for (const Contact& c : contacts_) {
     if (c.mode != Mode::kSlide) continue;
-    const Vec3 rel = particle(v1, c.particle) - c.surface_velocity;
-    particle(w, c.particle) += c.viscosity * (rel - rel.dot(c.normal) * c.normal);
+    particle(w, c.particle) +=
+        c.viscosity * tangential(particle(v1, c.particle) - c.surface_velocity, c.normal);
   }
 }
 
@@ -338,15 +345,14 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
         c.mode = Mode::kSlide;
         // Alone it would slide with momentum |p_t|; friction mu p_n = c |p_t| / (m + c).
         const Real force = params.friction * pn;
-        c.viscosity = force * mass_[c.particle] / (pt_norm - force);
+        c.viscosity = force * model_->mass[c.particle] / (pt_norm - force);
       }
     } else {
       const Vec3 w = particle(v0_, c.particle) + particle(dv, c.particle) - c.surface_velocity;
-      const Vec3 wt = w - w.dot(n) * n;
-      const Real speed = wt.norm();
+      const Real speed = tangential(w, n).norm();
       // The viscosity that gives friction mu p_n at this speed, for the next solve (or step):
       // a change of it alone is no reason to solve again, the friction stays dissipative.
-      const Real m = mass_[c.particle];
+      const Real m = model_->mass[c.particle];
       const Real viscosity = params.friction * pn / std::max(speed, 1e-300);
       if (viscosity >= kStickViscosity * m) {  // friction has all but stopped it: stick
         c.mode = Mode::kStick;
@@ -364,7 +370,7 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
     const Vec3 x1 = particle(x0_, i) + h_ * v1;
     const int k = penetrated_terrain(terrains, x1, kPenetrationTolerance);
     if (k >= 0) {
-      next_.push_back(make_contact(terrains, i, k, v1, mass_[i]));
+      next_.push_back(make_contact(terrains, i, k, v1, model_->mass[i]));
       changed = true;
     }
   }
@@ -413,10 +419,9 @@ void ImplicitContact::finish(const Model& model, const Terrains& terrains, State
   bool any_impact = false, one_frame = true;
   Vec3 frame = Vec3::Zero();
   for (const Contact& c : contacts_) {
-    const ContactParams& params = terrains[c.terrain]->contact();
-    if (c.approach <= params.resting_speed || params.restitution <= 0) continue;
-    const Real m = model.mass[c.particle];
-    quadratic += 0.5 * m * std::pow(params.restitution * c.approach, 2);
+    const Real bounce = bounce_speed(c, terrains);
+    if (bounce <= 0) continue;
+    quadratic += 0.5 * model.mass[c.particle] * bounce * bounce;
     if (!any_impact) frame = c.surface_velocity;
     one_frame = one_frame && (c.surface_velocity - frame).norm() <= 1e-12 * (1 + frame.norm());
     any_impact = true;
@@ -425,9 +430,7 @@ void ImplicitContact::finish(const Model& model, const Terrains& terrains, State
   if (!one_frame) frame.setZero();
   Real linear = 0;
   for (const Contact& c : contacts_) {
-    const ContactParams& params = terrains[c.terrain]->contact();
-    if (c.approach <= params.resting_speed || params.restitution <= 0) continue;
-    linear += model.mass[c.particle] * params.restitution * c.approach *
+    linear += model.mass[c.particle] * bounce_speed(c, terrains) *
               (particle(s1.v, c.particle) - frame).dot(c.normal);
   }
   const Real budget = energy_in_frame(model, x0_, v0_, frame, t1_ - h_) -
@@ -440,11 +443,8 @@ void ImplicitContact::finish(const Model& model, const Terrains& terrains, State
     ++counters_.restitution_limited;
   }
   if (s <= 0) return;
-  for (const Contact& c : contacts_) {
-    const ContactParams& params = terrains[c.terrain]->contact();
-    if (c.approach <= params.resting_speed || params.restitution <= 0) continue;
-    particle(s1.v, c.particle) += (s * params.restitution * c.approach) * c.normal;
-  }
+  for (const Contact& c : contacts_)
+    particle(s1.v, c.particle) += (s * bounce_speed(c, terrains)) * c.normal;
 }
 
 }  // namespace jelly

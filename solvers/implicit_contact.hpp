@@ -107,6 +107,9 @@ class ImplicitContact {
  private:
   // The projector onto the free directions of a contact.
   static Eigen::Matrix3d free_projector(const Contact& c);
+  // e times the approach speed for a contact that hit its surface faster than the resting
+  // speed (it bounces), else 0.
+  static Real bounce_speed(const Contact& c, const Terrains& terrains);
   // Contact of particle i (mass m) with terrain k, from x0, v0 and the velocity v1 with which
   // the particle would end the step without it.
   Contact make_contact(const Terrains& terrains, int i, int k, const Vec3& v1, Real mass) const;
@@ -115,7 +118,8 @@ class ImplicitContact {
   int penetrated_terrain(const Terrains& terrains, const Vec3& p, Real tolerance) const;
 
   Real t1_ = 0, h_ = 0;
-  VecX x0_, v0_, mass_;
+  const Model* model_ = nullptr;  // of the current step
+  VecX x0_, v0_;
   std::vector<Contact> contacts_, next_;
   std::vector<int> slot_;      // [N]: index into contacts_ or -1
   std::vector<Real> saved_;    // original values of the constrained columns
