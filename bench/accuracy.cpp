@@ -9,7 +9,7 @@
 #include <jelly/bench/stability_region.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly::bench {
 

@@ -16,11 +16,11 @@
 #include <jelly/core/cube.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/core/jacobian.hpp>
-#include <jelly/solvers/cg_solver.hpp>
-#include <jelly/solvers/cholmod_solver.hpp>
-#include <jelly/solvers/implicit_euler.hpp>
-#include <jelly/solvers/ldlt_solver.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
+#include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/ldlt_solver.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/plane.hpp>
 

@@ -14,7 +14,7 @@
 #include <jelly/bench/speed.hpp>
 #include <jelly/bench/stability.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include <jelly/solvers/dynamics.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly::bench {
 

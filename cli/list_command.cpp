@@ -2,7 +2,7 @@
 #include <string>
 
 #include <jelly/io/scene.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/contact_params.hpp>
 
 #include "commands.hpp"

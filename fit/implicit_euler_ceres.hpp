@@ -4,8 +4,8 @@
 #include <memory>
 #include <string_view>
 
-#include <jelly/solvers/integrator.hpp>
-#include <jelly/solvers/integrator_options.hpp>
+#include <jelly/solvers/integrators/integrator.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 

@@ -7,8 +7,8 @@
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/solvers/integrator_options.hpp>
-#include <jelly/terrain/contact.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 

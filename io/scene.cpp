@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly {

@@ -9,7 +9,7 @@
 
 #include <jelly/core/cube.hpp>
 #include <jelly/solvers/divergence_guard.hpp>
-#include <jelly/solvers/integrator_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/contact_params.hpp>
 #include <jelly/terrain/elevator.hpp>

@@ -7,7 +7,7 @@ packages=(
   build-essential cmake make pkg-config git
   libeigen3-dev libsuitesparse-dev libopenblas-dev libsundials-dev libhdf5-dev hdf5-tools
   libceres-dev libgtest-dev libgmock-dev googletest libbenchmark-dev nlohmann-json3-dev libcli11-dev
-  python3-h5py python3-matplotlib python3-numpy ffmpeg clang-format
+  python3-h5py python3-matplotlib python3-numpy ffmpeg clang-format ccache
 )
 
 missing=()

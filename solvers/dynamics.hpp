@@ -3,7 +3,7 @@
 // the contact forces active during the current step, and the accelerations M^-1 f.
 #include <jelly/core/model.hpp>
 #include <jelly/core/spring_bands.hpp>
-#include <jelly/terrain/contact.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 
 namespace jelly {
 

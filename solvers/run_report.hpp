@@ -3,7 +3,7 @@
 #include <string>
 #include <string_view>
 
-#include <jelly/solvers/integrator.hpp>
+#include <jelly/solvers/integrators/integrator.hpp>
 
 namespace jelly {
 

@@ -7,10 +7,10 @@
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/divergence_guard.hpp>
-#include <jelly/solvers/integrator.hpp>
+#include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/run_report.hpp>
-#include <jelly/terrain/contact.hpp>
 
 namespace jelly {
 

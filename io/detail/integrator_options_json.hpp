@@ -3,7 +3,7 @@
 #include <string>
 
 #include <jelly/io/detail/json_fields.hpp>
-#include <jelly/solvers/integrator_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly::detail {
 

@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/io/scene.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
 namespace {

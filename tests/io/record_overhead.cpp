@@ -16,7 +16,7 @@
 
 #include <jelly/core/cube.hpp>
 #include <jelly/io/h5_recorder.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace {

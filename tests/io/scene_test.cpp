@@ -11,7 +11,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly {

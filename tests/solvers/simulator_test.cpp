@@ -2,7 +2,7 @@
 
 #include <jelly/core/cube.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 
 #include "support/systems.hpp"
 

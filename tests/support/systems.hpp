@@ -8,7 +8,7 @@
 #include <jelly/core/cube.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/solvers/registry.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly::testing {

@@ -1,0 +1,131 @@
+#pragma once
+// Coulomb contact inside the implicit Euler solve (docs/implicit.md, "Contact inside the solve").
+//
+// A particle that the step would carry into a coulomb terrain becomes a velocity constraint of
+// the linear system: its normal velocity is prescribed so that it ends the step on the surface
+// (n.v1 = -d(x0, t1) / h), and, while it sticks, its tangential velocity is the surface's. The
+// system is filtered as in Baraff & Witkin 1998 (section 5.3): with S_i the projector onto the
+// free directions of particle i, the solve is (S A S + C + I - S) y = S (b - C w0 - A z),
+// dv = y + z, with z the prescribed components and C the sliding friction (below); this keeps
+// A's sparsity pattern and its definiteness, so every linear solver works unchanged. The
+// constraint impulse p_i = (A dv - b)_i then decides which particles touch, solving again while
+// that changes (at most contact_iterations solves):
+//   free -> contact  when the solve carries the particle below the surface;
+//   contact -> free  when p_n < 0 (the surface would have to pull); a particle whose
+//                    prescribed normal velocity is >= 0 (touching, not landing) is pulled
+//                    without work, so it is held for this step and let go at the next,
+//                    without another solve.
+// Friction follows each solve, for the next solve or step (a change of friction alone is no
+// reason to solve again):
+//   stick -> slide   when |p_t| > mu_s p_n (outside Coulomb's cone);
+//   slide            friction is an implicit tangential viscosity c_i, impulse -c_i (v1 - u)_t
+//                    (C = c_i P_t on the diagonal block), with c_i = mu p_n / |(v1 - u)_t| from
+//                    the last solve: it always opposes the sliding and never reverses it;
+//   slide -> stick   when c_i reaches 100 m_i (the particle has all but stopped).
+// A new contact sticks or slides as a lone particle would (|v_t| <= mu_s dv_n sticks).
+// The constraint impulses do no positive work (p_n >= 0 against a velocity that lands the
+// particle; friction against the sliding), so contact adds no energy to the backward-Euler step.
+// At the end of the step a contact's normal velocity relative to the surface is zeroed, and a
+// particle that hit the surface faster than the resting speed bounces with restitution e, as far
+// as the energy the step lost allows (in the terrain's frame); a lone particle bounces fully.
+#include <vector>
+
+#include <Eigen/SparseCore>
+
+#include <jelly/core/jacobian.hpp>
+#include <jelly/core/model.hpp>
+#include <jelly/core/state.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
+
+namespace jelly {
+
+class ImplicitContact {
+ public:
+  enum class Mode { kStick, kSlide };
+
+  struct Contact {
+    int particle = 0;
+    int terrain = 0;
+    Mode mode = Mode::kStick;
+    Vec3 normal = Vec3::UnitY();
+    Vec3 surface_velocity = Vec3::Zero();
+    Real target_normal = 0;  // n.v1 that lands the particle on the surface at t1
+    // Sliding: friction impulse -viscosity (v1 - u)_t, implicit in the solve, with
+    // viscosity = mu p_n / |(v1 - u)_t| iterated; always against the sliding.
+    Real viscosity = 0;
+    Real normal_impulse = 0;  // p_n of the last solve
+    bool release = false;     // held for this step (pulled without work), free at the next
+    Real approach = 0;        // -(v0 - u).n at the start of the step
+  };
+
+  struct Counters {
+    long extra_solves = 0;         // solves beyond the first caused by active-set changes
+    long not_converged = 0;        // steps that ended with the active set still changing
+    long restitution_limited = 0;  // steps whose bounce the energy budget reduced
+  };
+
+  // Starts a step of size h from s0 (time s0.t) with forces f(x0, v0): the active set starts
+  // from the last step's contacts still touching their terrain and the particles that the
+  // explicit prediction x0 + h (v0 + h f / m) puts below a coulomb terrain. Returns whether any
+  // terrain uses the coulomb model (else the step has nothing to do here).
+  bool begin_step(const Model& model, const Terrains& terrains, const State& s0, const VecX& f,
+                  Real h);
+  bool has_constraints() const { return !contacts_.empty(); }
+
+  // Filters a (full storage, 3x3 blocks, symmetric) in place to S A S + C + I - S after saving
+  // the columns of the constrained particles, and forms rhs and z: with `prescribe` (the
+  // linearized solves of a step) z = the prescribed velocity changes and rhs = S (b - C w0 - A z),
+  // else (Newton corrections, whose b includes the friction) z = 0 and rhs = S b. Projects
+  // `guess` (an initial iterate) onto the free directions.
+  void constrain(SparseMatrix& a, const VecX& b, bool prescribe, VecX& rhs, VecX& z, VecX& guess);
+  // Puts the saved columns back (before constraining again with another active set).
+  void unconstrain(SparseMatrix& a) const;
+  // After a solve of the filtered system a (dv = y + z; b as passed to constrain): the contacts'
+  // impulses and the next active set. Returns true when the set changes; then, if `commit`, a is
+  // unconstrained and the new set replaces the old (solve again), else nothing changes.
+  bool update(const Terrains& terrains, const VecX& b, const VecX& dv, bool commit,
+              SparseMatrix& a);
+  // S applied in place to a 3N vector (a Newton residual).
+  void project(VecX& w) const;
+  // w += c_i (v1 - u)_t: removes the sliding friction impulses at velocities v1 from w.
+  void subtract_friction(const VecX& v1, VecX& w) const;
+  // Ends the step (s1 = x0 + h v1, v1; time t1): zeroes the contacts' normal velocity relative to
+  // the surface, projects onto the surface any particle left below it, and applies restitution
+  // within the energy budget.
+  void finish(const Model& model, const Terrains& terrains, State& s1);
+
+  // The contact set as numbers (what begin_step() carries over: particle, terrain, mode,
+  // viscosity, release per contact), appended to `out`; and back (InputError when malformed).
+  void save(std::vector<Real>& out) const;
+  void restore(const Real* data, size_t size);
+
+  // Particles in contact at the end of the last step.
+  int count() const { return static_cast<int>(contacts_.size()) + projected_; }
+  const std::vector<Contact>& contacts() const { return contacts_; }
+  const Counters& counters() const { return counters_; }
+
+ private:
+  // The projector onto the free directions of a contact.
+  static Eigen::Matrix3d free_projector(const Contact& c);
+  // e times the approach speed for a contact that hit its surface faster than the resting
+  // speed (it bounces), else 0.
+  static Real bounce_speed(const Contact& c, const Terrains& terrains);
+  // Contact of particle i (mass m) with terrain k, from x0, v0 and the velocity v1 with which
+  // the particle would end the step without it.
+  Contact make_contact(const Terrains& terrains, int i, int k, const Vec3& v1, Real mass) const;
+  void index_contacts();
+  // The coulomb terrain that position p (at time t1) penetrates deepest, or -1.
+  int penetrated_terrain(const Terrains& terrains, const Vec3& p, Real tolerance) const;
+
+  Real t1_ = 0, h_ = 0;
+  const Model* model_ = nullptr;  // of the current step
+  VecX x0_, v0_;
+  std::vector<Contact> contacts_, next_;
+  std::vector<int> slot_;      // [N]: index into contacts_ or -1
+  std::vector<Real> saved_;    // original values of the constrained columns
+  std::vector<int> saved_at_;  // [contacts]: offset into saved_
+  int projected_ = 0;
+  Counters counters_;
+};
+
+}  // namespace jelly

@@ -1,0 +1,450 @@
+#include <jelly/solvers/contact/detail/implicit_contact.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
+
+namespace jelly {
+
+namespace {
+
+using Mat3 = Eigen::Matrix3d;
+
+// A particle this far below a surface at the end of a solve becomes a contact; a contact whose
+// explicit prediction ends at most this far above its surface stays one.
+constexpr Real kPenetrationTolerance = 1e-9;  // m
+constexpr Real kTouchTolerance = 1e-6;        // m
+// A prescribed normal velocity above -this is "not moving towards the surface" (round-off).
+constexpr Real kTouchSpeed = 1e-9;  // m/s
+// A sliding contact whose friction viscosity reaches this many times its mass has all but
+// stopped (its tangential speed is under 1 % of the free one): it sticks.
+constexpr Real kStickViscosity = 100;
+
+// The three columns of particle j in a full-storage matrix of dense 3x3 blocks: entry
+// (3 i + r, 3 j + q) of the block in slot k (row particle i) is values[start + q stride + 3 k + r].
+struct BlockColumn {
+  int start, stride;
+  int blocks() const { return stride / 3; }
+};
+
+BlockColumn block_column(const SparseMatrix& a, int j) {
+  const int* outer = a.outerIndexPtr();
+  return {outer[3 * j], outer[3 * j + 1] - outer[3 * j]};
+}
+
+int row_particle(const SparseMatrix& a, const BlockColumn& col, int k) {
+  return a.innerIndexPtr()[col.start + 3 * k] / 3;
+}
+
+// The slot of row particle i in column particle j (the pattern is symmetric, so it exists).
+int slot_of(const SparseMatrix& a, const BlockColumn& col, int i) {
+  const int* rows = a.innerIndexPtr() + col.start;
+  return static_cast<int>(std::lower_bound(rows, rows + col.stride, 3 * i) - rows) / 3;
+}
+
+Mat3 read_block(const Real* values, const BlockColumn& col, int k) {
+  Mat3 b;
+  for (int q = 0; q < 3; ++q)
+    for (int r = 0; r < 3; ++r) b(r, q) = values[col.start + q * col.stride + 3 * k + r];
+  return b;
+}
+
+void write_block(Real* values, const BlockColumn& col, int k, const Mat3& b) {
+  for (int q = 0; q < 3; ++q)
+    for (int r = 0; r < 3; ++r) values[col.start + q * col.stride + 3 * k + r] = b(r, q);
+}
+
+// The part of w in the plane normal to the unit vector n.
+Vec3 tangential(const Vec3& w, const Vec3& n) { return w - w.dot(n) * n; }
+
+bool uses_coulomb(const Terrain& terrain) {
+  return terrain.contact().model == ContactModel::kCoulomb;
+}
+
+// Energy in the frame moving with velocity u: elastic + gravitational at x - u t + kinetic of
+// v - u.
+Real energy_in_frame(const Model& model, const VecX& x, const VecX& v, const Vec3& u, Real t) {
+  Real e = elastic_energy(model, x) + gravitational_energy(model, x) +
+           t * model.mass.sum() * model.gravity.dot(u);
+  for (int i = 0; i < model.num_particles(); ++i)
+    e += 0.5 * model.mass[i] * (particle(v, i) - u).squaredNorm();
+  return e;
+}
+
+}  // namespace
+
+Mat3 ImplicitContact::free_projector(const Contact& c) {
+  if (c.mode == Mode::kStick) return Mat3::Zero();
+  return Mat3::Identity() - c.normal * c.normal.transpose();
+}
+
+int ImplicitContact::penetrated_terrain(const Terrains& terrains, const Vec3& p,
+                                        Real tolerance) const {
+  int best = -1;
+  Real deepest = -tolerance;
+  for (int k = 0; k < static_cast<int>(terrains.size()); ++k) {
+    const Terrain& terrain = *terrains[k];
+    if (!uses_coulomb(terrain) || !terrain.can_contact(p, t1_)) continue;
+    const Real d = terrain.signed_distance(p, t1_);
+    if (d < deepest) {
+      deepest = d;
+      best = k;
+    }
+  }
+  return best;
+}
+
+Real ImplicitContact::bounce_speed(const Contact& c, const Terrains& terrains) {
+  const ContactParams& params = terrains[c.terrain]->contact();
+  return c.approach > params.resting_speed ? params.restitution * c.approach : 0.0;
+}
+
+ImplicitContact::Contact ImplicitContact::make_contact(const Terrains& terrains, int i, int k,
+                                                       const Vec3& v1, Real mass) const {
+  const Terrain& terrain = *terrains[k];
+  const Vec3 x0 = particle(x0_, i);
+  Contact c;
+  c.particle = i;
+  c.terrain = k;
+  c.normal = terrain.normal(x0, t1_);
+  c.surface_velocity = terrain.surface_velocity(x0, t1_);
+  c.target_normal = -terrain.signed_distance(x0, t1_) / h_;
+  c.approach = -(particle(v0_, i) - c.surface_velocity).dot(c.normal);
+  // Stick or slide as a lone particle would: the normal velocity change dv_n the contact needs
+  // bounds the friction impulse (mu_s m dv_n for sticking, mu m dv_n sliding).
+  const ContactParams& params = terrain.contact();
+  const Vec3 w = v1 - c.surface_velocity;
+  const Real dvn = std::max(c.target_normal - v1.dot(c.normal), 0.0);
+  const Vec3 wt = tangential(w, c.normal);
+  const Real speed = wt.norm();
+  if (speed > params.static_friction * dvn) {  // (mass speed > mu m dv_n: c > 0)
+    c.mode = Mode::kSlide;
+    c.viscosity = params.friction * mass * dvn / (speed - params.friction * dvn);
+  }
+  return c;
+}
+
+void ImplicitContact::index_contacts() {
+  std::fill(slot_.begin(), slot_.end(), -1);
+  for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci)
+    slot_[contacts_[ci].particle] = ci;
+}
+
+bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, const State& s0,
+                                 const VecX& f, Real h) {
+  const bool any = std::any_of(terrains.begin(), terrains.end(),
+                               [](const auto& terrain) { return uses_coulomb(*terrain); });
+  projected_ = 0;
+  if (!any) {
+    contacts_.clear();
+    return false;
+  }
+  const int np = model.num_particles();
+  t1_ = s0.t + h;
+  h_ = h;
+  x0_ = s0.x;
+  v0_ = s0.v;
+  model_ = &model;
+  slot_.resize(np);
+  // The explicit prediction x0 + h v1, v1 = v0 + h f / m: last step's contacts (unless let go)
+  // that it keeps on their surface, and the particles it carries into a terrain.
+  std::fill(slot_.begin(), slot_.end(), -1);
+  for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
+    const Contact& old = contacts_[ci];
+    if (old.release || old.particle >= np || old.terrain >= static_cast<int>(terrains.size()))
+      continue;
+    slot_[old.particle] = ci;
+  }
+  next_.clear();
+  for (int i = 0; i < np; ++i) {
+    const Vec3 v1 = particle(v0_, i) + (h / model.mass[i]) * particle(f, i);
+    const Vec3 predicted = particle(x0_, i) + h * v1;
+    if (slot_[i] >= 0) {
+      const Contact& old = contacts_[slot_[i]];
+      const Terrain& terrain = *terrains[old.terrain];
+      if (uses_coulomb(terrain) && terrain.can_contact(predicted, t1_) &&
+          terrain.signed_distance(predicted, t1_) <= kTouchTolerance) {
+        Contact c = make_contact(terrains, i, old.terrain, v1, model.mass[i]);
+        c.mode = old.mode;
+        c.viscosity = old.viscosity;
+        next_.push_back(c);
+        continue;
+      }
+    }
+    const int k = penetrated_terrain(terrains, predicted, 0);
+    if (k >= 0) next_.push_back(make_contact(terrains, i, k, v1, model.mass[i]));
+  }
+  contacts_.swap(next_);
+  index_contacts();
+  return true;
+}
+
+void ImplicitContact::constrain(SparseMatrix& a, const VecX& b, bool prescribe, VecX& rhs, VecX& z,
+                                VecX& guess) {
+  Real* values = a.valuePtr();
+  saved_.clear();
+  saved_at_.clear();
+  for (const Contact& c : contacts_) {
+    const BlockColumn col = block_column(a, c.particle);
+    saved_at_.push_back(static_cast<int>(saved_.size()));
+    saved_.insert(saved_.end(), values + col.start, values + col.start + 3 * col.stride);
+  }
+  // rhs = b - C w0 - A z, with A's original columns.
+  rhs = b;
+  z.setZero();
+  for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
+    const Contact& c = contacts_[ci];
+    if (!prescribe) continue;
+    const Vec3 v0 = particle(v0_, c.particle);
+    Vec3 dz;
+    if (c.mode == Mode::kStick) {
+      const Vec3 u = c.surface_velocity;
+      dz = tangential(u, c.normal) + c.target_normal * c.normal - v0;
+    } else {
+      dz = (c.target_normal - v0.dot(c.normal)) * c.normal;
+      particle(rhs, c.particle) -= c.viscosity * tangential(v0 - c.surface_velocity, c.normal);
+    }
+    particle(z, c.particle) = dz;
+    const BlockColumn col = block_column(a, c.particle);
+    const Real* orig = saved_.data() + saved_at_[ci];
+    for (int k = 0; k < col.blocks(); ++k) {
+      const int i = row_particle(a, col, k);
+      for (int r = 0; r < 3; ++r) {
+        Real s = 0;
+        for (int q = 0; q < 3; ++q) s += orig[q * col.stride + 3 * k + r] * dz[q];
+        rhs[3 * i + r] -= s;
+      }
+    }
+  }
+  // A -> S A S + I - S, block by block (idempotent where two constrained particles meet).
+  for (const Contact& c : contacts_) {
+    const Mat3 sc = free_projector(c);
+    const BlockColumn col = block_column(a, c.particle);
+    for (int k = 0; k < col.blocks(); ++k) {
+      const int i = row_particle(a, col, k);
+      const Mat3 block = read_block(values, col, k);
+      if (i == c.particle) {  // sliding: the friction viscosity on the tangent plane (sc)
+        const Real viscosity = c.mode == Mode::kSlide ? c.viscosity : 0.0;
+        write_block(values, col, k, sc * block * sc + viscosity * sc + Mat3::Identity() - sc);
+        continue;
+      }
+      const Mat3 filtered =
+          slot_[i] >= 0 ? Mat3(free_projector(contacts_[slot_[i]]) * block * sc) : Mat3(block * sc);
+      write_block(values, col, k, filtered);
+      const BlockColumn row = block_column(a, i);
+      write_block(values, row, slot_of(a, row, c.particle), filtered.transpose());
+    }
+  }
+  for (const Contact& c : contacts_) {
+    const Mat3 sc = free_projector(c);
+    particle(rhs, c.particle) = sc * particle(rhs, c.particle);
+    particle(guess, c.particle) = sc * particle(guess, c.particle);
+  }
+}
+
+void ImplicitContact::unconstrain(SparseMatrix& a) const {
+  Real* values = a.valuePtr();
+  for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
+    const int j = contacts_[ci].particle;
+    const BlockColumn col = block_column(a, j);
+    const Real* orig = saved_.data() + saved_at_[ci];
+    std::copy(orig, orig + 3 * col.stride, values + col.start);
+    const BlockColumn saved{0, col.stride};
+    for (int k = 0; k < col.blocks(); ++k) {
+      const int i = row_particle(a, col, k);
+      if (i == j) continue;
+      const BlockColumn row = block_column(a, i);
+      write_block(values, row, slot_of(a, row, j), read_block(orig, saved, k).transpose());
+    }
+  }
+}
+
+void ImplicitContact::project(VecX& w) const {
+  for (const Contact& c : contacts_)
+    particle(w, c.particle) = free_projector(c) * particle(w, c.particle);
+}
+
+namespace {
+constexpr size_t kSavedPerContact = 5;
+}
+
+void ImplicitContact::save(std::vector<Real>& out) const {
+  for (const Contact& c : contacts_) {
+    out.push_back(c.particle);
+    out.push_back(c.terrain);
+    out.push_back(c.mode == Mode::kSlide ? 1 : 0);
+    out.push_back(c.viscosity);
+    out.push_back(c.release ? 1 : 0);
+  }
+}
+
+void ImplicitContact::restore(const Real* data, size_t size) {
+  require(size % kSavedPerContact == 0, "integrator state (contacts)", size,
+          "5 numbers per contact");
+  contacts_.clear();
+  for (size_t i = 0; i < size; i += kSavedPerContact) {
+    Contact c;
+    require(data[i] >= 0 && data[i] == std::floor(data[i]) && data[i + 1] >= 0,
+            "integrator state (contact particle)", data[i], "a particle and a terrain index");
+    c.particle = static_cast<int>(data[i]);
+    c.terrain = static_cast<int>(data[i + 1]);
+    c.mode = data[i + 2] != 0 ? Mode::kSlide : Mode::kStick;
+    c.viscosity = data[i + 3];
+    c.release = data[i + 4] != 0;
+    contacts_.push_back(c);
+  }
+}
+
+void ImplicitContact::subtract_friction(const VecX& v1, VecX& w) const {
+  for (const Contact& c : contacts_) {
+    if (c.mode != Mode::kSlide) continue;
+    particle(w, c.particle) +=
+        c.viscosity * tangential(particle(v1, c.particle) - c.surface_velocity, c.normal);
+  }
+}
+
+bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX& dv, bool commit,
+                             SparseMatrix& a) {
+  bool changed = false;
+  next_.clear();
+  for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
+    Contact c = contacts_[ci];
+    // p = (A dv - b)_c from the original column (A is symmetric).
+    const BlockColumn col = block_column(a, c.particle);
+    const Real* orig = saved_.data() + saved_at_[ci];
+    // (Sliding friction is tangential and only p_n of a sliding contact is used.)
+    Vec3 p = -particle(b, c.particle);
+    for (int k = 0; k < col.blocks(); ++k) {
+      const int i = row_particle(a, col, k);
+      for (int q = 0; q < 3; ++q)
+        for (int r = 0; r < 3; ++r) p[q] += orig[q * col.stride + 3 * k + r] * dv[3 * i + r];
+    }
+    const Vec3& n = c.normal;
+    const Real pn = p.dot(n);
+    c.normal_impulse = pn;
+    c.release = false;  // decided again by this solve
+    if (pn < 0) {       // the surface would have to pull: let go
+      // A particle that does not move towards its surface (n.v1 >= 0 prescribed) is pulled
+      // without work: it is held for this step and let go at the next (no solve again).
+      // Otherwise the pull would do work: solve again without it.
+      if (c.target_normal >= -kTouchSpeed) {
+        c.release = true;
+        next_.push_back(c);
+      } else {
+        changed = true;
+      }
+      continue;
+    }
+    const ContactParams& params = terrains[c.terrain]->contact();
+    if (c.mode == Mode::kStick) {
+      const Vec3 pt = p - pn * n;
+      const Real pt_norm = pt.norm();
+      if (pt_norm > params.static_friction * pn) {  // outside the friction cone: slide
+        c.mode = Mode::kSlide;
+        // Alone it would slide with momentum |p_t|; friction mu p_n = c |p_t| / (m + c).
+        const Real force = params.friction * pn;
+        c.viscosity = force * model_->mass[c.particle] / (pt_norm - force);
+      }
+    } else {
+      const Vec3 w = particle(v0_, c.particle) + particle(dv, c.particle) - c.surface_velocity;
+      const Real speed = tangential(w, n).norm();
+      // The viscosity that gives friction mu p_n at this speed, for the next solve (or step):
+      // a change of it alone is no reason to solve again, the friction stays dissipative.
+      const Real m = model_->mass[c.particle];
+      const Real viscosity = params.friction * pn / std::max(speed, 1e-300);
+      if (viscosity >= kStickViscosity * m) {  // friction has all but stopped it: stick
+        c.mode = Mode::kStick;
+        c.viscosity = 0;
+      } else {
+        c.viscosity = viscosity;
+      }
+    }
+    next_.push_back(c);
+  }
+  // Free particles the solve carried into a terrain.
+  for (int i = 0; i < static_cast<int>(slot_.size()); ++i) {
+    if (slot_[i] >= 0) continue;
+    const Vec3 v1 = particle(v0_, i) + particle(dv, i);
+    const Vec3 x1 = particle(x0_, i) + h_ * v1;
+    const int k = penetrated_terrain(terrains, x1, kPenetrationTolerance);
+    if (k >= 0) {
+      next_.push_back(make_contact(terrains, i, k, v1, model_->mass[i]));
+      changed = true;
+    }
+  }
+  if (!changed) {  // same particles in the same order: keep the new impulses and friction
+    contacts_.swap(next_);
+  } else if (commit) {
+    unconstrain(a);
+    contacts_.swap(next_);
+    index_contacts();
+    ++counters_.extra_solves;
+  } else {  // the solve's set stays; its kept contacts (first in next_, in order) update
+    ++counters_.not_converged;
+    size_t j = 0;
+    for (Contact& c : contacts_) {
+      if (j < next_.size() && next_[j].particle == c.particle) c = next_[j++];
+    }
+  }
+  return changed;
+}
+
+void ImplicitContact::finish(const Model& model, const Terrains& terrains, State& s1) {
+  // Particles left below a surface (the active set was still changing when the solves ran out):
+  // onto the surface, without inward velocity.
+  projected_ = 0;
+  for (int i = 0; i < model.num_particles(); ++i) {
+    if (slot_[i] >= 0) continue;
+    auto x = particle(s1.x, i);
+    const int k = penetrated_terrain(terrains, x, kPenetrationTolerance);
+    if (k < 0) continue;
+    const Terrain& terrain = *terrains[k];
+    const Vec3 n = terrain.normal(x, t1_);
+    const Vec3 u = terrain.surface_velocity(x, t1_);
+    x -= terrain.signed_distance(x, t1_) * n;
+    auto v = particle(s1.v, i);
+    const Real vn = (v - u).dot(n);
+    if (vn < 0) v -= vn * n;
+    ++projected_;
+  }
+  // Contacts end at rest on their surface in the normal direction.
+  for (const Contact& c : contacts_) {
+    auto v = particle(s1.v, c.particle);
+    v -= (v - c.surface_velocity).dot(c.normal) * c.normal;
+  }
+  // Restitution for the particles that hit their surface, within the energy the step lost.
+  Real quadratic = 0;
+  bool any_impact = false, one_frame = true;
+  Vec3 frame = Vec3::Zero();
+  for (const Contact& c : contacts_) {
+    const Real bounce = bounce_speed(c, terrains);
+    if (bounce <= 0) continue;
+    quadratic += 0.5 * model.mass[c.particle] * bounce * bounce;
+    if (!any_impact) frame = c.surface_velocity;
+    one_frame = one_frame && (c.surface_velocity - frame).norm() <= 1e-12 * (1 + frame.norm());
+    any_impact = true;
+  }
+  if (!any_impact) return;
+  if (!one_frame) frame.setZero();
+  Real linear = 0;
+  for (const Contact& c : contacts_) {
+    linear += model.mass[c.particle] * bounce_speed(c, terrains) *
+              (particle(s1.v, c.particle) - frame).dot(c.normal);
+  }
+  const Real budget = energy_in_frame(model, x0_, v0_, frame, t1_ - h_) -
+                      energy_in_frame(model, s1.x, s1.v, frame, t1_);
+  // Largest s in [0, 1] with kinetic energy gain s linear + s^2 quadratic <= budget.
+  Real s = 1;
+  if (linear + quadratic > budget) {
+    const Real disc = linear * linear + 4 * quadratic * budget;
+    s = disc > 0 ? std::clamp((-linear + std::sqrt(disc)) / (2 * quadratic), 0.0, 1.0) : 0.0;
+    ++counters_.restitution_limited;
+  }
+  if (s <= 0) return;
+  for (const Contact& c : contacts_)
+    particle(s1.v, c.particle) += (s * bounce_speed(c, terrains)) * c.normal;
+}
+
+}  // namespace jelly

@@ -1,0 +1,276 @@
+#include <jelly/solvers/integrators/implicit_euler.hpp>
+
+#include <chrono>
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/ldlt_solver.hpp>
+
+namespace jelly {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+CholmodOrdering ordering_of(const std::string& name) {
+  if (name == "amd") return CholmodOrdering::kAmd;
+  if (name == "nesdis") return CholmodOrdering::kNesdis;
+  if (name == "best") return CholmodOrdering::kBest;
+  return CholmodOrdering::kMetis;
+}
+
+// Below this many unknowns a fresh CHOLMOD factorization every step is cheap and exact; above
+// it block-Jacobi CG was the fastest backend measured at every size and stiffness of the
+// benchmark (docs/implicit.md, bench/implicit_benchmark.cpp), ahead of CG preconditioned by a
+// lagged CHOLMOD factor (whose triangular solves cost ~6 CG iterations each) and far ahead of a
+// factorization per step.
+constexpr int kAutoDirectMaxDofs = 1000;
+
+// Uniform translations are in the null space of K and D, so 1^T A = 1^T M and an exact solve
+// of A y = b changes the momentum by sum(b). An iterative solve misses by the sum of its
+// residual; this shifts y uniformly (which changes nothing else) to restore that identity.
+void restore_momentum(const VecX& mass, const VecX& b, VecX& y) {
+  const Eigen::Index np = mass.size();
+  Vec3 missing = Vec3::Zero();
+  for (Eigen::Index i = 0; i < np; ++i)
+    missing += b.segment<3>(3 * i) - mass[i] * y.segment<3>(3 * i);
+  const Vec3 shift = missing / mass.sum();
+  for (Eigen::Index i = 0; i < np; ++i) y.segment<3>(3 * i) += shift;
+}
+
+}  // namespace
+
+std::string auto_linear_solver(int dofs) {
+  return dofs <= kAutoDirectMaxDofs ? "cholmod" : "cg_jacobi";
+}
+
+ImplicitEuler::ImplicitEuler(ImplicitEulerOptions options) : options_(std::move(options)) {
+  std::string why;
+  if (!options_.is_valid(&why)) throw InputError("integrator." + why);
+  jacobian_options_.definiteness = options_.definiteness;
+  residuals_.reserve(options_.newton_iterations + 1);
+}
+
+std::string_view ImplicitEuler::linear_solver_name() const {
+  return solver_ ? solver_->name() : std::string_view();
+}
+
+Statistics ImplicitEuler::statistics() const {
+  Statistics s = Integrator::statistics();
+  const LinearSolverCounters c = solver_ ? solver_->counters() : LinearSolverCounters{};
+  s["symbolic_analyses"] = static_cast<double>(c.analyses);
+  s["numeric_factorizations"] = static_cast<double>(c.factorizations);
+  s["linear_solves"] = static_cast<double>(c.solves);
+  s["cg_iterations"] = static_cast<double>(c.cg_iterations);
+  s["newton_iterations"] = static_cast<double>(newton_iterations_);
+  s["newton_not_converged"] = static_cast<double>(newton_not_converged_);
+  s["assembly_seconds"] = assembly_seconds_;
+  s["factorization_seconds"] = factorization_seconds_;
+  s["solve_seconds"] = solve_seconds_;
+  if (resolves_contact()) {
+    const ImplicitContact::Counters& cc = contact_.counters();
+    s["contact_extra_solves"] = static_cast<double>(cc.extra_solves);
+    s["contact_not_converged"] = static_cast<double>(cc.not_converged);
+    s["contact_restitution_limited"] = static_cast<double>(cc.restitution_limited);
+  }
+  return s;
+}
+
+std::vector<Real> ImplicitEuler::internal_state() const {
+  // [size of the warm start dv (0 if none), dv..., the contact set]
+  std::vector<Real> out;
+  out.push_back(have_dv_ ? static_cast<Real>(dv_.size()) : 0.0);
+  if (have_dv_) out.insert(out.end(), dv_.data(), dv_.data() + dv_.size());
+  contact_.save(out);
+  return out;
+}
+
+void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
+  if (data.empty()) {
+    have_dv_ = false;
+    contact_.restore(nullptr, 0);
+    return;
+  }
+  const Real n = data[0];
+  require(n >= 0 && n == std::floor(n) && n + 1 <= static_cast<Real>(data.size()),
+          "integrator state (warm start size)", n, "the size of a saved implicit_euler state");
+  const size_t size = static_cast<size_t>(n);
+  // A warm start of another size (another model) is dropped; prepare() sizes dv_ then.
+  have_dv_ = size > 0 && (!jacobian_ || static_cast<int>(size) == jacobian_->rows());
+  if (have_dv_) dv_ = Eigen::Map<const VecX>(data.data() + 1, static_cast<Eigen::Index>(size));
+  contact_.restore(data.data() + 1 + size, data.size() - 1 - size);
+}
+
+StepResult ImplicitEuler::prepare(const Model& model, Real h) {
+  const int n = model.num_dofs();
+  if (!jacobian_ || jacobian_->rows() != n || jacobian_->num_springs() != model.springs.size()) {
+    const auto start = Clock::now();
+    jacobian_.emplace(model);
+    a_ = jacobian_->make_matrix();
+    std::string kind = options_.linear_solver;
+    if (kind == "auto") kind = auto_linear_solver(n);
+    CholmodOptions cholmod;
+    cholmod.ordering = ordering_of(options_.ordering);
+    if (kind == "cholmod") {
+      solver_ = std::make_unique<CholmodSolver>(cholmod);
+    } else if (kind == "ldlt") {
+      solver_ = std::make_unique<LdltSolver>();
+    } else {
+      CgOptions cg;
+      cg.preconditioner =
+          kind == "cg_lagged_cholmod" || (kind == "cg" && options_.cg_preconditioner == "cholmod")
+              ? CgPreconditioner::kLaggedCholesky
+              : CgPreconditioner::kJacobi;
+      cg.tolerance = options_.cg_tolerance;
+      cg.max_iterations = options_.cg_max_iterations;
+      cg.refactor_iterations = options_.refactor_iterations;
+      cg.cholmod = cholmod;
+      solver_ = std::make_unique<CgSolver>(cg);
+    }
+    const LinearResult r = solver_->analyze(a_);
+    factorization_seconds_ += seconds_since(start);
+    if (!r.ok()) return StepResult::failure("implicit_euler: " + r.message);
+    f_.setZero(n);
+    kw_.setZero(n);
+    b_.setZero(n);
+    if (dv_.size() != n) {  // (a restored warm start of the right size stays)
+      dv_.setZero(n);
+      have_dv_ = false;
+    }
+    v1_.setZero(n);
+    x1_.setZero(n);
+    g_.setZero(n);
+    delta_.setZero(n);
+    rhs_.setZero(n);
+    z_.setZero(n);
+  }
+  if (h != last_h_) solver_->invalidate();
+  last_h_ = h;
+  return StepResult::success();
+}
+
+StepResult ImplicitEuler::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
+                                              bool constrained, Real t) {
+  auto start = Clock::now();
+  LinearResult r = solver_->factorize(a_);
+  factorization_seconds_ += seconds_since(start);
+  if (r.ok()) {
+    start = Clock::now();
+    r = solver_->solve(b, y);
+    solve_seconds_ += seconds_since(start);
+  }
+  if (!r.ok())
+    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(t) + " (" +
+                               std::string(linear_status_name(r.status)) + "): " + r.message);
+  if (!y.allFinite())
+    return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
+  // With contact constraints momentum is not conserved (the terrain pushes).
+  if (r.iterations > 0 && !constrained) restore_momentum(model.mass, b, y);
+  return StepResult::success();
+}
+
+StepResult ImplicitEuler::linearized_solve(const Dynamics& dynamics, const State& s, Real h) {
+  const Model& model = dynamics.model();
+  const int np = model.num_particles();
+  const Real* m = model.mass.data();
+  // (M - h D - h^2 K) dv = h (f + h K v); K v comes out of the assembly.
+  const auto start = Clock::now();
+  dynamics.forces(s.x, s.v, f_);
+  if (!have_dv_) {  // first guess for CG: the explicit step h M^-1 f; later the last dv
+    for (int i = 0; i < np; ++i) dv_.segment<3>(3 * i) = (h / m[i]) * f_.segment<3>(3 * i);
+  }
+  jacobian_->assemble_system(model, s.x, s.v, jacobian_options_, h, h * h, a_, s.v, kw_);
+  b_ = h * (f_ + h * kw_);
+  assembly_seconds_ += seconds_since(start);
+  const Terrains* terrains = dynamics.terrains();
+  terrains_seen_ = terrains != nullptr;
+  contact_active_ = resolves_contact() && contact_.begin_step(model, *terrains, s, f_, h);
+  // Solve; with contacts, again while their active set changes.
+  for (int round = 1;; ++round) {
+    const bool constrained = contact_active_ && contact_.has_constraints();
+    if (constrained) contact_.constrain(a_, b_, true, rhs_, z_, dv_);
+    if (StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t);
+        !r.ok) {
+      have_dv_ = false;
+      return r;
+    }
+    if (constrained) dv_ += z_;
+    ++newton_iterations_;
+    if (!contact_active_) break;
+    const bool last = round >= options_.contact_iterations;
+    if (!contact_.update(*terrains, b_, dv_, !last, a_) || last) break;
+  }
+  have_dv_ = true;
+  return StepResult::success();
+}
+
+StepResult ImplicitEuler::newton(const Dynamics& dynamics, const State& s, Real h) {
+  // Newton on g(v1) = M (v1 - v0) - h f(x0 + h v1, v1) = 0, dg/dv1 = M - h D - h^2 K; with
+  // contacts, g is projected onto the free directions (the constraints hold already) and the
+  // sliding friction impulses are part of it.
+  const Model& model = dynamics.model();
+  const int np = model.num_particles();
+  const Real* m = model.mass.data();
+  Real scale = h * f_.norm();
+  if (!(scale > 0)) scale = 1;
+  const bool constrained = contact_active_ && contact_.has_constraints();
+  converged_ = false;
+  for (int k = 1;; ++k) {
+    x1_ = s.x + h * v1_;
+    dynamics.forces(x1_, v1_, f_);
+    for (int i = 0; i < np; ++i)
+      g_.segment<3>(3 * i) =
+          m[i] * (v1_.segment<3>(3 * i) - s.v.segment<3>(3 * i)) - h * f_.segment<3>(3 * i);
+    if (constrained) {
+      contact_.subtract_friction(v1_, g_);
+      contact_.project(g_);
+    }
+    const Real residual = g_.norm();
+    residuals_.push_back(residual);
+    if (!std::isfinite(residual))
+      return StepResult::failure("implicit_euler: Newton residual is not finite");
+    if (residual <= options_.newton_tolerance * scale) {
+      converged_ = true;
+      break;
+    }
+    if (k >= options_.newton_iterations) break;
+    g_ = -g_;
+    delta_.setZero();
+    const auto start = Clock::now();
+    jacobian_->assemble_system(model, x1_, v1_, jacobian_options_, h, h * h, a_, v1_, kw_);
+    assembly_seconds_ += seconds_since(start);
+    if (constrained) contact_.constrain(a_, g_, false, rhs_, z_, delta_);
+    if (StepResult r =
+            factorize_and_solve(model, constrained ? rhs_ : g_, delta_, constrained, s.t);
+        !r.ok)
+      return r;
+    ++newton_iterations_;
+    v1_ += delta_;
+  }
+  if (!converged_) ++newton_not_converged_;
+  dv_ = v1_ - s.v;
+  return StepResult::success();
+}
+
+StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
+  if (StepResult r = prepare(dynamics.model(), h); !r.ok) return r;
+  if (StepResult r = linearized_solve(dynamics, s, h); !r.ok) return r;
+  v1_ = s.v + dv_;
+  residuals_.clear();
+  converged_ = true;
+  if (options_.newton_iterations > 1) {
+    if (StepResult r = newton(dynamics, s, h); !r.ok) return r;
+  }
+  s.v = v1_;
+  s.x += h * s.v;
+  s.t += h;
+  if (contact_active_) contact_.finish(dynamics.model(), *dynamics.terrains(), s);
+  return StepResult::success();
+}
+
+}  // namespace jelly

@@ -1,0 +1,34 @@
+#include <jelly/solvers/integrators/integrator.hpp>
+
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
+  require(std::isfinite(h) && h > 0, "dt", h, "a finite time step > 0");
+  const Eigen::Index n = dynamics.model().num_dofs();
+  require(state.x.size() == n && state.v.size() == n, "state.size", state.x.size(),
+          "3 x the number of particles (" + std::to_string(n) + ")");
+  StepResult result = do_step(dynamics, state, h);
+  if (result.ok) ++steps_;
+  return result;
+}
+
+void Integrator::restore_internal_state(const std::vector<Real>& /*data*/) {}
+
+Statistics Integrator::statistics() const { return {{"steps", static_cast<double>(steps_)}}; }
+
+void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,
+                                const Model& model, const Terrains& terrains, const State& before,
+                                State& state, Real h) {
+  if (!integrator.resolves_contact()) {
+    contacts.resolve(model, terrains, before, state, h);
+    return;
+  }
+  contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kSeedOnly);
+  contacts.add_resolved(integrator.contacts_resolved());
+}
+
+}  // namespace jelly

@@ -1,0 +1,20 @@
+#pragma once
+// Semi-implicit (symplectic) Euler: v' = v + h a(x, v), x' = x + h v'. This is what the seed
+// report called "implicit Euler": it re-evaluated forces but never solved a system.
+#include <jelly/solvers/integrators/integrator.hpp>
+
+namespace jelly {
+
+class SymplecticEuler final : public Integrator {
+ public:
+  std::string_view name() const override { return "symplectic_euler"; }
+  int order() const override { return 1; }
+
+ protected:
+  StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;
+
+ private:
+  VecX a_;
+};
+
+}  // namespace jelly

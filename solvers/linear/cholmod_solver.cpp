@@ -1,0 +1,211 @@
+#include <jelly/solvers/linear/cholmod_solver.hpp>
+
+#include <cholmod.h>
+
+#include <string>
+
+namespace jelly {
+
+std::string_view cholmod_ordering_name(CholmodOrdering ordering) {
+  switch (ordering) {
+    case CholmodOrdering::kAmd:
+      return "amd";
+    case CholmodOrdering::kMetis:
+      return "metis";
+    case CholmodOrdering::kNesdis:
+      return "nesdis";
+    case CholmodOrdering::kBest:
+      return "best";
+  }
+  return "?";
+}
+
+namespace {
+
+void silent_error_handler(int /*status*/, const char* /*file*/, int /*line*/,
+                          const char* /*message*/) {}
+
+// CHOLMOD's status codes (cholmod_core.h) as a result with a reason.
+LinearResult from_status(int status, const std::string& what) {
+  switch (status) {
+    case CHOLMOD_OK:
+      return {};
+    case CHOLMOD_NOT_POSDEF:
+      return LinearResult::failure(LinearStatus::kNotPositiveDefinite,
+                                   "CHOLMOD: " + what + ": matrix not positive definite");
+    case CHOLMOD_DSMALL:
+      // A warning: the factorization succeeded but a diagonal entry of L is tiny.
+      return {};
+    case CHOLMOD_OUT_OF_MEMORY:
+      return LinearResult::failure(LinearStatus::kOutOfMemory,
+                                   "CHOLMOD: " + what + ": out of memory");
+    case CHOLMOD_TOO_LARGE:
+      return LinearResult::failure(LinearStatus::kOutOfMemory,
+                                   "CHOLMOD: " + what + ": problem too large (integer overflow)");
+    case CHOLMOD_INVALID:
+      return LinearResult::failure(LinearStatus::kInvalidInput,
+                                   "CHOLMOD: " + what + ": invalid input");
+    case CHOLMOD_NOT_INSTALLED:
+      return LinearResult::failure(LinearStatus::kFailure,
+                                   "CHOLMOD: " + what + ": method not installed");
+    case CHOLMOD_GPU_PROBLEM:
+      return LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: " + what + ": GPU problem");
+    default:
+      return LinearResult::failure(
+          LinearStatus::kFailure,
+          "CHOLMOD: " + what + ": unknown status " + std::to_string(status));
+  }
+}
+
+}  // namespace
+
+struct CholmodSolver::Impl {
+  cholmod_common common;
+  cholmod_factor* factor = nullptr;
+  cholmod_dense* x = nullptr;  // solve2 workspaces, reused
+  cholmod_dense* y = nullptr;
+  cholmod_dense* e = nullptr;
+  cholmod_sparse view{};  // the caller's matrix, not owned
+  bool factorized = false;
+  int rows = 0;
+  long nnz = 0;
+
+  CholmodOptions options;
+
+  explicit Impl(const CholmodOptions& o) : options(o) {
+    cholmod_start(&common);
+    common.print = 0;
+    common.error_handler = &silent_error_handler;
+    common.final_ll = 1;
+    switch (options.ordering) {
+      case CholmodOrdering::kAmd:
+        common.nmethods = 1;
+        common.method[0].ordering = CHOLMOD_AMD;
+        break;
+      case CholmodOrdering::kMetis:
+        common.nmethods = 1;
+        common.method[0].ordering = CHOLMOD_METIS;
+        break;
+      case CholmodOrdering::kNesdis:
+        common.nmethods = 1;
+        common.method[0].ordering = CHOLMOD_NESDIS;
+        break;
+      case CholmodOrdering::kBest:
+        break;
+    }
+    common.postorder = 1;
+  }
+  ~Impl() {
+    free_all();
+    cholmod_finish(&common);
+  }
+  void free_all() {
+    if (factor) cholmod_free_factor(&factor, &common);
+    if (x) cholmod_free_dense(&x, &common);
+    if (y) cholmod_free_dense(&y, &common);
+    if (e) cholmod_free_dense(&e, &common);
+    factorized = false;
+  }
+  // A view of the lower triangle of `a` (stype -1: CHOLMOD ignores the upper triangle).
+  void wrap(const SparseMatrix& a) {
+    view.nrow = static_cast<size_t>(a.rows());
+    view.ncol = static_cast<size_t>(a.cols());
+    view.nzmax = static_cast<size_t>(a.nonZeros());
+    view.p = const_cast<int*>(a.outerIndexPtr());
+    view.i = const_cast<int*>(a.innerIndexPtr());
+    view.nz = nullptr;
+    view.x = const_cast<Real*>(a.valuePtr());
+    view.z = nullptr;
+    view.stype = -1;
+    view.itype = CHOLMOD_INT;
+    view.xtype = CHOLMOD_REAL;
+    view.dtype = CHOLMOD_DOUBLE;
+    view.sorted = 1;
+    view.packed = 1;
+  }
+};
+
+CholmodSolver::CholmodSolver(CholmodOptions options) : impl_(std::make_unique<Impl>(options)) {}
+CholmodSolver::~CholmodSolver() = default;
+
+bool CholmodSolver::factorized() const { return impl_->factorized; }
+double CholmodSolver::factor_non_zeros() const { return impl_->common.lnz; }
+double CholmodSolver::factor_flops() const { return impl_->common.fl; }
+
+LinearResult CholmodSolver::analyze(const SparseMatrix& a) {
+  if (a.rows() != a.cols() || !a.isCompressed())
+    return LinearResult::failure(LinearStatus::kInvalidInput,
+                                 "CHOLMOD: analyze: the matrix must be square and compressed");
+  impl_->free_all();
+  impl_->wrap(a);
+  impl_->common.status = CHOLMOD_OK;
+  impl_->common.supernodal =
+      a.rows() >= impl_->options.supernodal_min_rows ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
+  impl_->factor = cholmod_analyze(&impl_->view, &impl_->common);
+  ++counters_.analyses;
+  if (impl_->factor == nullptr) {
+    LinearResult r = from_status(impl_->common.status, "analyze");
+    if (r.ok()) r = LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: analyze failed");
+    return r;
+  }
+  impl_->rows = static_cast<int>(a.rows());
+  impl_->nnz = static_cast<long>(a.nonZeros());
+  return {};
+}
+
+LinearResult CholmodSolver::factorize(const SparseMatrix& a) {
+  Impl& m = *impl_;
+  if (m.factor == nullptr)
+    return LinearResult::failure(LinearStatus::kInvalidInput,
+                                 "CHOLMOD: factorize called before analyze");
+  if (a.rows() != m.rows || a.nonZeros() != m.nnz || !a.isCompressed())
+    return LinearResult::failure(
+        LinearStatus::kInvalidInput,
+        "CHOLMOD: factorize: the matrix does not have the analysed pattern");
+  m.wrap(a);
+  m.factorized = false;
+  m.common.status = CHOLMOD_OK;
+  const int ok = cholmod_factorize(&m.view, m.factor, &m.common);
+  ++counters_.factorizations;
+  const int status = m.common.status;
+  if (status == CHOLMOD_NOT_POSDEF || m.factor->minor < m.factor->n) {
+    return LinearResult::failure(LinearStatus::kNotPositiveDefinite,
+                                 "CHOLMOD: matrix not positive definite (leading minor of order " +
+                                     std::to_string(m.factor->minor + 1) + " of " +
+                                     std::to_string(m.factor->n) + " is not positive)");
+  }
+  LinearResult r = from_status(status, "factorize");
+  if (r.ok() && !ok) r = LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: factorize failed");
+  m.factorized = r.ok();
+  return r;
+}
+
+LinearResult CholmodSolver::solve(const VecX& b, VecX& x) {
+  Impl& m = *impl_;
+  if (!m.factorized)
+    return LinearResult::failure(LinearStatus::kInvalidInput,
+                                 "CHOLMOD: solve without a successful factorization");
+  if (b.size() != m.rows || x.size() != m.rows)
+    return LinearResult::failure(LinearStatus::kInvalidInput, "CHOLMOD: solve: wrong vector size");
+  cholmod_dense rhs{};
+  rhs.nrow = static_cast<size_t>(m.rows);
+  rhs.ncol = 1;
+  rhs.nzmax = static_cast<size_t>(m.rows);
+  rhs.d = static_cast<size_t>(m.rows);
+  rhs.x = const_cast<Real*>(b.data());
+  rhs.z = nullptr;
+  rhs.xtype = CHOLMOD_REAL;
+  rhs.dtype = CHOLMOD_DOUBLE;
+  m.common.status = CHOLMOD_OK;
+  const int ok =
+      cholmod_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.x, nullptr, &m.y, &m.e, &m.common);
+  ++counters_.solves;
+  LinearResult r = from_status(m.common.status, "solve");
+  if (r.ok() && !ok) r = LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: solve failed");
+  if (!r.ok()) return r;
+  const Real* out = static_cast<const Real*>(m.x->x);
+  std::copy(out, out + m.rows, x.data());
+  return r;
+}
+
+}  // namespace jelly

@@ -1,0 +1,53 @@
+#pragma once
+// Sparse Cholesky (LL^T) by SuiteSparse CHOLMOD: the symbolic analysis is done once per pattern,
+// each factorize is numeric only. CHOLMOD prints nothing; every CHOLMOD status becomes a
+// LinearResult with CHOLMOD's reason (a non-positive-definite matrix is a status, not a crash).
+#include <memory>
+
+#include <jelly/solvers/linear/linear_solver.hpp>
+
+namespace jelly {
+
+enum class CholmodOrdering {
+  kAmd,     // approximate minimum degree
+  kMetis,   // METIS nested dissection of A + A^T
+  kNesdis,  // CHOLMOD's own nested dissection (METIS bisection + constrained minimum degree)
+  kBest,    // CHOLMOD's default: AMD, and METIS when AMD gives much fill
+};
+std::string_view cholmod_ordering_name(CholmodOrdering ordering);
+
+struct CholmodOptions {
+  // Measured on the seed cube (docs/implicit.md): METIS gives the least fill and the fastest
+  // factorization there.
+  CholmodOrdering ordering = CholmodOrdering::kMetis;
+  // Supernodal (BLAS-3) factorization from this many unknowns on; simplicial (no BLAS) below,
+  // where BLAS calls, and OpenBLAS waking its threads on a busy machine, cost more than they
+  // save (a 64-particle cube on a loaded 2-core machine: supernodal 45 ms per step with
+  // OpenBLAS's default threads, 1.2 ms with one thread; simplicial 0.5 ms either way).
+  // 0 = always supernodal; a huge value = always simplicial.
+  int supernodal_min_rows = 1000;
+};
+
+class CholmodSolver final : public LinearSolver {
+ public:
+  explicit CholmodSolver(CholmodOptions options = {});
+  ~CholmodSolver() override;
+  CholmodSolver(const CholmodSolver&) = delete;
+  CholmodSolver& operator=(const CholmodSolver&) = delete;
+
+  std::string_view name() const override { return "cholmod"; }
+  LinearResult analyze(const SparseMatrix& a) override;
+  LinearResult factorize(const SparseMatrix& a) override;
+  LinearResult solve(const VecX& b, VecX& x) override;
+
+  bool factorized() const;
+  // Non-zeros of the factor L (after analyze) and the flop count of the last factorization.
+  double factor_non_zeros() const;
+  double factor_flops() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace jelly
