@@ -10,7 +10,7 @@
 #include <vector>
 
 #include <jelly/core/jacobian.hpp>
-#include <jelly/solvers/contact/detail/implicit_contact.hpp>
+#include <jelly/solvers/contact/implicit_contact.hpp>
 #include <jelly/solvers/integrators/implicit_euler_options.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/linear/linear_solver.hpp>

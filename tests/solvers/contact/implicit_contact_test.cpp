@@ -10,7 +10,7 @@
 #include <jelly/core/forces.hpp>
 #include <jelly/core/jacobian.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/solvers/contact/detail/implicit_contact.hpp>
+#include <jelly/solvers/contact/implicit_contact.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/elevator.hpp>
