@@ -57,6 +57,11 @@ class SpringJacobian {
   void assemble_system(const Model& model, const VecX& x, const VecX& v,
                        const JacobianOptions& options, Real alpha, Real beta, SparseMatrix& a,
                        const VecX& w, VecX& kw) const;
+  // Adds `value` to entry (dof, dof) of a matrix with this pattern (an external force's
+  // diagonal Jacobian, core/anchor_springs.hpp).
+  void add_to_diagonal(SparseMatrix& m, int dof, Real value) const {
+    m.valuePtr()[diagonal_[dof]] += value;
+  }
 
  private:
   int num_particles_ = 0;

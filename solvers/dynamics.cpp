@@ -10,6 +10,7 @@ void Dynamics::forces(const VecX& x, const VecX& v, VecX& f) const {
     bands_->compute_forces(*model_, x, v, f);
   else
     compute_forces(*model_, x, v, f);
+  if (anchors_) add_anchor_forces(*anchors_, x, v, f);
   contacts_->add_forces(v, f);
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 // The right-hand side every integrator sees: the model's forces (gravity, springs, dampers) plus
-// the contact forces active during the current step, and the accelerations M^-1 f.
+// the contact forces active during the current step and the anchor springs (external pulls),
+// and the accelerations M^-1 f.
+#include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/spring_bands.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
@@ -10,10 +12,15 @@ namespace jelly {
 class Dynamics {
  public:
   // `terrains` (may be null) is for integrators that resolve contact inside their step;
-  // `bands` (may be null), built for `model`, evaluates the spring forces faster.
+  // `bands` (may be null), built for `model`, evaluates the spring forces faster; `anchors`
+  // (may be null) are added to the forces, and implicit integrators add their Jacobian.
   Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains = nullptr,
-           const SpringBands* bands = nullptr)
-      : model_(&model), contacts_(&contacts), terrains_(terrains), bands_(bands) {}
+           const SpringBands* bands = nullptr, const AnchorSprings* anchors = nullptr)
+      : model_(&model),
+        contacts_(&contacts),
+        terrains_(terrains),
+        bands_(bands),
+        anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr) {}
 
   // f(x, v): size 3N, no allocation.
   void forces(const VecX& x, const VecX& v, VecX& f) const;
@@ -24,6 +31,8 @@ class Dynamics {
   const ContactSolver& contacts() const { return *contacts_; }
   // The terrains of the scene, or null.
   const Terrains* terrains() const { return terrains_; }
+  // The anchor springs, or null when there are none.
+  const AnchorSprings* anchors() const { return anchors_; }
   long force_evaluations() const { return evaluations_; }
 
  private:
@@ -31,6 +40,7 @@ class Dynamics {
   const ContactSolver* contacts_;
   const Terrains* terrains_;
   const SpringBands* bands_;
+  const AnchorSprings* anchors_;
   mutable long evaluations_ = 0;
 };
 

@@ -37,6 +37,11 @@ void Simulator::add_terrain(std::unique_ptr<Terrain> terrain) {
 
 void Simulator::add_observer(Observer& observer) { observers_.push_back(&observer); }
 
+void Simulator::set_anchors(AnchorSprings anchors) {
+  validate_anchors(anchors, model_.num_particles());
+  anchors_ = std::move(anchors);
+}
+
 void Simulator::set_state(State state) {
   require(state.x.size() == model_.num_dofs() && state.v.size() == model_.num_dofs(),
           "state.x.size", state.x.size(), "3 x the number of particles");
@@ -79,7 +84,7 @@ StepResult Simulator::step() {
       bands_ = SpringBands(model_);
     bands_stale_ = false;
   }
-  const Dynamics dynamics(model_, contacts_, &terrains_, &bands_);
+  const Dynamics dynamics(model_, contacts_, &terrains_, &bands_, &anchors_);
   before_.x = state_.x;
   before_.v = state_.v;
   StepResult result = integrator_->step(dynamics, state_, options_.dt);

@@ -71,6 +71,11 @@ class Simulator {
     return model_;
   }
   const State& state() const { return state_; }
+  // Springs pulling particles to points (the viewer's mouse drag): part of the forces of every
+  // step until replaced; implicit integrators take their Jacobian into the solve. Throws
+  // InputError for an invalid anchor (validate_anchors). Not part of snapshots.
+  void set_anchors(AnchorSprings anchors);
+  const AnchorSprings& anchors() const { return anchors_; }
   // Replaces the state (a restart); forgets the active contacts.
   void set_state(State state);
   SimulatorSnapshot snapshot() const;
@@ -99,6 +104,7 @@ class Simulator {
   ContactSolver contacts_;
   State before_;  // the state at the start of the current step
   std::vector<Observer*> observers_;
+  AnchorSprings anchors_;
   long total_steps_ = 0;
   long force_evaluations_ = 0;
   long frames_ = 0;

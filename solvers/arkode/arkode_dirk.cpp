@@ -135,7 +135,7 @@ class DirkDriver final : public arkode::Driver {
     const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
     data.x = yy.head(n);
     data.v = yy.tail(n);
-    self.schur_->assemble(model, data.x, data.v);
+    self.schur_->assemble(model, data.x, data.v, data.dynamics->anchors());
     std::copy(self.column_start_.begin(), self.column_start_.end(),
               SUNSparseMatrix_IndexPointers(jac));
     std::copy(self.row_index_.begin(), self.row_index_.end(), SUNSparseMatrix_IndexValues(jac));

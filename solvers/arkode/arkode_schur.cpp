@@ -35,8 +35,10 @@ SchurSystem::SchurSystem(const Model& model)
 
 SchurSystem::~SchurSystem() = default;
 
-void SchurSystem::assemble(const Model& model, const VecX& x, const VecX& v) {
+void SchurSystem::assemble(const Model& model, const VecX& x, const VecX& v,
+                           const AnchorSprings* anchors) {
   jacobian_.assemble(model, x, v, JacobianOptions{}, k_, d_);
+  if (anchors) add_anchor_jacobians(*anchors, jacobian_, k_, d_);
 }
 
 LinearResult SchurSystem::factorize(const Model& model, Real gamma) {
@@ -111,7 +113,7 @@ int setup(SUNLinearSolver s, SUNMatrix /*unused: the matrix is embedded*/) {
     const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
     c.x = yy.head(n);
     c.v = yy.tail(n);
-    c.system->assemble(model, c.x, c.v);
+    c.system->assemble(model, c.x, c.v, c.data->dynamics->anchors());
     ++c.statistics.factorizations;
     const LinearResult r = c.system->factorize(model, gamma);
     if (!r.ok()) {

@@ -169,8 +169,9 @@ StepResult ImplicitEuler::factorize_and_solve(const Model& model, const VecX& b,
                                std::string(linear_status_name(r.status)) + "): " + r.message);
   if (!y.allFinite())
     return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
-  // With contact constraints momentum is not conserved (the terrain pushes).
-  if (r.iterations > 0 && !constrained) restore_momentum(model.mass, b, y);
+  // With contact constraints or anchors momentum is not conserved (the terrain or the anchor
+  // pushes).
+  if (r.iterations > 0 && !constrained && !anchored_) restore_momentum(model.mass, b, y);
   return StepResult::success();
 }
 
@@ -185,6 +186,8 @@ StepResult ImplicitEuler::linearized_solve(const Dynamics& dynamics, const State
     for (int i = 0; i < np; ++i) dv_.segment<3>(3 * i) = (h / m[i]) * f_.segment<3>(3 * i);
   }
   jacobian_->assemble_system(model, s.x, s.v, jacobian_options_, h, h * h, a_, s.v, kw_);
+  anchored_ = dynamics.anchors() != nullptr;
+  if (anchored_) add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, s.v, kw_);
   b_ = h * (f_ + h * kw_);
   assembly_seconds_ += seconds_since(start);
   const Terrains* terrains = dynamics.terrains();
@@ -243,6 +246,7 @@ StepResult ImplicitEuler::newton(const Dynamics& dynamics, const State& s, Real 
     delta_.setZero();
     const auto start = Clock::now();
     jacobian_->assemble_system(model, x1_, v1_, jacobian_options_, h, h * h, a_, v1_, kw_);
+    if (anchored_) add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, v1_, kw_);
     assembly_seconds_ += seconds_since(start);
     if (constrained) contact_.constrain(a_, g_, false, rhs_, z_, delta_);
     if (StepResult r =

@@ -73,6 +73,7 @@ class ImplicitEuler final : public Integrator {
   ImplicitContact contact_;
   bool contact_active_ = false;  // the current step constrains contacts
   bool terrains_seen_ = true;    // the last step's Dynamics had terrains
+  bool anchored_ = false;        // the current step's Dynamics has anchor springs
   Real last_h_ = 0;
   bool have_dv_ = false;
   std::vector<Real> residuals_;

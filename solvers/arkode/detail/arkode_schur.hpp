@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/jacobian.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/arkode/detail/arkode_support.hpp>
@@ -28,8 +29,10 @@ class SchurSystem {
 
   // Refills K and D at (x, v) with the default definiteness fix (compressed springs' geometric
   // term clamped, Choi and Ko 2002) and without the damper's non-symmetric df/dx term: a
-  // symmetric Newton matrix, not the exact Jacobian.
-  void assemble(const Model& model, const VecX& x, const VecX& v);
+  // symmetric Newton matrix, not the exact Jacobian. `anchors` (may be null): their diagonal
+  // K and D are added.
+  void assemble(const Model& model, const VecX& x, const VecX& v,
+                const AnchorSprings* anchors = nullptr);
   // Factorizes S = M - gamma D - gamma^2 K (CHOLMOD's status and reason on failure:
   // kNotPositiveDefinite, kOutOfMemory, ...).
   LinearResult factorize(const Model& model, Real gamma);

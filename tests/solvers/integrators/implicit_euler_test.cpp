@@ -397,5 +397,50 @@ TEST_P(SeedScenes, ElevatorIsStable) {
   EXPECT_GT(out.deepest, -0.05);
 }
 
+// A stiff anchor spring (the viewer's mouse drag) at dt = 1/60: its Jacobian is part of the
+// solve, so the step stays stable (an explicit treatment, h sqrt(k / m) = 5.3, would not) and
+// the dragged corner follows the target, on the floor with coulomb contact inside the solve too.
+TEST(ImplicitEuler, StiffAnchorAtOneSixtieth) {
+  for (const bool floor : {false, true}) {
+    SCOPED_TRACE(floor ? "on a coulomb floor" : "in the air");
+    const Model model = build_cube(testing::small_cube(4, 1, Vec3(0, 0.001, 0)));
+    SimulatorOptions options;
+    options.dt = 1.0 / 60;
+    Simulator sim(model, rest_state(model), make_integrator("implicit_euler"), options);
+    if (floor) {
+      ContactParams contact;
+      contact.model = ContactModel::kCoulomb;
+      sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitY(), contact));
+    }
+    const int corner = cube_index(4, 3, 3, 3);
+    const Vec3 target = Vec3(particle(sim.state().x, corner)) + Vec3(0.3, 1.0, 0.2);
+    sim.set_anchors({AnchorSpring{corner, target, 1e5, 200}});
+    const RunReport report = sim.run_until(3.0);
+    ASSERT_TRUE(report.ok()) << report.reason;
+    ASSERT_TRUE(sim.state().x.allFinite());
+    // The anchor carries the cube's weight (64 kg: about 6 mm of stretch); the cube swings
+    // about it as a pendulum.
+    EXPECT_LT((Vec3(particle(sim.state().x, corner)) - target).norm(), 0.02);
+    EXPECT_LT(sim.state().v.cwiseAbs().maxCoeff(), 1.0);
+  }
+}
+
+// The anchor's Jacobian enters the solve: a particle on an anchor of k = 1e6 N/m at h = 1/60
+// (h^2 k / m = 278) decays to the target; taken explicitly it would grow 278-fold per step.
+TEST(ImplicitEuler, AnchorJacobianInTheSolve) {
+  Model model;
+  model.mass = VecX::Constant(1, 1.0);
+  model.rest_position = VecX::Zero(3);
+  model.gravity.setZero();
+  State s;
+  s.x = Vec3(0.1, 0, 0);
+  s.v = VecX::Zero(3);
+  Simulator sim = testing::make_sim(model, s, "implicit_euler", 1.0 / 60);
+  sim.set_anchors({AnchorSpring{0, Vec3::Zero(), 1e6, 0}});
+  for (int i = 0; i < 60; ++i) ASSERT_TRUE(sim.step().ok);
+  EXPECT_LT(std::abs(sim.state().x[0]), 0.1);
+  EXPECT_LT(std::abs(sim.state().x[0]), 1e-3);
+}
+
 }  // namespace
 }  // namespace jelly

@@ -4,6 +4,7 @@
 #include <random>
 
 #include <jelly/core/cube.hpp>
+#include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
@@ -19,6 +20,29 @@ using testing::TwoParticleSpring;
 class EveryIntegrator : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Registry, EveryIntegrator, ::testing::ValuesIn(integrator_names()),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// One particle held by an anchor spring (k, c) to the origin, no gravity: a damped oscillator,
+// x(t) = x0 e^(-g t) (cos w t + g / w sin w t), g = c / 2m, w = sqrt(k / m - g^2). Every
+// integrator follows it (first-order methods to O(h)).
+TEST_P(EveryIntegrator, AnchorSpringIsADampedOscillator) {
+  const Real m = 2, k = 200, c = 4, x0 = 0.1;
+  Model model;
+  model.mass = VecX::Constant(1, m);
+  model.rest_position = VecX::Zero(3);
+  model.gravity.setZero();
+  State s;
+  s.x = Vec3(x0, 0, 0);
+  s.v = VecX::Zero(3);
+  Simulator sim = make_sim(model, s, GetParam(), 1e-3);
+  sim.set_anchors({AnchorSpring{0, Vec3::Zero(), k, c}});
+  ASSERT_TRUE(sim.run_until(1.0).ok());
+  const Real g = c / (2 * m), w = std::sqrt(k / m - g * g), t = sim.state().t;
+  const Real exact = x0 * std::exp(-g * t) * (std::cos(w * t) + g / w * std::sin(w * t));
+  EXPECT_NEAR(sim.state().x[0], exact, sim.integrator().order() >= 2 ? 1e-5 : 2e-3);
+  EXPECT_EQ(sim.state().x[1], 0.0);
+  EXPECT_THROW(sim.set_anchors({AnchorSpring{1, Vec3::Zero(), k, c}}), InputError);
+  EXPECT_THROW(sim.set_anchors({AnchorSpring{0, Vec3::Zero(), -1, c}}), InputError);
+}
 
 // Free fall of the whole cube at rest: springs stay at rest length, so x(t) = x0 + v0 t + g t^2/2.
 // Methods of order >= 2 are exact; both first-order Euler variants are off by exactly g t h / 2.
