@@ -2,6 +2,7 @@
 // integrator on the seed slope (contact included).
 #include <benchmark/benchmark.h>
 
+#include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/jelly.hpp>
 
 namespace {

@@ -14,8 +14,8 @@
 #include <tuple>
 
 #include <jelly/core/cube.hpp>
+#include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/forces.hpp>
-#include <jelly/core/jacobian.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>

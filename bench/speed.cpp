@@ -6,6 +6,7 @@
 #include <jelly/bench/memory.hpp>
 #include <jelly/bench/scenes.hpp>
 #include <jelly/bench/stability_region.hpp>
+#include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/integrators/registry.hpp>

@@ -1,7 +1,6 @@
 #pragma once
-// The seam between the jelly program and the HDF5 output of io/ (recorder, checkpoints,
-// recording summaries). A build without io/h5_recorder.hpp still runs scenes; asking it for a
-// file is an InputError "... not available in this build".
+// The jelly program's use of the HDF5 files of io/ (recorder, checkpoints, recording summaries),
+// with their errors turned into InputErrors that name the argument.
 #include <memory>
 #include <string>
 
@@ -10,8 +9,6 @@
 
 namespace jelly::cli {
 
-// Whether this build can write HDF5 files (-o), read them (info) and restart from them.
-bool hdf5_output_available();
 // An observer that records `sim` to `path` (and an XDMF sidecar); the effective scene is stored
 // in the file. Throws InputError when the file cannot be created.
 std::unique_ptr<Observer> make_recorder(const std::string& path, const Simulator& sim,

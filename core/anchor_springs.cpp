@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <jelly/core/detail/anchor_jacobian.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly {

@@ -1,4 +1,4 @@
-#include <jelly/core/spring_bands.hpp>
+#include <jelly/core/detail/spring_bands.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 // One copy of the band loops per instruction set, chosen when the library is loaded (GCC's
 // function multi-versioning): AVX2 where the CPU has it, the x86-64 baseline (SSE2) elsewhere.
-// AVX-512 measured no faster than AVX2 here.
+// AVX-512 is not among them: docs/benchmarks.md ("The force loop").
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
 #define JELLY_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
 #else
@@ -117,7 +117,7 @@ SpringBands::SpringBands(const Model& model)
     bands_.clear();
     return;
   }
-  update_coefficients(model);
+  copy_coefficients(model);
   scratch_.assign(9 * static_cast<size_t>(particles_), 0.0);
   band_force_.assign(3 * max_slots, 0.0);
 }
@@ -126,7 +126,7 @@ bool SpringBands::fits(const Model& model) const {
   return model.num_particles() == particles_ && model.springs.size() == springs_;
 }
 
-void SpringBands::update_coefficients(const Model& model) {
+void SpringBands::copy_coefficients(const Model& model) {
   const Springs& s = model.springs;
   for (Band& band : bands_) {
     const size_t slots = band.spring.size();

@@ -37,7 +37,7 @@ std::string xdmf_path_for(const std::string& h5_path) {
 
 namespace {
 
-// The observables of DESIGN.md, computed from a frame's positions and velocities.
+// The observables of docs/output.md, computed from a frame's positions and velocities.
 struct ObservableSpec {
   const char* name;
   int width;  // 1 (scalar) or 3 (vector)

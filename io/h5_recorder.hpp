@@ -1,7 +1,7 @@
 #pragma once
-// An observer that records a run to an HDF5 file in the H5MD-style layout of DESIGN.md (masses,
-// springs, positions, velocities, observables, terrain motion, run report, a restart checkpoint)
-// and writes an XDMF sidecar that ParaView opens as a time series.
+// An observer that records a run to an HDF5 file in the H5MD-style layout of docs/output.md
+// (masses, springs, positions, velocities, observables, terrain motion, run report, a restart
+// checkpoint) and writes an XDMF sidecar that ParaView opens as a time series.
 #include <memory>
 #include <string>
 

@@ -1,5 +1,6 @@
 #include <jelly/solvers/dynamics.hpp>
 
+#include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/forces.hpp>
 
 namespace jelly {

@@ -4,10 +4,11 @@
 // and the accelerations M^-1 f.
 #include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/core/spring_bands.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
 
 namespace jelly {
+
+class SpringBands;  // core/detail/spring_bands.hpp: the Simulator's vectorised force loop
 
 class Dynamics {
  public:

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 
+#include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly {
@@ -22,13 +23,17 @@ Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integ
       options_(options) {
   model_.validate();
   options_.validate();
-  bands_ = SpringBands(model_);
+  bands_ = std::make_unique<const SpringBands>(model_);
   require(integrator_ != nullptr, "integrator", "null", "an integrator");
   require(state_.x.size() == model_.num_dofs() && state_.v.size() == model_.num_dofs(),
           "state.x.size", state_.x.size(), "3 x the number of particles");
   require(std::isfinite(state_.t), "state.t", state_.t, "a finite time");
   next_output_ = state_.t;
 }
+
+Simulator::~Simulator() = default;
+Simulator::Simulator(Simulator&&) noexcept = default;
+Simulator& Simulator::operator=(Simulator&&) noexcept = default;
 
 void Simulator::add_terrain(std::unique_ptr<Terrain> terrain) {
   require(terrain != nullptr, "terrain", "null", "a terrain");
@@ -77,14 +82,7 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
 }
 
 StepResult Simulator::step() {
-  if (bands_stale_) {
-    if (bands_.fits(model_))
-      bands_.update_coefficients(model_);
-    else
-      bands_ = SpringBands(model_);
-    bands_stale_ = false;
-  }
-  const Dynamics dynamics(model_, contacts_, &terrains_, &bands_, &anchors_);
+  const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_);
   before_.x = state_.x;
   before_.v = state_.v;
   StepResult result = integrator_->step(dynamics, state_, options_.dt);

@@ -15,6 +15,7 @@
 namespace jelly {
 
 class Simulator;
+class SpringBands;
 
 // Called with the simulator at the first output time and then every output interval.
 class Observer {
@@ -51,6 +52,9 @@ class Simulator {
   // Throws InputError for an invalid model, state size or option.
   Simulator(Model model, State state, std::unique_ptr<Integrator> integrator,
             SimulatorOptions options = {});
+  ~Simulator();
+  Simulator(Simulator&&) noexcept;
+  Simulator& operator=(Simulator&&) noexcept;
 
   void add_terrain(std::unique_ptr<Terrain> terrain);
   // The observer must outlive the runs it observes.
@@ -64,12 +68,6 @@ class Simulator {
   RunReport run_until(Real t_end);
 
   const Model& model() const { return model_; }
-  // For changing coefficients between runs (fitting); the sparsity of springs must not change.
-  // The spring bands of the force loop are refreshed from it at the next step.
-  Model& mutable_model() {
-    bands_stale_ = true;
-    return model_;
-  }
   const State& state() const { return state_; }
   // Springs pulling particles to points (the viewer's mouse drag): part of the forces of every
   // step until replaced; implicit integrators take their Jacobian into the solve. Throws
@@ -95,8 +93,7 @@ class Simulator {
   void emit_frame();
 
   Model model_;
-  SpringBands bands_;  // the vectorised force loop's grouping of model_'s springs
-  bool bands_stale_ = false;
+  std::unique_ptr<const SpringBands> bands_;  // the vectorised force loop over model_'s springs
   State state_;
   std::unique_ptr<Integrator> integrator_;
   SimulatorOptions options_;

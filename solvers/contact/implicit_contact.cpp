@@ -1,4 +1,4 @@
-#include <jelly/solvers/contact/implicit_contact.hpp>
+#include <jelly/solvers/contact/detail/implicit_contact.hpp>
 
 #include <algorithm>
 #include <cmath>

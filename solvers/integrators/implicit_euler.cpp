@@ -2,8 +2,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 
+#include <jelly/core/detail/anchor_jacobian.hpp>
+#include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>
 #include <jelly/solvers/linear/ldlt_solver.hpp>
@@ -25,10 +29,8 @@ CholmodOrdering ordering_of(const std::string& name) {
 }
 
 // Below this many unknowns a fresh CHOLMOD factorization every step is cheap and exact; above
-// it block-Jacobi CG was the fastest backend measured at every size and stiffness of the
-// benchmark (docs/implicit.md, bench/implicit_benchmark.cpp), ahead of CG preconditioned by a
-// lagged CHOLMOD factor (whose triangular solves cost ~6 CG iterations each) and far ahead of a
-// factorization per step.
+// it block-Jacobi CG was the fastest backend at every size and stiffness of the benchmark
+// (docs/implicit.md, "Measured speed"; bench/implicit_benchmark.cpp).
 constexpr int kAutoDirectMaxDofs = 1000;
 
 // Uniform translations are in the null space of K and D, so 1^T A = 1^T M and an exact solve
@@ -49,19 +51,78 @@ std::string auto_linear_solver(int dofs) {
   return dofs <= kAutoDirectMaxDofs ? "cholmod" : "cg_jacobi";
 }
 
-ImplicitEuler::ImplicitEuler(ImplicitEulerOptions options) : options_(std::move(options)) {
+struct ImplicitEuler::Impl {
+  explicit Impl(ImplicitEulerOptions o) : options_(std::move(o)) {}
+
+  bool resolves_contact() const { return options_.contact == "implicit" && terrains_seen_; }
+  void add_statistics(Statistics& s) const;
+  StepResult step(const Dynamics& dynamics, State& state, Real h);
+  StepResult prepare(const Model& model, Real h);
+  // Factorizes A (filtered by the contact constraints, if any) and solves for dv_: the
+  // linearized step, repeated while the contacts' active set changes.
+  StepResult linearized_solve(const Dynamics& dynamics, const State& s, Real h);
+  // Factorizes a_ and solves a_ y = b (constrained: a_ is filtered by contacts).
+  StepResult factorize_and_solve(const Model& model, const VecX& b, VecX& y, bool constrained,
+                                 Real t);
+  // Newton corrections on the nonlinear backward-Euler equations from v1_.
+  StepResult newton(const Dynamics& dynamics, const State& s, Real h);
+
+  ImplicitEulerOptions options_;
+  JacobianOptions jacobian_options_;
+  std::optional<SpringJacobian> jacobian_;
+  std::unique_ptr<LinearSolver> solver_;
+  SparseMatrix a_;
+  VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_;
+  ImplicitContact contact_;
+  bool contact_active_ = false;  // the current step constrains contacts
+  bool terrains_seen_ = true;    // the last step's Dynamics had terrains
+  bool anchored_ = false;        // the current step's Dynamics has anchor springs
+  Real last_h_ = 0;
+  bool have_dv_ = false;
+  std::vector<Real> residuals_;
+  bool converged_ = true;
+  long newton_iterations_ = 0;
+  long newton_not_converged_ = 0;
+  double assembly_seconds_ = 0, factorization_seconds_ = 0, solve_seconds_ = 0;
+};
+
+ImplicitEuler::ImplicitEuler(ImplicitEulerOptions options)
+    : impl_(std::make_unique<Impl>(std::move(options))) {
   std::string why;
-  if (!options_.is_valid(&why)) throw InputError("integrator." + why);
-  jacobian_options_.definiteness = options_.definiteness;
-  residuals_.reserve(options_.newton_iterations + 1);
+  if (!impl_->options_.is_valid(&why)) throw InputError("integrator." + why);
+  impl_->jacobian_options_.definiteness = impl_->options_.definiteness;
+  impl_->residuals_.reserve(impl_->options_.newton_iterations + 1);
 }
 
+ImplicitEuler::~ImplicitEuler() = default;
+
+bool ImplicitEuler::resolves_contact() const { return impl_->resolves_contact(); }
+
+int ImplicitEuler::contacts_resolved() const {
+  return impl_->contact_active_ ? impl_->contact_.count() : 0;
+}
+
+const ImplicitEulerOptions& ImplicitEuler::options() const { return impl_->options_; }
+
+const std::vector<Real>& ImplicitEuler::last_residuals() const { return impl_->residuals_; }
+
+bool ImplicitEuler::last_converged() const { return impl_->converged_; }
+
 std::string_view ImplicitEuler::linear_solver_name() const {
-  return solver_ ? solver_->name() : std::string_view();
+  return impl_->solver_ ? impl_->solver_->name() : std::string_view();
 }
 
 Statistics ImplicitEuler::statistics() const {
   Statistics s = Integrator::statistics();
+  impl_->add_statistics(s);
+  return s;
+}
+
+StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
+  return impl_->step(dynamics, s, h);
+}
+
+void ImplicitEuler::Impl::add_statistics(Statistics& s) const {
   const LinearSolverCounters c = solver_ ? solver_->counters() : LinearSolverCounters{};
   s["symbolic_analyses"] = static_cast<double>(c.analyses);
   s["numeric_factorizations"] = static_cast<double>(c.factorizations);
@@ -78,22 +139,23 @@ Statistics ImplicitEuler::statistics() const {
     s["contact_not_converged"] = static_cast<double>(cc.not_converged);
     s["contact_restitution_limited"] = static_cast<double>(cc.restitution_limited);
   }
-  return s;
 }
 
 std::vector<Real> ImplicitEuler::internal_state() const {
   // [size of the warm start dv (0 if none), dv..., the contact set]
+  const Impl& m = *impl_;
   std::vector<Real> out;
-  out.push_back(have_dv_ ? static_cast<Real>(dv_.size()) : 0.0);
-  if (have_dv_) out.insert(out.end(), dv_.data(), dv_.data() + dv_.size());
-  contact_.save(out);
+  out.push_back(m.have_dv_ ? static_cast<Real>(m.dv_.size()) : 0.0);
+  if (m.have_dv_) out.insert(out.end(), m.dv_.data(), m.dv_.data() + m.dv_.size());
+  m.contact_.save(out);
   return out;
 }
 
 void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
+  Impl& m = *impl_;
   if (data.empty()) {
-    have_dv_ = false;
-    contact_.restore(nullptr, 0);
+    m.have_dv_ = false;
+    m.contact_.restore(nullptr, 0);
     return;
   }
   const Real n = data[0];
@@ -101,12 +163,12 @@ void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
           "integrator state (warm start size)", n, "the size of a saved implicit_euler state");
   const size_t size = static_cast<size_t>(n);
   // A warm start of another size (another model) is dropped; prepare() sizes dv_ then.
-  have_dv_ = size > 0 && (!jacobian_ || static_cast<int>(size) == jacobian_->rows());
-  if (have_dv_) dv_ = Eigen::Map<const VecX>(data.data() + 1, static_cast<Eigen::Index>(size));
-  contact_.restore(data.data() + 1 + size, data.size() - 1 - size);
+  m.have_dv_ = size > 0 && (!m.jacobian_ || static_cast<int>(size) == m.jacobian_->rows());
+  if (m.have_dv_) m.dv_ = Eigen::Map<const VecX>(data.data() + 1, static_cast<Eigen::Index>(size));
+  m.contact_.restore(data.data() + 1 + size, data.size() - 1 - size);
 }
 
-StepResult ImplicitEuler::prepare(const Model& model, Real h) {
+StepResult ImplicitEuler::Impl::prepare(const Model& model, Real h) {
   const int n = model.num_dofs();
   if (!jacobian_ || jacobian_->rows() != n || jacobian_->num_springs() != model.springs.size()) {
     const auto start = Clock::now();
@@ -122,10 +184,9 @@ StepResult ImplicitEuler::prepare(const Model& model, Real h) {
       solver_ = std::make_unique<LdltSolver>();
     } else {
       CgOptions cg;
-      cg.preconditioner =
-          kind == "cg_lagged_cholmod" || (kind == "cg" && options_.cg_preconditioner == "cholmod")
-              ? CgPreconditioner::kLaggedCholesky
-              : CgPreconditioner::kJacobi;
+      cg.preconditioner = kind == "cg" && options_.cg_preconditioner == "cholmod"
+                              ? CgPreconditioner::kLaggedCholesky
+                              : CgPreconditioner::kJacobi;
       cg.tolerance = options_.cg_tolerance;
       cg.max_iterations = options_.cg_max_iterations;
       cg.refactor_iterations = options_.refactor_iterations;
@@ -154,8 +215,8 @@ StepResult ImplicitEuler::prepare(const Model& model, Real h) {
   return StepResult::success();
 }
 
-StepResult ImplicitEuler::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
-                                              bool constrained, Real t) {
+StepResult ImplicitEuler::Impl::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
+                                                    bool constrained, Real t) {
   auto start = Clock::now();
   LinearResult r = solver_->factorize(a_);
   factorization_seconds_ += seconds_since(start);
@@ -175,7 +236,7 @@ StepResult ImplicitEuler::factorize_and_solve(const Model& model, const VecX& b,
   return StepResult::success();
 }
 
-StepResult ImplicitEuler::linearized_solve(const Dynamics& dynamics, const State& s, Real h) {
+StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const State& s, Real h) {
   const Model& model = dynamics.model();
   const int np = model.num_particles();
   const Real* m = model.mass.data();
@@ -212,7 +273,7 @@ StepResult ImplicitEuler::linearized_solve(const Dynamics& dynamics, const State
   return StepResult::success();
 }
 
-StepResult ImplicitEuler::newton(const Dynamics& dynamics, const State& s, Real h) {
+StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s, Real h) {
   // Newton on g(v1) = M (v1 - v0) - h f(x0 + h v1, v1) = 0, dg/dv1 = M - h D - h^2 K; with
   // contacts, g is projected onto the free directions (the constraints hold already) and the
   // sliding friction impulses are part of it.
@@ -261,7 +322,7 @@ StepResult ImplicitEuler::newton(const Dynamics& dynamics, const State& s, Real 
   return StepResult::success();
 }
 
-StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
+StepResult ImplicitEuler::Impl::step(const Dynamics& dynamics, State& s, Real h) {
   if (StepResult r = prepare(dynamics.model(), h); !r.ok) return r;
   if (StepResult r = linearized_solve(dynamics, s, h); !r.ok) return r;
   v1_ = s.v + dv_;

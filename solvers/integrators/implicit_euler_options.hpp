@@ -3,7 +3,7 @@
 // the offending field.
 #include <string>
 
-#include <jelly/core/jacobian.hpp>
+#include <jelly/core/definiteness.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {
@@ -28,8 +28,9 @@ struct ImplicitEulerOptions {
   // Fill-reducing ordering of CHOLMOD: "metis", "amd", "nesdis" or "best" (CHOLMOD's default).
   std::string ordering = "metis";
   // How coulomb terrains enter the step: "implicit" (constraints inside the linear solve, with
-  // friction and restitution; solvers/implicit_contact.hpp) or "after_step" (the resolve after
-  // the step that the explicit integrators use; it crushes the springs at large steps).
+  // friction and restitution; solvers/contact/detail/implicit_contact.hpp) or "after_step" (the
+  // resolve after the step that the explicit integrators use; it crushes the springs at large
+  // steps).
   std::string contact = "implicit";
   // "implicit": at most this many linear solves per step while the active set changes.
   int contact_iterations = 10;

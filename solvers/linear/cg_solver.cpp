@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/LU>
 
@@ -37,12 +38,63 @@ bool has_block3_pattern(const SparseMatrix& a) {
 
 }  // namespace
 
-CgSolver::CgSolver(CgOptions options) : options_(options) {
-  if (options_.preconditioner == CgPreconditioner::kLaggedCholesky)
-    factor_ = std::make_unique<CholmodSolver>(options_.cholmod);
+struct CgSolver::Impl {
+  explicit Impl(const CgOptions& o) : options_(o) {}
+
+  LinearResult analyze(const SparseMatrix& a, LinearSolverCounters& counters);
+  LinearResult factorize(const SparseMatrix& a, LinearSolverCounters& counters);
+  LinearResult solve(const VecX& b, VecX& x, LinearSolverCounters& counters);
+  LinearResult run(const VecX& b, VecX& x, int max_iterations, LinearSolverCounters& counters);
+  void precondition(const VecX& r, VecX& z);
+  void multiply(const VecX& x, VecX& y) const;  // y = A x
+
+  bool block3_ = false;  // columns 3j, 3j + 1, 3j + 2 share one row pattern (3x3 blocks)
+  std::vector<int> diagonal_block_;     // [N]: value index of diagonal block (0, 0), when block3_
+  std::vector<double> inverse_blocks_;  // [9 N]: inverses of the 3x3 diagonal blocks
+  // Upper block triangle of A (block3_): for column block j, blocks (i, j) with i <= j, each
+  // 9 values row-major; half the memory traffic of the full matrix per mat-vec.
+  std::vector<int> upper_start_;    // [N + 1] first block of column block j
+  std::vector<int> upper_row_;      // [blocks] row block i
+  std::vector<int> upper_source_;   // [blocks] value index of entry (0, 0) of the block in A
+  std::vector<Real> upper_values_;  // [9 blocks]
+  double factor_seconds_ = 0;       // CPU time of the last refresh of the lagged factor
+  double lagged_seconds_ = 0;       // ... plus the CPU time of the solves since
+  long lagged_solves_ = 0;          // solves since the last refresh
+
+  CgOptions options_;
+  const SparseMatrix* a_ = nullptr;
+  VecX inverse_diagonal_, r_, z_, p_, q_;
+  std::unique_ptr<CholmodSolver> factor_;
+  bool stale_ = true;   // the next factorize must refactor
+  bool fresh_ = false;  // the factor is of the current matrix
+  long preconditioner_factorizations_ = 0;
+};
+
+CgSolver::CgSolver(CgOptions options) : impl_(std::make_unique<Impl>(options)) {
+  if (options.preconditioner == CgPreconditioner::kLaggedCholesky)
+    impl_->factor_ = std::make_unique<CholmodSolver>(options.cholmod);
 }
 
-LinearResult CgSolver::analyze(const SparseMatrix& a) {
+CgSolver::~CgSolver() = default;
+
+std::string_view CgSolver::name() const {
+  return impl_->options_.preconditioner == CgPreconditioner::kJacobi ? "cg_jacobi"
+                                                                     : "cg_lagged_cholmod";
+}
+
+LinearResult CgSolver::analyze(const SparseMatrix& a) { return impl_->analyze(a, counters_); }
+
+LinearResult CgSolver::factorize(const SparseMatrix& a) { return impl_->factorize(a, counters_); }
+
+LinearResult CgSolver::solve(const VecX& b, VecX& x) { return impl_->solve(b, x, counters_); }
+
+void CgSolver::invalidate() { impl_->stale_ = true; }
+
+long CgSolver::preconditioner_factorizations() const {
+  return impl_->preconditioner_factorizations_;
+}
+
+LinearResult CgSolver::Impl::analyze(const SparseMatrix& a, LinearSolverCounters& counters) {
   if (a.rows() != a.cols() || !a.isCompressed())
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CG: the matrix must be square and compressed");
@@ -87,7 +139,7 @@ LinearResult CgSolver::analyze(const SparseMatrix& a) {
     }
     upper_values_.assign(9 * upper_row_.size(), 0.0);
   }
-  ++counters_.analyses;
+  ++counters.analyses;
   if (factor_) {
     LinearResult r = factor_->analyze(a);
     if (!r.ok()) return r;
@@ -95,7 +147,7 @@ LinearResult CgSolver::analyze(const SparseMatrix& a) {
   return {};
 }
 
-LinearResult CgSolver::factorize(const SparseMatrix& a) {
+LinearResult CgSolver::Impl::factorize(const SparseMatrix& a, LinearSolverCounters& counters) {
   if (a.rows() != r_.size())
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CG: factorize: the matrix does not have the analysed size");
@@ -153,7 +205,7 @@ LinearResult CgSolver::factorize(const SparseMatrix& a) {
   if (stale_ || !factor_->factorized()) {
     const double start = thread_seconds();
     LinearResult r = factor_->factorize(a);
-    ++counters_.factorizations;
+    ++counters.factorizations;
     ++preconditioner_factorizations_;
     if (!r.ok()) {
       a_ = nullptr;
@@ -168,7 +220,7 @@ LinearResult CgSolver::factorize(const SparseMatrix& a) {
   return {};
 }
 
-void CgSolver::multiply(const VecX& x, VecX& y) const {
+void CgSolver::Impl::multiply(const VecX& x, VecX& y) const {
   if (!block3_) {
     y.noalias() = *a_ * x;
     return;
@@ -206,7 +258,7 @@ void CgSolver::multiply(const VecX& x, VecX& y) const {
   }
 }
 
-void CgSolver::precondition(const VecX& r, VecX& z) {
+void CgSolver::Impl::precondition(const VecX& r, VecX& z) {
   if (factor_) {
     factor_->solve(r, z);
   } else if (block3_) {
@@ -225,7 +277,8 @@ void CgSolver::precondition(const VecX& r, VecX& z) {
   }
 }
 
-LinearResult CgSolver::run(const VecX& b, VecX& x, int max_iterations) {
+LinearResult CgSolver::Impl::run(const VecX& b, VecX& x, int max_iterations,
+                                 LinearSolverCounters& counters) {
   const Real b_norm = b.norm();
   LinearResult result;
   if (b_norm == 0) {
@@ -264,7 +317,7 @@ LinearResult CgSolver::run(const VecX& b, VecX& x, int max_iterations) {
       p_ = z_ + beta * p_;
     }
   }
-  counters_.cg_iterations += k;
+  counters.cg_iterations += k;
   result.iterations = k;
   result.residual = r_norm / b_norm;
   if (result.ok() && !(r_norm <= target)) {
@@ -278,26 +331,26 @@ LinearResult CgSolver::run(const VecX& b, VecX& x, int max_iterations) {
   return result;
 }
 
-LinearResult CgSolver::solve(const VecX& b, VecX& x) {
+LinearResult CgSolver::Impl::solve(const VecX& b, VecX& x, LinearSolverCounters& counters) {
   if (a_ == nullptr)
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CG: solve without a successful factorize");
   if (b.size() != r_.size() || x.size() != r_.size())
     return LinearResult::failure(LinearStatus::kInvalidInput, "CG: solve: wrong vector size");
-  ++counters_.solves;
+  ++counters.solves;
   const double start = factor_ ? thread_seconds() : 0;
   // With a lagged factor, give up early: a fresh factorization is cheaper than many iterations.
   const int first_limit = factor_ && !fresh_
                               ? std::min(options_.max_iterations, options_.lagged_iteration_limit)
                               : options_.max_iterations;
-  LinearResult result = run(b, x, first_limit);
+  LinearResult result = run(b, x, first_limit, counters);
   if (factor_ && !fresh_ && result.status == LinearStatus::kNotConverged) {
     // The lagged factor is too far from A: refactor now and solve again.
     stale_ = true;
-    LinearResult f = factorize(*a_);
+    LinearResult f = factorize(*a_, counters);
     if (!f.ok()) return f;
     const int before = result.iterations;
-    result = run(b, x, options_.max_iterations);
+    result = run(b, x, options_.max_iterations, counters);
     result.iterations += before;
   }
   if (factor_) {

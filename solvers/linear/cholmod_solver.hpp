@@ -17,14 +17,12 @@ enum class CholmodOrdering {
 std::string_view cholmod_ordering_name(CholmodOrdering ordering);
 
 struct CholmodOptions {
-  // Measured on the seed cube (docs/implicit.md): METIS gives the least fill and the fastest
-  // factorization there.
+  // METIS gives the least fill and the fastest factorization on the seed cube (docs/implicit.md).
   CholmodOrdering ordering = CholmodOrdering::kMetis;
   // Supernodal (BLAS-3) factorization from this many unknowns on; simplicial (no BLAS) below,
   // where BLAS calls, and OpenBLAS waking its threads on a busy machine, cost more than they
-  // save (a 64-particle cube on a loaded 2-core machine: supernodal 45 ms per step with
-  // OpenBLAS's default threads, 1.2 ms with one thread; simplicial 0.5 ms either way).
-  // 0 = always supernodal; a huge value = always simplicial.
+  // save (docs/implicit.md, "Measured speed"). 0 = always supernodal; a huge value = always
+  // simplicial.
   int supernodal_min_rows = 1000;
 };
 

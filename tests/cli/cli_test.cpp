@@ -240,9 +240,6 @@ TEST(Cli, HelpExitsZero) {
   EXPECT_THAT(r.out, HasSubstr("Exit codes: 0 ok, 2 bad input"));
 }
 
-#if __has_include(<jelly/io/h5_recorder.hpp>) && __has_include(<jelly/io/checkpoint.hpp>) && \
-    __has_include(<jelly/io/recording.hpp>)
-
 TEST(Cli, RunWritesAFileThatInfoDescribes) {
   const std::string file = temp_path(".h5");
   Result r = jelly("run " + kSmallSlope + " --duration 0.1 -o '" + file + "'");
@@ -305,23 +302,6 @@ TEST(Cli, FitErrorsExitTwo) {
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, StartsWith("error: recording.frames = 1 is invalid: at least 3 frames"));
 }
-
-#else
-
-TEST(Cli, HdfOptionsSayTheyAreNotAvailableInThisBuild) {
-  Result r = jelly("run " + kSmallSlope + " --duration 0.01 -o out.h5");
-  EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err, StartsWith("error: -o out.h5: HDF5 output is not available in this build"));
-  r = jelly("run " + kSmallSlope + " --restart run.h5");
-  EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err,
-              StartsWith("error: --restart run.h5: reading checkpoints is not available in this"));
-  r = jelly("info run.h5");
-  EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err, StartsWith("error: info run.h5: reading HDF5 files is not available in this"));
-}
-
-#endif
 
 }  // namespace
 }  // namespace jelly

@@ -5,8 +5,8 @@
 #include <Eigen/Dense>
 
 #include <jelly/core/cube.hpp>
+#include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/forces.hpp>
-#include <jelly/core/jacobian.hpp>
 
 namespace jelly {
 namespace {

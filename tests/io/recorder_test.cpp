@@ -112,7 +112,7 @@ bool has_attribute(hid_t file, const char* object, const char* name) {
   return H5Aexists_by_name(file, object, name, H5P_DEFAULT) > 0;
 }
 
-// The layout of DESIGN.md, by name and shape, read with the HDF5 C API.
+// The layout of docs/output.md, by name and shape, read with the HDF5 C API.
 TEST(Layout, NamesAndShapes) {
   TempDir dir;
   const std::string path = dir.file("layout.h5");

@@ -347,7 +347,7 @@ TEST(Overrides, BadPathsAreInputErrors) {
 }
 
 TEST(MakeSimulator, BuildsTheSceneAndRunsIt) {
-  // The library API of DESIGN.md, on a small cube.
+  // The library API of the README, on a small cube.
   Scene scene = load_scene(scene_path("seed_slope.json"), {"cube.n=4"});
   scene.integrator.name = "symplectic_euler";
   scene.integrator.dt = 0.002;

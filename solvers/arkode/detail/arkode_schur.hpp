@@ -7,8 +7,8 @@
 #include <memory>
 #include <string>
 
-#include <jelly/core/anchor_springs.hpp>
-#include <jelly/core/jacobian.hpp>
+#include <jelly/core/detail/anchor_jacobian.hpp>
+#include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/arkode/detail/arkode_support.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>

@@ -6,11 +6,11 @@
 #include <cmath>
 
 #include <jelly/core/cube.hpp>
+#include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
-#include <jelly/core/jacobian.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/solvers/contact/implicit_contact.hpp>
+#include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/elevator.hpp>

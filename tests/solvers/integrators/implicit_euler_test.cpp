@@ -6,13 +6,9 @@
 #include <jelly/core/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
-#include <jelly/core/jacobian.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/solvers/linear/cg_solver.hpp>
-#include <jelly/solvers/linear/cholmod_solver.hpp>
-#include <jelly/solvers/linear/ldlt_solver.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
@@ -20,127 +16,6 @@
 
 namespace jelly {
 namespace {
-
-// The backward-Euler system of a deformed, moving cube of n^3 particles.
-struct System {
-  Model model;
-  SparseMatrix a;
-  VecX b;
-};
-
-System backward_euler_system(int n, Real ks, Real h, DefinitenessFix fix, Real squeeze = 1.0) {
-  CubeSpec spec = testing::small_cube(n, 1.0);
-  for (auto& c : spec.springs) c = SpringCoefficients{ks, 50};
-  System s;
-  s.model = build_cube(spec);
-  State st = rest_state(s.model);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<Real> u(-1, 1);
-  const Vec3 c = center_of_mass(s.model, st);
-  for (int i = 0; i < s.model.num_particles(); ++i) {
-    particle(st.x, i) = c + squeeze * (Vec3(particle(st.x, i)) - c);
-    for (int k = 0; k < 3; ++k) {
-      st.x[3 * i + k] += 0.05 / (n - 1) * u(rng);
-      st.v[3 * i + k] = 0.5 * u(rng);
-    }
-  }
-  SpringJacobian jacobian(s.model);
-  s.a = jacobian.make_matrix();
-  VecX f(s.model.num_dofs()), kv(s.model.num_dofs());
-  compute_forces(s.model, st.x, st.v, f);
-  JacobianOptions o;
-  o.definiteness = fix;
-  jacobian.assemble_system(s.model, st.x, st.v, o, h, h * h, s.a, st.v, kv);
-  s.b = h * (f + h * kv);
-  return s;
-}
-
-VecX solve_with(LinearSolver& solver, const System& s) {
-  EXPECT_TRUE(solver.analyze(s.a).ok()) << solver.name();
-  const LinearResult f = solver.factorize(s.a);
-  EXPECT_TRUE(f.ok()) << solver.name() << ": " << f.message;
-  VecX x = VecX::Zero(s.b.size());
-  const LinearResult r = solver.solve(s.b, x);
-  EXPECT_TRUE(r.ok()) << solver.name() << ": " << r.message;
-  return x;
-}
-
-// Every backend, and every CHOLMOD ordering, solves the same SPD system to 1e-10 relative.
-TEST(LinearSolvers, BackendsAgreeOnTheSameSystem) {
-  for (Real ks : {1400.0, 100000.0}) {
-    const System s = backward_euler_system(5, ks, 1.0 / 60, DefinitenessFix::kClampCompressed);
-    CholmodSolver reference;
-    const VecX x = solve_with(reference, s);
-    EXPECT_LT((s.a * x - s.b).norm(), 1e-13 * s.b.norm());
-    for (CholmodOrdering o :
-         {CholmodOrdering::kAmd, CholmodOrdering::kNesdis, CholmodOrdering::kBest}) {
-      CholmodOptions options;
-      options.ordering = o;
-      options.supernodal_min_rows = o == CholmodOrdering::kAmd ? 1 << 30 : 0;  // both paths
-      CholmodSolver solver(options);
-      EXPECT_LT((solve_with(solver, s) - x).norm(), 1e-10 * x.norm()) << cholmod_ordering_name(o);
-    }
-    LdltSolver ldlt;
-    EXPECT_LT((solve_with(ldlt, s) - x).norm(), 1e-10 * x.norm());
-    CgOptions cg;
-    cg.tolerance = 1e-14;
-    CgSolver jacobi(cg);
-    EXPECT_LT((solve_with(jacobi, s) - x).norm(), 1e-10 * x.norm());
-    cg.preconditioner = CgPreconditioner::kLaggedCholesky;
-    CgSolver lagged(cg);
-    EXPECT_LT((solve_with(lagged, s) - x).norm(), 1e-10 * x.norm());
-  }
-}
-
-// CG preconditioned by the factor of an earlier matrix solves a later one in a few iterations
-// without refactoring.
-TEST(LinearSolvers, LaggedFactorPreconditionsALaterMatrix) {
-  const System s0 = backward_euler_system(5, 1400, 1.0 / 60, DefinitenessFix::kClampCompressed);
-  const System s1 =
-      backward_euler_system(5, 1400, 1.0 / 60, DefinitenessFix::kClampCompressed, 0.97);
-  CgOptions o;
-  o.preconditioner = CgPreconditioner::kLaggedCholesky;
-  o.tolerance = 1e-12;
-  CgSolver cg(o);
-  ASSERT_TRUE(cg.analyze(s0.a).ok());
-  ASSERT_TRUE(cg.factorize(s0.a).ok());
-  ASSERT_TRUE(cg.factorize(s1.a).ok());  // keeps the factor of s0
-  VecX x = VecX::Zero(s1.b.size());
-  const LinearResult r = cg.solve(s1.b, x);
-  ASSERT_TRUE(r.ok()) << r.message;
-  EXPECT_EQ(cg.counters().factorizations, 1);
-  EXPECT_GT(r.iterations, 1);
-  EXPECT_LT(r.iterations, 20);
-  EXPECT_LT((s1.a * x - s1.b).norm(), 1e-11 * s1.b.norm());
-}
-
-// A crushed jelly without a definiteness fix: every backend reports "not positive definite"
-// with its reason instead of returning garbage.
-TEST(LinearSolvers, NotPositiveDefiniteIsAStatus) {
-  const System s = backward_euler_system(4, 100000, 1.0 / 30, DefinitenessFix::kNone, 0.4);
-  CholmodSolver cholmod;
-  ASSERT_TRUE(cholmod.analyze(s.a).ok());
-  const LinearResult r = cholmod.factorize(s.a);
-  EXPECT_EQ(r.status, LinearStatus::kNotPositiveDefinite);
-  EXPECT_NE(r.message.find("CHOLMOD"), std::string::npos) << r.message;
-  EXPECT_NE(r.message.find("not positive definite"), std::string::npos) << r.message;
-  VecX x = VecX::Zero(s.b.size());
-  EXPECT_EQ(cholmod.solve(s.b, x).status, LinearStatus::kInvalidInput);  // no factor to use
-  LdltSolver ldlt;
-  ASSERT_TRUE(ldlt.analyze(s.a).ok());
-  EXPECT_EQ(ldlt.factorize(s.a).status, LinearStatus::kNotPositiveDefinite);
-  CgSolver cg;
-  ASSERT_TRUE(cg.analyze(s.a).ok());
-  LinearResult c = cg.factorize(s.a);
-  if (c.ok()) c = cg.solve(s.b, x);
-  EXPECT_EQ(c.status, LinearStatus::kNotPositiveDefinite) << c.message;
-  // With the default fix the same state is fine.
-  const System fixed =
-      backward_euler_system(4, 100000, 1.0 / 30, DefinitenessFix::kClampCompressed, 0.4);
-  CholmodSolver ok;
-  ASSERT_TRUE(ok.analyze(fixed.a).ok());
-  EXPECT_TRUE(ok.factorize(fixed.a).ok());
-}
 
 TEST(ImplicitEuler, SimulatorReportsSolverFailure) {
   CubeSpec spec = testing::small_cube(4, 1.0);

@@ -1,30 +1,13 @@
 #pragma once
 // Sparse Jacobians df/dx (K) and df/dv (D) of the spring and damper forces on one fixed 3x3-block
 // sparsity pattern, built once with a scatter map; each assembly only refills the values.
-#include <string>
-#include <string_view>
 #include <vector>
 
-#include <Eigen/SparseCore>
-
+#include <jelly/core/definiteness.hpp>
 #include <jelly/core/model.hpp>
+#include <jelly/core/sparse_matrix.hpp>
 
 namespace jelly {
-
-using SparseMatrix = Eigen::SparseMatrix<Real, Eigen::ColMajor, int>;
-
-// How the geometric (transverse) stiffness of a spring is kept from making -K indefinite
-// (docs/implicit.md). Per spring, the symmetric part of -df_a/dxa is ks u u^T + s P, with
-// P = I - u u^T, s = ks (1 - l0/L) + kd c / L (c = (va - vb).u); it is negative for a compressed
-// (or a closing) spring.
-enum class DefinitenessFix {
-  kClampCompressed,  // Choi & Ko 2002: ks (1 - l0/L) and kd c/L each clamped to >= 0 (default)
-  kProjectPsd,       // the spring's 3x3 block projected to PSD: s clamped to >= 0
-  kNone,             // the exact symmetric Jacobian; M - h D - h^2 K may be indefinite
-};
-std::string_view definiteness_name(DefinitenessFix fix);
-// "clamp", "project" or "none"; false for anything else.
-bool parse_definiteness(std::string_view text, DefinitenessFix* fix);
 
 struct JacobianOptions {
   DefinitenessFix definiteness = DefinitenessFix::kClampCompressed;

@@ -4,8 +4,8 @@
 // stored densely over a range of first particles, with positions, velocities and forces
 // transposed to one array per coordinate. Within a band the loop reads particles a and a + offset
 // from contiguous memory, so the compiler vectorises sqrt, division and all (AVX2 where the CPU
-// has it, chosen at run time). Measured on the seed cube (docs/benchmarks.md): 38 us against
-// 73 us for compute_forces. Slots of a band that are not springs have zero coefficients.
+// has it, chosen at run time); docs/benchmarks.md ("The force loop") has its measurements.
+// Slots of a band that are not springs have zero coefficients.
 //
 // Same forces as compute_forces up to rounding (another summation order). A model whose springs
 // do not fill their bands densely, or a state with a degenerate (collapsed) spring, is evaluated
@@ -26,14 +26,15 @@ class SpringBands {
   bool dense() const { return dense_; }
   // True when built for a model with these particle and spring counts.
   bool fits(const Model& model) const;
-  // Copies rest lengths, ks and kd from the model again (after they changed; same springs).
-  void update_coefficients(const Model& model);
 
   // f = m g + spring and damper forces at (x, v), as compute_forces. No allocation. Not for
   // concurrent calls on one object (it keeps its scratch arrays).
   void compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f) const;
 
  private:
+  // Copies rest lengths, ks and kd from the model into the bands.
+  void copy_coefficients(const Model& model);
+
   struct Band {
     int offset = 0;                  // b - a
     int first = 0;                   // first particle a of slot 0

@@ -32,7 +32,7 @@
 
 #include <Eigen/SparseCore>
 
-#include <jelly/core/jacobian.hpp>
+#include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
