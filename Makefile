@@ -24,13 +24,16 @@ test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
 # 3 s of the seed slope with RK4 (a few seconds of wall time), then the plots when
-# scripts/plot.py is there.
+# scripts/plot.py is there, and the video (jelly render; exit 2 = built without the viewer).
 demo: build
 	@mkdir -p out
 	$(JELLY) run scenes/seed_slope.json --duration 3 -o out/demo.h5
 	@if [ -f scripts/plot.py ]; then /usr/bin/python3 scripts/plot.py out/demo.h5 -o out/demo.png; \
 	else echo "demo: scripts/plot.py is not in this tree: no plots"; fi
-	@echo "demo: written:"; for f in out/demo.h5 out/demo.xdmf out/demo.png; do \
+	@status=0; $(JELLY) render out/demo.h5 -o out/demo.mp4 || status=$$?; \
+	if [ $$status -eq 2 ]; then echo "demo: no out/demo.mp4 (see above)"; \
+	elif [ $$status -ne 0 ]; then exit $$status; fi
+	@echo "demo: written:"; for f in out/demo.h5 out/demo.xdmf out/demo.png out/demo.mp4; do \
 	  if [ -e $$f ]; then echo "  $(CURDIR)/$$f"; fi; done
 
 format:

@@ -37,4 +37,42 @@ int fit_command(const FitArgs& args);
 // jelly list: integrators, terrain kinds and contact models, one line each.
 int list_command();
 
+struct ViewArgs {
+  std::string file;  // a scene (JSON: live) or a recording (.h5: replay)
+  std::string integrator, dt;
+  std::vector<std::string> sets;
+  int width = 1280, height = 720;
+  std::string camera;
+  std::string screenshot;
+  int frames = -1;
+  int frame = 0;  // replay: the frame shown first
+  bool paused = false, hide_panel = false, particles = false, springs = false, stats = false;
+  double speed = 1;
+  int samples = 4;
+};
+// jelly view SCENE.json | FILE.h5: the live window or the replay.
+int view_command(const ViewArgs& args);
+
+struct RenderArgs {
+  std::string recording;
+  std::string output;
+  int width = 1280, height = 720;
+  double fps = 0;
+  double start = -1, end = -1;
+  std::string camera;
+  int samples = 4;
+  int crf = 18;
+  bool particles = false, springs = false, no_shadows = false;
+};
+// jelly render FILE.h5 -o out.mp4|out.gif|frames/%04d.png: offscreen video.
+int render_command(const RenderArgs& args);
+
+struct ExportArgs {
+  std::string recording;
+  std::string obj_sequence;  // folder of one OBJ per frame
+  std::string pc2;           // PC2 file (+ the rest surface as .obj beside it)
+};
+// jelly export FILE.h5 --obj-sequence DIR | --pc2 out.pc2.
+int export_command(const ExportArgs& args);
+
 }  // namespace jelly::cli

@@ -1,5 +1,6 @@
 // jelly: simulate scenes (run), describe recordings (info), fit coefficients to a recording
-// (fit), list what a scene can name (list).
+// (fit), list what a scene can name (list), watch scenes and recordings (view), render videos
+// (render), export surfaces for other tools (export).
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -77,6 +78,72 @@ int main(int argc, char** argv) {
   CLI::App* list = app.add_subcommand(
       "list", "List the integrators, terrain kinds and contact models, one per line");
 
+  ViewArgs view_args;
+  CLI::App* view = app.add_subcommand(
+      "view", "Watch a scene live (JSON) or replay a recording (.h5) in a window");
+  view->add_option("file", view_args.file, "Scene file (JSON) or recording (.h5)")->required();
+  view->add_option("--integrator", view_args.integrator, "Integrator name (live)");
+  view->add_option("--dt", view_args.dt, "Time step in s (live)")->type_name("H");
+  view->add_option("--set", view_args.sets, "Override a scene field (live), as for `jelly run`")
+      ->type_name("PATH=VALUE")
+      ->allow_extra_args(false);
+  view->add_option("--width", view_args.width, "Window width in pixels")->capture_default_str();
+  view->add_option("--height", view_args.height, "Window height in pixels")->capture_default_str();
+  view->add_option("--camera", view_args.camera,
+                   "Camera: yaw,pitch,distance[,tx,ty,tz] (degrees, m); default: framed");
+  view->add_option("--screenshot", view_args.screenshot,
+                   "Write the window as PNG after --frames N frames and exit (live: each frame "
+                   "is then one output interval of simulated time)");
+  view->add_option("--frames", view_args.frames, "Exit after this many frames");
+  view->add_option("--frame", view_args.frame, "Replay: the frame shown first");
+  view->add_option("--speed", view_args.speed,
+                   "Live: simulated seconds per wall second (0: as fast as possible)")
+      ->capture_default_str();
+  view->add_option("--samples", view_args.samples, "Multisampling (1 = none)")
+      ->capture_default_str();
+  view->add_flag("--paused", view_args.paused, "Start paused");
+  view->add_flag("--hide-panel", view_args.hide_panel, "No panel (H toggles it)");
+  view->add_flag("--particles", view_args.particles, "Show the particles");
+  view->add_flag("--springs", view_args.springs, "Show the structural springs");
+  view->add_flag("--stats", view_args.stats,
+                 "Print frames per second, render and simulation times at exit");
+
+  RenderArgs render_args;
+  CLI::App* render = app.add_subcommand(
+      "render", "Render a recording offscreen to a video (.mp4, .gif) or PNG frames");
+  render->add_option("recording", render_args.recording, "HDF5 file from `jelly run -o`")
+      ->required();
+  render
+      ->add_option("-o,--output", render_args.output,
+                   "out.mp4, out.gif or a PNG pattern such as frames/%04d.png")
+      ->required();
+  render->add_option("--width", render_args.width, "Width in pixels")->capture_default_str();
+  render->add_option("--height", render_args.height, "Height in pixels")->capture_default_str();
+  render->add_option("--fps", render_args.fps,
+                     "Video frames per simulated second (default: the recording's own rate)");
+  render->add_option("--start", render_args.start, "First simulated time (s)");
+  render->add_option("--end", render_args.end, "Last simulated time (s)");
+  render->add_option("--camera", render_args.camera,
+                     "Camera: yaw,pitch,distance[,tx,ty,tz] (degrees, m); default: as `jelly "
+                     "view` frames the recording");
+  render->add_option("--samples", render_args.samples, "Multisampling (1 = none)")
+      ->capture_default_str();
+  render->add_option("--crf", render_args.crf, "H.264 quality, lower is better")
+      ->capture_default_str();
+  render->add_flag("--particles", render_args.particles, "Show the particles");
+  render->add_flag("--springs", render_args.springs, "Show the structural springs");
+  render->add_flag("--no-shadows", render_args.no_shadows, "No shadows");
+
+  ExportArgs export_args;
+  CLI::App* export_cmd = app.add_subcommand(
+      "export", "Export a recording's surfaces for Blender, Houdini, ParaView: OBJ per frame, PC2");
+  export_cmd->add_option("recording", export_args.recording, "HDF5 file from `jelly run -o`")
+      ->required();
+  export_cmd->add_option("--obj-sequence", export_args.obj_sequence,
+                         "Folder for frame_0000.obj, frame_0001.obj, ...");
+  export_cmd->add_option("--pc2", export_args.pc2,
+                         "PC2 point cache (the rest surface goes beside it as .obj)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -91,6 +158,9 @@ int main(int argc, char** argv) {
     if (info->parsed()) return info_command(info_path);
     if (fit->parsed()) return fit_command(fit_args);
     if (list->parsed()) return list_command();
+    if (view->parsed()) return view_command(view_args);
+    if (render->parsed()) return render_command(render_args);
+    if (export_cmd->parsed()) return export_command(export_args);
   } catch (const jelly::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitBadInput;

@@ -8,6 +8,10 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas-dev libsundials-dev libhdf5-dev hdf5-tools
   libceres-dev libgtest-dev libgmock-dev googletest libbenchmark-dev nlohmann-json3-dev libcli11-dev
   python3-h5py python3-matplotlib python3-numpy ffmpeg clang-format ccache
+  # the viewer (jelly view / render): OpenGL through GLVND, Mesa's EGL and software drivers
+  # (llvmpipe), GLFW, Dear ImGui with its backends, stb for PNG; Xvfb for its tests
+  libglfw3-dev libimgui-dev libstb-dev libopengl-dev libegl-dev libegl-mesa0 libglx-mesa0
+  libgl1-mesa-dri xvfb xauth
 )
 
 missing=()

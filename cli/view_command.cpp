@@ -1,0 +1,144 @@
+// jelly view, jelly render, jelly export: the viewer layer's commands. The window and the
+// offscreen renderer are optional parts of the build (JELLY_HAVE_WINDOW, JELLY_HAVE_RENDER).
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/io/recording.hpp>
+#include <jelly/io/scene.hpp>
+#include <jelly/viewer/exports.hpp>
+#ifdef JELLY_HAVE_RENDER
+#include <jelly/viewer/render_video.hpp>
+#endif
+#ifdef JELLY_HAVE_WINDOW
+#include <jelly/viewer/window.hpp>
+#endif
+
+#include "commands.hpp"
+#include "exit_codes.hpp"
+
+namespace jelly::cli {
+
+namespace {
+
+bool is_recording(const std::string& path) {
+  const auto dot = path.rfind('.');
+  const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  return ext == ".h5" || ext == ".hdf5";
+}
+
+[[maybe_unused]] std::vector<std::string> overrides(const ViewArgs& args) {
+  std::vector<std::string> out = args.sets;
+  if (!args.integrator.empty())
+    out.push_back("integrator.name=" + nlohmann::json(args.integrator).dump());
+  if (!args.dt.empty()) out.push_back("integrator.dt=" + args.dt);
+  return out;
+}
+
+}  // namespace
+
+int view_command(const ViewArgs& args) {
+#ifdef JELLY_HAVE_WINDOW
+  require(args.width >= 16 && args.width <= 8192, "--width", args.width, "16 to 8192 pixels");
+  require(args.height >= 16 && args.height <= 8192, "--height", args.height, "16 to 8192 pixels");
+  require(args.frames >= -1, "--frames", args.frames, ">= 0 frames (-1: until closed)");
+  require(args.speed >= 0, "--speed", args.speed, ">= 0 (0: as fast as possible)");
+  require(args.samples >= 1 && args.samples <= 16, "--samples", args.samples, "1 to 16");
+  if (!args.screenshot.empty() && args.frames < 0)
+    throw InputError("--screenshot", args.screenshot, "used with --frames N (the frame to save)");
+  viewer::ViewOptions options;
+  options.width = args.width;
+  options.height = args.height;
+  options.camera = args.camera;
+  if (!options.camera.empty()) viewer::Camera().parse(options.camera);  // checked before a window
+  options.screenshot = args.screenshot;
+  options.frames = args.frames;
+  options.start_frame = args.frame;
+  options.paused = args.paused;
+  options.hide_panel = args.hide_panel;
+  options.particles = args.particles;
+  options.springs = args.springs;
+  options.stats = args.stats;
+  options.speed = args.speed;
+  options.samples = args.samples;
+  try {
+    std::unique_ptr<viewer::ViewerWindow> window;
+    if (is_recording(args.file)) {
+      if (!args.sets.empty() || !args.integrator.empty() || !args.dt.empty())
+        throw InputError("--set/--integrator/--dt", args.file,
+                         "options of a live scene, not of a recording");
+      window = viewer::ViewerWindow::replay(args.file, options);
+    } else {
+      const Scene scene = load_scene(args.file, overrides(args));
+      window = viewer::ViewerWindow::live(scene, args.file, options);
+    }
+    return window->run();
+  } catch (const viewer::DisplayUnavailable& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitBadInput;
+  }
+#else
+  (void)args;
+  std::fprintf(stderr,
+               "error: this jelly was built without the viewer window (GLFW, Dear ImGui or "
+               "OpenGL were not found when it was configured: apt-get install libglfw3-dev "
+               "libimgui-dev libegl-dev libstb-dev, then rebuild)\n");
+  return kExitBadInput;
+#endif
+}
+
+int render_command(const RenderArgs& args) {
+#ifdef JELLY_HAVE_RENDER
+  viewer::RenderVideoOptions options;
+  options.width = args.width;
+  options.height = args.height;
+  options.fps = args.fps;
+  options.start = args.start;
+  options.end = args.end;
+  options.camera = args.camera;
+  options.samples = args.samples;
+  options.crf = args.crf;
+  options.particles = args.particles;
+  options.springs = args.springs;
+  options.shadows = !args.no_shadows;
+  require(args.fps >= 0, "--fps", args.fps, "> 0 frames per second (0: the recording's rate)");
+  require(args.crf >= 0 && args.crf <= 51, "--crf", args.crf, "0 to 51");
+  const viewer::RenderVideoReport r = viewer::render_video(args.recording, args.output, options);
+  std::printf(
+      "rendered %d frames of %dx%d to %s in %.2f s (%.1f ms per frame: drawing %.1f, "
+      "encoding %.1f)\nrenderer: %s\n",
+      r.frames, args.width, args.height, args.output.c_str(), r.seconds,
+      1e3 * r.seconds / std::max(1, r.frames), 1e3 * r.render_seconds / std::max(1, r.frames),
+      1e3 * r.encode_seconds / std::max(1, r.frames), r.renderer.c_str());
+  return kExitOk;
+#else
+  (void)args;
+  std::fprintf(stderr,
+               "error: this jelly was built without offscreen rendering (OpenGL, EGL or stb were "
+               "not found when it was configured: apt-get install libopengl-dev libegl-dev "
+               "libstb-dev, then rebuild)\n");
+  return kExitBadInput;
+#endif
+}
+
+int export_command(const ExportArgs& args) {
+  if (args.obj_sequence.empty() && args.pc2.empty())
+    throw InputError("jelly export", args.recording, "--obj-sequence DIR and/or --pc2 FILE.pc2");
+  const Recording recording = read_recording(args.recording);
+  if (!args.obj_sequence.empty()) {
+    const int files = viewer::export_obj_sequence(recording, args.obj_sequence);
+    std::printf("wrote %d OBJ files to %s (frame_0000.obj ...)\n", files,
+                args.obj_sequence.c_str());
+  }
+  if (!args.pc2.empty()) {
+    const std::string rest = viewer::export_pc2(recording, args.pc2);
+    std::printf("wrote %s (%d samples) and its rest surface %s\n", args.pc2.c_str(),
+                recording.frames(), rest.c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace jelly::cli

@@ -1,0 +1,143 @@
+#include <jelly/io/export.hpp>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+namespace {
+
+constexpr char kPc2Signature[12] = {'P', 'O', 'I', 'N', 'T', 'C', 'A', 'C', 'H', 'E', '2', '\0'};
+
+// Little-endian int32 and float32, as the format (and every x86 and ARM machine) has them.
+void put_i32(std::FILE* f, std::int32_t v) { std::fwrite(&v, 4, 1, f); }
+void put_f32(std::FILE* f, float v) { std::fwrite(&v, 4, 1, f); }
+
+}  // namespace
+
+void write_obj(const std::string& path, const std::vector<ObjObject>& objects) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr)
+    throw InputError("output", path,
+                     "a file that can be written (" + std::string(std::strerror(errno)) + ")");
+  std::fprintf(f, "# jelly render surface\n");
+  int base = 1;
+  for (const ObjObject& o : objects) {
+    std::fprintf(f, "o %s\n", o.name.c_str());
+    for (const Vec3& v : o.vertices) std::fprintf(f, "v %.9g %.9g %.9g\n", v.x(), v.y(), v.z());
+    for (const auto& t : o.triangles)
+      std::fprintf(f, "f %d %d %d\n", t[0] + base, t[1] + base, t[2] + base);
+    base += static_cast<int>(o.vertices.size());
+  }
+  const bool ok = std::ferror(f) == 0;
+  if (std::fclose(f) != 0 || !ok)
+    throw InputError("output", path, "a file that can be written (the write failed)");
+}
+
+std::vector<ObjObject> read_obj(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("file", path, "an OBJ file that can be read");
+  std::vector<ObjObject> objects;
+  int base = 1;  // index of the current object's first vertex, file-wide
+  int seen = 0;  // vertices so far, file-wide
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream items(line);
+    std::string key;
+    items >> key;
+    if (key == "o") {
+      objects.emplace_back();
+      items >> objects.back().name;
+      base = seen + 1;
+    } else if (key == "v" || key == "f") {
+      if (objects.empty()) {
+        objects.emplace_back();
+        base = 1;
+      }
+      if (key == "v") {
+        Vec3 v;
+        items >> v.x() >> v.y() >> v.z();
+        objects.back().vertices.push_back(v);
+        ++seen;
+      } else {
+        std::array<int, 3> t{};
+        items >> t[0] >> t[1] >> t[2];
+        for (int& i : t) i -= base;
+        objects.back().triangles.push_back(t);
+      }
+      if (!items) throw InputError("file", path, "an OBJ file (bad line: " + line + ")");
+    }
+  }
+  return objects;
+}
+
+Pc2Writer::Pc2Writer(const std::string& path, int num_points, float start_frame, float sample_rate)
+    : path_(path), num_points_(num_points), buffer_(static_cast<size_t>(3 * num_points)) {
+  require(num_points >= 0, "num_points", num_points, ">= 0");
+  file_ = std::fopen(path.c_str(), "wb");
+  if (file_ == nullptr)
+    throw InputError("--pc2", path,
+                     "a file that can be written (" + std::string(std::strerror(errno)) + ")");
+  std::fwrite(kPc2Signature, 1, sizeof kPc2Signature, file_);
+  put_i32(file_, 1);  // file version
+  put_i32(file_, num_points);
+  put_f32(file_, start_frame);
+  put_f32(file_, sample_rate);
+  put_i32(file_, 0);  // samples: written by close()
+}
+
+Pc2Writer::~Pc2Writer() {
+  try {
+    close();
+  } catch (...) {
+  }
+}
+
+void Pc2Writer::write(const double* xyz) {
+  for (size_t i = 0; i < buffer_.size(); ++i) buffer_[i] = static_cast<float>(xyz[i]);
+  if (std::fwrite(buffer_.data(), sizeof(float), buffer_.size(), file_) != buffer_.size())
+    failed_ = true;
+  ++samples_;
+}
+
+void Pc2Writer::close() {
+  if (file_ == nullptr) return;
+  std::fseek(file_, sizeof kPc2Signature + 4 * 4, SEEK_SET);
+  put_i32(file_, samples_);
+  const bool ok = !failed_ && std::ferror(file_) == 0;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!ok || !closed)
+    throw InputError("--pc2", path_, "a file that can be written (the write failed)");
+}
+
+Pc2Data read_pc2(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("file", path, "a PC2 file that can be read");
+  char signature[12];
+  std::int32_t version = 0, points = 0, samples = 0;
+  Pc2Data d;
+  in.read(signature, 12);
+  in.read(reinterpret_cast<char*>(&version), 4);
+  in.read(reinterpret_cast<char*>(&points), 4);
+  in.read(reinterpret_cast<char*>(&d.start_frame), 4);
+  in.read(reinterpret_cast<char*>(&d.sample_rate), 4);
+  in.read(reinterpret_cast<char*>(&samples), 4);
+  if (!in || std::memcmp(signature, kPc2Signature, 12) != 0 || version != 1 || points < 0 ||
+      samples < 0)
+    throw InputError("file", path, "a PC2 file (POINTCACHE2 header, version 1)");
+  d.num_points = points;
+  for (int s = 0; s < samples; ++s) {
+    d.samples.emplace_back(static_cast<size_t>(3 * points));
+    in.read(reinterpret_cast<char*>(d.samples.back().data()),
+            static_cast<std::streamsize>(12 * static_cast<size_t>(points)));
+    if (!in) throw InputError("file", path, "a complete PC2 file (it is truncated)");
+  }
+  return d;
+}
+
+}  // namespace jelly

@@ -1,0 +1,65 @@
+#pragma once
+// File formats that DCC tools read: Wavefront OBJ triangle meshes and PC2 point caches (the
+// format of Blender's Mesh Cache modifier, Houdini and 3ds Max: a header and float32 x, y, z
+// per point per sample). Writers only; they know nothing of bodies or recordings.
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+// One named object of an OBJ file.
+struct ObjObject {
+  std::string name;
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> triangles;  // 0-based here, written 1-based
+};
+
+// Writes the objects into one OBJ file ("o name", "v x y z" with 9 significant digits, "f a b c"
+// with indices counted over the whole file). Throws InputError naming the path when it cannot
+// be written.
+void write_obj(const std::string& path, const std::vector<ObjObject>& objects);
+
+// Reads back what write_obj wrote (vertices and triangles of every object in order; other OBJ
+// statements are skipped). Throws InputError for a file it cannot read.
+std::vector<ObjObject> read_obj(const std::string& path);
+
+// A PC2 file written sample by sample; the sample count in the header is fixed by close().
+class Pc2Writer {
+ public:
+  // start_frame: the frame of the first sample; sample_rate: frames between samples.
+  // Throws InputError naming the path when it cannot be created.
+  Pc2Writer(const std::string& path, int num_points, float start_frame = 0, float sample_rate = 1);
+  ~Pc2Writer();
+  Pc2Writer(const Pc2Writer&) = delete;
+  Pc2Writer& operator=(const Pc2Writer&) = delete;
+
+  // One sample: num_points points, [3 num_points] values.
+  void write(const double* xyz);
+  // Writes the sample count and closes; throws InputError when the file could not be written.
+  void close();
+  int samples() const { return samples_; }
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  int num_points_;
+  int samples_ = 0;
+  std::vector<float> buffer_;
+  bool failed_ = false;
+};
+
+// A PC2 file read back.
+struct Pc2Data {
+  int num_points = 0;
+  float start_frame = 0, sample_rate = 1;
+  std::vector<std::vector<float>> samples;  // [samples][3 num_points]
+};
+// Throws InputError for a file that is not PC2 or is truncated.
+Pc2Data read_pc2(const std::string& path);
+
+}  // namespace jelly

@@ -1,0 +1,113 @@
+#pragma once
+// Helpers of the viewer tests: temporary folders, running the jelly program, recordings, and
+// finding the jelly in a picture (its raspberry red against sky, ground and shadow, none red).
+#include <sys/wait.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include <jelly/core/types.hpp>
+#include <jelly/viewer/camera.hpp>
+
+namespace jelly::testing {
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "jelly-viewer-XXXXXX").string();
+    path_ = mkdtemp(pattern.data());
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+inline std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Runs a shell command with stdout and stderr captured.
+inline Result run(const std::string& command, const TempDir& dir) {
+  const std::string out = dir.file("run.out"), err = dir.file("run.err");
+  const int status = std::system((command + " >'" + out + "' 2>'" + err + "' </dev/null").c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_text(out);
+  r.err = read_text(err);
+  return r;
+}
+
+// The jelly's colour: red well above green and blue, lit or in shadow.
+inline bool is_jelly(const std::uint8_t* p) {
+  return p[0] > 60 && p[0] > p[1] + 40 && p[0] > p[2] + 30;
+}
+
+struct Box {
+  float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+  void add(float x, float y) {
+    x0 = std::min(x0, x);
+    y0 = std::min(y0, y);
+    x1 = std::max(x1, x);
+    y1 = std::max(y1, y);
+  }
+  bool contains(float x, float y, float margin = 0) const {
+    return x >= x0 - margin && x <= x1 + margin && y >= y0 - margin && y <= y1 + margin;
+  }
+};
+
+// The window-pixel box of the particles' projections.
+inline Box projected_box(const viewer::Camera& camera, const VecX& x, int width, int height) {
+  Box box;
+  for (Eigen::Index i = 0; i + 2 < x.size(); i += 3) {
+    const auto p = camera.project(x.segment<3>(i).cast<float>(), width, height);
+    if (p) box.add(p->x(), p->y());
+  }
+  return box;
+}
+
+struct JellyPixels {
+  long inside = 0;      // jelly-coloured pixels inside the box
+  long outside = 0;     // jelly-coloured pixels outside the box grown by a margin
+  long box_pixels = 0;  // pixels inside the box
+  double fraction() const { return box_pixels > 0 ? double(inside) / double(box_pixels) : 0; }
+};
+
+// Counts the jelly's pixels of an RGB image (rows top to bottom) inside and outside `box`.
+inline JellyPixels count_jelly(const std::vector<std::uint8_t>& rgb, int width, int height,
+                               const Box& box, float margin = 3) {
+  JellyPixels c;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const float cx = x + 0.5f, cy = y + 0.5f;
+      const bool jelly = is_jelly(rgb.data() + 3 * (static_cast<size_t>(y) * width + x));
+      if (box.contains(cx, cy)) {
+        ++c.box_pixels;
+        if (jelly) ++c.inside;
+      } else if (!box.contains(cx, cy, margin) && jelly) {
+        ++c.outside;
+      }
+    }
+  return c;
+}
+
+}  // namespace jelly::testing

@@ -1,0 +1,207 @@
+// `jelly view` in a window, run under xvfb-run (Mesa's llvmpipe): screenshots show the jelly
+// where the camera projects the simulated, or recorded, particles; dragging a particle moves
+// it; `jelly render` makes the same picture as the window; the window exits 0 when closed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+
+#include <jelly/core/cube.hpp>
+#include <jelly/io/recording.hpp>
+#include <jelly/io/scene.hpp>
+#include <jelly/viewer/image_io.hpp>
+#include <jelly/viewer/window.hpp>
+
+#include "viewer/viewer_support.hpp"
+
+namespace jelly {
+namespace {
+
+using testing::TempDir;
+
+constexpr const char* kCamera = "-20,18,25,0,6,0";
+constexpr int kWidth = 480, kHeight = 360;
+const std::string kSlope = JELLY_SCENES_DIR "/seed_slope.json";
+
+std::string jelly() { return std::string("'") + JELLY_CLI + "' "; }
+
+std::string view_args(int width = kWidth, int height = kHeight) {
+  return " --hide-panel --camera " + std::string(kCamera) + " --width " + std::to_string(width) +
+         " --height " + std::to_string(height);
+}
+
+// Checks that the screenshot shows the jelly inside the projection of `x` and nowhere else.
+void expect_jelly_at(const std::string& png, const VecX& x) {
+  const viewer::Image image = viewer::read_png(png);
+  ASSERT_EQ(image.width, kWidth);
+  ASSERT_EQ(image.height, kHeight);
+  viewer::Camera camera;
+  camera.parse(kCamera);
+  const testing::Box box = testing::projected_box(camera, x, kWidth, kHeight);
+  const testing::JellyPixels c = testing::count_jelly(image.rgb, kWidth, kHeight, box);
+  EXPECT_GT(c.fraction(), 0.6) << c.inside << " of " << c.box_pixels << " in the box";
+  EXPECT_EQ(c.outside, 0);
+}
+
+TEST(Window, ScreenshotOfTheSeedSlopeAtStart) {
+  TempDir dir;
+  const testing::Result r =
+      testing::run(jelly() + "view '" + kSlope + "' --frames 0 --screenshot '" + dir.file("s.png") +
+                       "'" + view_args(),
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Model model = build_cube(load_scene(kSlope).cube);
+  expect_jelly_at(dir.file("s.png"), model.rest_position);
+}
+
+// 45 frames of 1/60 s: the jelly has fallen 2.8 m, where the simulation puts it.
+TEST(Window, AfterFramesTheJellyIsWhereTheSimulationSays) {
+  TempDir dir;
+  const testing::Result r =
+      testing::run(jelly() + "view '" + kSlope + "' --frames 45 --screenshot '" +
+                       dir.file("s.png") + "'" + view_args(),
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  Simulator sim = make_simulator(load_scene(kSlope));
+  ASSERT_TRUE(sim.run_until(45.0 / 60).ok());
+  expect_jelly_at(dir.file("s.png"), sim.state().x);
+  // It moved: the start pose's projection is no longer covered.
+  viewer::Camera camera;
+  camera.parse(kCamera);
+  const testing::Box start =
+      testing::projected_box(camera, sim.model().rest_position, kWidth, kHeight);
+  const testing::Box now = testing::projected_box(camera, sim.state().x, kWidth, kHeight);
+  EXPECT_GT(now.y0 - start.y0, 20) << "the jelly fell by fewer than 20 pixels";
+}
+
+TEST(Window, ReplayShowsTheRecordedFrame) {
+  TempDir dir;
+  const std::string h5 = dir.file("r.h5");
+  testing::Result r =
+      testing::run(jelly() + "run '" + kSlope + "' --duration 1.5 --quiet -o '" + h5 + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Recording rec = read_recording(h5);
+  for (const int k : {0, 50, 90}) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    r = testing::run(jelly() + "view '" + h5 + "' --frame " + std::to_string(k) +
+                         " --frames 0 --screenshot '" + dir.file("s.png") + "'" + view_args(),
+                     dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    expect_jelly_at(dir.file("s.png"), rec.position[k]);
+  }
+}
+
+// Left press on the jelly picks the particle under the cursor; dragging pulls it to the cursor,
+// with RK4 at its step and with implicit Euler at 1/60 (its Jacobian in the solve).
+TEST(Window, PickingAndDraggingMovesTheParticle) {
+  for (const auto& [integrator, dt] : {std::pair{"rk4", 0.001}, {"implicit_euler", 1.0 / 60}}) {
+    SCOPED_TRACE(integrator);
+    Scene scene = load_scene(kSlope, {"gravity=[0,0,0]"});
+    scene.integrator.name = integrator;
+    scene.integrator.dt = dt;
+    viewer::ViewOptions options;
+    options.width = kWidth;
+    options.height = kHeight;
+    options.hide_panel = true;
+    options.lockstep = true;
+    options.camera = kCamera;
+    auto window = viewer::ViewerWindow::live(scene, kSlope, options);
+    ASSERT_TRUE(window->frame());
+    // The middle of the face towards the camera (+z).
+    const int n = scene.cube.n, p = cube_index(n, n / 2, n / 2, n - 1);
+    const Vec3 start = particle(window->positions(), p);
+    const auto at =
+        window->camera().project(start.cast<float>(), window->width(), window->height());
+    ASSERT_TRUE(at);
+    window->mouse_button(0, true, at->x(), at->y());
+    ASSERT_EQ(window->dragged_particle(), p);
+    window->cursor(at->x() + 60, at->y() - 40);
+    // The target: where the cursor's ray meets the plane through the particle facing the view.
+    Eigen::Vector3f o, d;
+    window->camera().ray(at->x() + 60, at->y() - 40, window->width(), window->height(), o, d);
+    const Eigen::Vector3f f = window->camera().forward();
+    const Vec3 target = (o + d * (f.dot(start.cast<float>() - o) / f.dot(d))).cast<double>();
+    ASSERT_GT((target - start).norm(), 1.0);
+    for (int i = 0; i < 60; ++i) ASSERT_TRUE(window->frame());
+    const Vec3 end = particle(window->positions(), p);
+    EXPECT_LT((end - target).norm(), 0.4 * (target - start).norm())
+        << "start " << start.transpose() << " end " << end.transpose() << " target "
+        << target.transpose();
+    // The rest of the jelly follows, less far.
+    const int far = cube_index(n, 0, 0, 0);
+    EXPECT_GT((particle(window->positions(), far) - particle(scene.cube.origin, 0)).norm(), 0.01);
+    window->mouse_button(0, false, at->x() + 60, at->y() - 40);
+    EXPECT_EQ(window->dragged_particle(), -1);
+    EXPECT_EQ(window->simulation()->front().status, RunStatus::kCompleted);
+  }
+}
+
+// `jelly render`'s first frame is the window's screenshot of the same state: bit for bit as PNG
+// frames (the same renderer through the same kind of target), within the codec's error as mp4.
+TEST(Window, RenderMatchesTheViewerScreenshot) {
+  TempDir dir;
+  if (std::system("command -v ffprobe >/dev/null 2>&1") != 0) GTEST_SKIP() << "no ffprobe";
+  const std::string h5 = dir.file("r.h5");
+  testing::Result r =
+      testing::run(jelly() + "run '" + kSlope + "' --duration 0.5 --quiet -o '" + h5 + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string size = " --width " + std::to_string(kWidth) + " --height " +
+                           std::to_string(kHeight) + " --camera " + kCamera;
+  r = testing::run(jelly() + "render '" + h5 + "' -o '" + dir.file("v.mp4") + "'" + size, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(
+      jelly() + "render '" + h5 + "' -o '" + dir.file("f%04d.png") + "'" + size + " --end 0", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+      "stream=width,height,nb_read_frames -of csv=p=0 '" +
+          dir.file("v.mp4") + "'",
+      dir);
+  EXPECT_EQ(r.out, std::to_string(kWidth) + "," + std::to_string(kHeight) + ",31\n") << r.err;
+  r = testing::run(
+      "ffmpeg -v error -i '" + dir.file("v.mp4") + "' -frames:v 1 '" + dir.file("first.png") + "'",
+      dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(jelly() + "view '" + h5 + "' --frame 0 --frames 0 --screenshot '" +
+                       dir.file("s.png") + "'" + view_args(),
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const viewer::Image shot = viewer::read_png(dir.file("s.png"));
+  const auto difference = [&](const std::string& png, int* largest) {
+    const viewer::Image other = viewer::read_png(png);
+    EXPECT_EQ(other.width, shot.width);
+    EXPECT_EQ(other.height, shot.height);
+    if (other.rgb.size() != shot.rgb.size()) return 1e9;
+    double sum = 0;
+    *largest = 0;
+    for (size_t i = 0; i < shot.rgb.size(); ++i) {
+      const int d = std::abs(int(shot.rgb[i]) - int(other.rgb[i]));
+      sum += d;
+      *largest = std::max(*largest, d);
+    }
+    return sum / static_cast<double>(shot.rgb.size());
+  };
+  int largest = 0;
+  const double png_mean = difference(dir.file("f0000.png"), &largest);
+  EXPECT_LT(png_mean, 0.5) << "largest " << largest;
+  const double mp4_mean = difference(dir.file("first.png"), &largest);
+  EXPECT_LT(mp4_mean, 3.0) << "largest " << largest;
+}
+
+TEST(Window, ExitsZeroWhenClosed) {
+  TempDir dir;
+  // --frames closes the window the way its close button does, from a running simulation.
+  const testing::Result r =
+      testing::run(jelly() + "view '" + kSlope + "' --frames 5 --width 320 --height 240", dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  viewer::ViewOptions options;
+  options.width = 320;
+  options.height = 240;
+  auto window = viewer::ViewerWindow::live(load_scene(kSlope), kSlope, options);
+  ASSERT_TRUE(window->frame());
+  window->request_close();
+  EXPECT_EQ(window->run(), 0);
+}
+
+}  // namespace
+}  // namespace jelly

@@ -1,0 +1,26 @@
+#pragma once
+// `jelly export`: a recording's render surfaces (scene_adapter.hpp) as an OBJ per frame, or as a
+// PC2 point cache with the rest surface as OBJ beside it (io/export.hpp writes the formats).
+#include <string>
+#include <vector>
+
+#include <jelly/io/export.hpp>
+#include <jelly/io/recording.hpp>
+#include <jelly/viewer/scene_adapter.hpp>
+
+namespace jelly::viewer {
+
+// The surfaces of every body at positions x, one OBJ object per body.
+std::vector<ObjObject> surface_objects(const std::vector<BodySurface>& surfaces, const VecX& x);
+
+// Writes DIR/frame_0000.obj, DIR/frame_0001.obj, ... (one per recorded frame; DIR is created)
+// and returns the number of files. Throws InputError for a recording without a surface or a
+// folder that cannot be made.
+int export_obj_sequence(const Recording& recording, const std::string& dir);
+
+// Writes the PC2 file (one sample per recorded frame, start frame 0, sample rate 1) and the
+// rest surface (the surfaces at the model's rest positions, the vertex order of the cache) as
+// an OBJ file of the same name with .obj; returns that OBJ's path.
+std::string export_pc2(const Recording& recording, const std::string& pc2_path);
+
+}  // namespace jelly::viewer

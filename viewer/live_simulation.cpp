@@ -1,0 +1,353 @@
+#include <jelly/viewer/live_simulation.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <exception>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
+
+namespace jelly::viewer {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double now_seconds() {
+  return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+}
+
+bool same(const ContactParams& a, const ContactParams& b) {
+  return a.model == b.model && a.restitution == b.restitution && a.friction == b.friction &&
+         a.static_friction == b.static_friction && a.epsilon == b.epsilon &&
+         a.resting_speed == b.resting_speed;
+}
+
+// Only the springs or gravity differ: the running model can take them in place.
+bool only_model_changed(const LiveSettings& a, const LiveSettings& b) {
+  if (a.integrator != b.integrator || a.dt != b.dt || a.contacts.size() != b.contacts.size())
+    return false;
+  for (size_t i = 0; i < a.contacts.size(); ++i)
+    if (!same(a.contacts[i], b.contacts[i])) return false;
+  return true;
+}
+
+}  // namespace
+
+LiveSettings LiveSettings::of(const Scene& scene) {
+  LiveSettings s;
+  s.integrator = scene.integrator.name;
+  s.dt = scene.integrator.dt;
+  s.springs = scene.cube.springs;
+  s.gravity = scene.cube.gravity;
+  for (const TerrainSpec& t : scene.terrains) s.contacts.push_back(t.contact);
+  return s;
+}
+
+Scene LiveSettings::applied_to(Scene scene) const {
+  if (scene.integrator.name != integrator) scene.integrator.options = {};
+  scene.integrator.name = integrator;
+  scene.integrator.dt = dt;
+  scene.cube.springs = springs;
+  scene.cube.gravity = gravity;
+  for (size_t i = 0; i < scene.terrains.size() && i < contacts.size(); ++i)
+    scene.terrains[i].contact = contacts[i];
+  return scene;
+}
+
+LiveSimulation::LiveSimulation(Scene scene, bool threaded)
+    : scene_(std::move(scene)), settings_(LiveSettings::of(scene_)) {
+  scene_.validate();
+  sim_scene_ = scene_;
+  rebuild(sim_scene_, false);
+  rate_wall_ = now_seconds();
+  publish();
+  refresh();
+  if (threaded) thread_ = std::thread([this] { loop(); });
+}
+
+LiveSimulation::~LiveSimulation() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    quit_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void LiveSimulation::set_playing(bool playing) {
+  playing_ = playing;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.playing = playing;
+  }
+  wake_.notify_all();
+}
+
+void LiveSimulation::step_once() {
+  playing_ = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.playing = false;
+    pending_.step = true;
+  }
+  wake_.notify_all();
+}
+
+void LiveSimulation::reset() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.reset = true;
+  }
+  wake_.notify_all();
+}
+
+void LiveSimulation::load(Scene scene) {
+  scene.validate();
+  scene_ = std::move(scene);
+  settings_ = LiveSettings::of(scene_);
+  ++generation_;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.scene = scene_;
+    pending_.settings.reset();
+    pending_.reset = false;
+  }
+  wake_.notify_all();
+}
+
+void LiveSimulation::set_speed(double speed) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  pending_.speed = speed;
+}
+
+void LiveSimulation::apply(const LiveSettings& settings) {
+  const Scene checked = settings.applied_to(scene_);
+  checked.validate();
+  make_integrator(checked.integrator.name, checked.integrator.options);
+  settings_ = settings;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.settings = settings;
+  }
+  wake_.notify_all();
+}
+
+void LiveSimulation::set_drag(std::optional<AnchorSpring> drag) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.drag_changed = true;
+    pending_.drag = drag;
+  }
+  wake_.notify_all();
+}
+
+void LiveSimulation::rebuild(const Scene& scene, bool keep_state) {
+  State state;
+  if (keep_state && sim_) state = sim_->state();
+  auto sim = std::make_unique<Simulator>(make_simulator(scene));
+  if (keep_state && state.x.size() == sim->model().num_dofs()) sim->set_state(std::move(state));
+  sim_ = std::move(sim);
+  if (drag_ && drag_->particle < sim_->model().num_particles()) sim_->set_anchors({*drag_});
+}
+
+bool LiveSimulation::take_commands() {
+  Commands c;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    c = std::move(pending_);
+    pending_ = Commands{};
+  }
+  bool changed = false;
+  if (c.speed) speed_ = *c.speed;
+  if (c.scene) {
+    sim_scene_ = std::move(*c.scene);
+    ++sim_generation_;
+    drag_.reset();
+    c.reset = true;
+  }
+  if (c.drag_changed) {
+    drag_ = c.drag;
+    if (drag_ && drag_->particle >= sim_->model().num_particles()) drag_.reset();
+    sim_->set_anchors(drag_ ? AnchorSprings{*drag_} : AnchorSprings{});
+    changed = true;
+  }
+  if (c.settings) {
+    const LiveSettings before = LiveSettings::of(sim_scene_);
+    sim_scene_ = c.settings->applied_to(std::move(sim_scene_));
+    if (!c.reset) {
+      if (only_model_changed(before, *c.settings)) {
+        Model& model = sim_->mutable_model();
+        for (int type = 0; type < kSpringTypeCount; ++type)
+          model.springs.set_coefficients(static_cast<SpringType>(type), c.settings->springs[type]);
+        model.gravity = c.settings->gravity;
+      } else {
+        rebuild(sim_scene_, true);
+      }
+    }
+    changed = true;
+  }
+  if (c.reset) {
+    rebuild(sim_scene_, false);
+    steps_ = 0;
+    stopped_ = false;
+    status_ = RunStatus::kCompleted;
+    message_.clear();
+    changed = true;
+  }
+  if (c.playing) {
+    sim_playing_ = *c.playing && !stopped_;
+    changed = true;
+  }
+  if (c.step && !stopped_) {
+    step();
+    changed = true;
+  }
+  return changed;
+}
+
+bool LiveSimulation::step() {
+  if (stopped_) return false;
+  const double start = now_seconds();
+  try {
+    const StepResult r = sim_->step();
+    if (!r.ok) {
+      status_ = RunStatus::kSolverFailed;
+      message_ = "the solver failed at t = " + to_text(sim_->state().t) + ": " + r.message;
+    } else if (auto why = sim_->options().divergence.check(sim_->model(), sim_->state())) {
+      status_ = RunStatus::kDiverged;
+      message_ = "diverged at t = " + to_text(sim_->state().t) + " s: " + *why;
+    }
+  } catch (const std::exception& e) {
+    status_ = RunStatus::kSolverFailed;
+    message_ = e.what();
+  }
+  step_seconds_sum_ += now_seconds() - start;
+  ++step_count_;
+  if (status_ != RunStatus::kCompleted) {
+    stopped_ = true;
+    sim_playing_ = false;
+    return false;
+  }
+  ++steps_;
+  return true;
+}
+
+void LiveSimulation::publish() {
+  const double now = now_seconds();
+  const State& s = sim_->state();
+  if (now - rate_wall_ >= 0.5 || !sim_playing_) {
+    const double span = now - rate_wall_;
+    if (span > 0 && sim_playing_) {
+      steps_per_second_ = static_cast<double>(steps_ - rate_steps_) / span;
+      sim_rate_ = (s.t - rate_t_) / span;
+    } else if (!sim_playing_) {
+      steps_per_second_ = sim_rate_ = 0;
+    }
+    if (step_count_ > 0) step_ms_ = 1e3 * step_seconds_sum_ / static_cast<double>(step_count_);
+    step_seconds_sum_ = 0;
+    step_count_ = 0;
+    rate_wall_ = now;
+    rate_steps_ = steps_;
+    rate_t_ = s.t;
+  }
+  LiveFrame& f = frames_[back_];
+  f.generation = sim_generation_;
+  f.t = s.t;
+  f.steps = steps_;
+  f.x = s.x;
+  const Model& m = sim_->model();
+  f.kinetic = kinetic_energy(m, s.v);
+  f.elastic = elastic_energy(m, s.x);
+  f.gravitational = gravitational_energy(m, s.x);
+  f.center_of_mass = center_of_mass(m, s.x);
+  f.steps_per_second = steps_per_second_;
+  f.sim_seconds_per_second = sim_rate_;
+  f.step_milliseconds = step_ms_;
+  f.playing = sim_playing_;
+  f.status = status_;
+  f.message = message_;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::swap(back_, middle_);
+    fresh_ = true;
+  }
+}
+
+bool LiveSimulation::refresh() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!fresh_) return false;
+    std::swap(front_, middle_);
+    fresh_ = false;
+  }
+  if (!frames_[front_].playing && frames_[front_].generation == generation_) playing_ = false;
+  return true;
+}
+
+void LiveSimulation::advance_to(Real t_end) {
+  take_commands();
+  const Real dt = sim_->options().dt;
+  while (!stopped_ && sim_->state().t < t_end - 0.5 * dt) step();
+  publish();
+}
+
+void LiveSimulation::loop() {
+  double pace_wall = now_seconds();
+  Real pace_t = sim_->state().t;
+  for (;;) {
+    bool changed = false;
+    try {
+      changed = take_commands();
+    } catch (const std::exception& e) {
+      status_ = RunStatus::kSolverFailed;
+      message_ = e.what();
+      stopped_ = true;
+      sim_playing_ = false;
+      changed = true;
+    }
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (quit_) return;
+      if (!sim_playing_) {
+        lock.unlock();
+        if (changed) publish();
+        lock.lock();
+        wake_.wait_for(lock, std::chrono::milliseconds(100));
+        pace_wall = now_seconds();
+        pace_t = sim_->state().t;
+        continue;
+      }
+    }
+    if (changed) {
+      pace_wall = now_seconds();
+      pace_t = sim_->state().t;
+    }
+    // A batch of steps for at most one display frame of wall time, or until the simulation is
+    // ahead of the paced clock.
+    const double batch_end = now_seconds() + 1.0 / 60;
+    bool ahead = false;
+    for (double now = now_seconds(); now < batch_end; now = now_seconds()) {
+      if (speed_ > 0 && sim_->state().t >= pace_t + speed_ * (now - pace_wall)) {
+        ahead = true;
+        break;
+      }
+      if (!step()) break;
+    }
+    publish();
+    const double now = now_seconds();
+    // Behind by more than a fifth of a second: the machine is too slow for this speed; do not
+    // try to catch up later.
+    if (speed_ > 0 && pace_t + speed_ * (now - pace_wall) - sim_->state().t > 0.2 * speed_) {
+      pace_wall = now;
+      pace_t = sim_->state().t;
+    }
+    if (ahead) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait_for(lock, std::chrono::milliseconds(4));
+    }
+  }
+}
+
+}  // namespace jelly::viewer

@@ -1,0 +1,80 @@
+#include <jelly/viewer/recording_view.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly::viewer {
+
+RecordingView::RecordingView(const std::string& path) : recording_(read_recording(path)) {
+  if (recording_.frames() == 0) throw InputError("recording", path, "a recording with frames");
+  bounds_of(recording_.position, lo_, hi_);
+  builder_ =
+      std::make_unique<SceneBuilder>(recording_.model, recording_terrains(recording_), lo_, hi_);
+}
+
+int RecordingView::frame_at(Real t) const {
+  const auto& time = recording_.time;
+  const int after = static_cast<int>(std::lower_bound(time.begin(), time.end(), t) - time.begin());
+  if (after >= frames()) return frames() - 1;
+  if (after == 0) return 0;
+  return t - time[after - 1] <= time[after] - t ? after - 1 : after;
+}
+
+double RecordingView::native_fps() const {
+  const auto it = recording_.attributes.find("output_interval");
+  if (it != recording_.attributes.end()) {
+    const double interval = std::atof(it->second.c_str());
+    if (interval > 0) return 1.0 / interval;
+  }
+  if (frames() >= 2) {
+    const double span = recording_.time.back() - recording_.time.front();
+    if (span > 0) return (frames() - 1) / span;
+  }
+  return 60;
+}
+
+std::vector<int> RecordingView::video_frames(double fps, Real t_start, Real t_end) const {
+  const Real first = recording_.time.front(), last = recording_.time.back();
+  t_start = std::clamp(t_start, first, last);
+  t_end = std::clamp(t_end, t_start, last);
+  std::vector<int> out;
+  const long count = static_cast<long>(std::floor((t_end - t_start) * fps + 1e-6)) + 1;
+  for (long k = 0; k < count; ++k) out.push_back(frame_at(t_start + static_cast<Real>(k) / fps));
+  return out;
+}
+
+RenderScene RecordingView::make_scene(int k) const {
+  return builder_->make_scene(recording_.position[k], recording_.time[k]);
+}
+
+void RecordingView::update(int k, RenderScene& scene) const {
+  builder_->update(recording_.position[k], recording_.time[k], scene);
+}
+
+Camera RecordingView::default_camera(float aspect) const {
+  return framing_camera(lo_, hi_, builder_->terrains(), recording_.time.front(), aspect);
+}
+
+Camera framing_camera(const Vec3& lo, const Vec3& hi, const Terrains& terrains, Real t,
+                      float aspect) {
+  Vec3 a = lo, b = hi;
+  const Vec3 centre = 0.5 * (lo + hi);
+  // The highest terrain surface below the centre: y where signed_distance vanishes, along -y.
+  Real ground = -std::numeric_limits<Real>::infinity();
+  for (const auto& terrain : terrains) {
+    const Vec3 n = terrain->normal(centre, t);
+    if (n.y() < 0.1) continue;
+    const Real y = centre.y() - terrain->signed_distance(centre, t) / n.y();
+    const Vec3 foot(centre.x(), y, centre.z());
+    if (y <= centre.y() && terrain->can_contact(foot, t)) ground = std::max(ground, y);
+  }
+  if (std::isfinite(ground)) {
+    a.y() = std::min(a.y(), ground);
+    b.y() = std::max(b.y(), ground);
+  }
+  return frame_box(a.cast<float>(), b.cast<float>(), aspect, -20, 18);
+}
+
+}  // namespace jelly::viewer
