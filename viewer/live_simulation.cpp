@@ -18,21 +18,6 @@ double now_seconds() {
   return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
 }
 
-bool same(const ContactParams& a, const ContactParams& b) {
-  return a.model == b.model && a.restitution == b.restitution && a.friction == b.friction &&
-         a.static_friction == b.static_friction && a.epsilon == b.epsilon &&
-         a.resting_speed == b.resting_speed;
-}
-
-// Only the springs or gravity differ: the running model can take them in place.
-bool only_model_changed(const LiveSettings& a, const LiveSettings& b) {
-  if (a.integrator != b.integrator || a.dt != b.dt || a.contacts.size() != b.contacts.size())
-    return false;
-  for (size_t i = 0; i < a.contacts.size(); ++i)
-    if (!same(a.contacts[i], b.contacts[i])) return false;
-  return true;
-}
-
 }  // namespace
 
 LiveSettings LiveSettings::of(const Scene& scene) {
@@ -174,18 +159,10 @@ bool LiveSimulation::take_commands() {
     changed = true;
   }
   if (c.settings) {
-    const LiveSettings before = LiveSettings::of(sim_scene_);
+    // A simulator of the new settings continues from the current state (the seed contact
+    // model's active set and an implicit method's warm start start afresh).
     sim_scene_ = c.settings->applied_to(std::move(sim_scene_));
-    if (!c.reset) {
-      if (only_model_changed(before, *c.settings)) {
-        Model& model = sim_->mutable_model();
-        for (int type = 0; type < kSpringTypeCount; ++type)
-          model.springs.set_coefficients(static_cast<SpringType>(type), c.settings->springs[type]);
-        model.gravity = c.settings->gravity;
-      } else {
-        rebuild(sim_scene_, true);
-      }
-    }
+    if (!c.reset) rebuild(sim_scene_, true);
     changed = true;
   }
   if (c.reset) {

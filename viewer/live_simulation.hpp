@@ -20,8 +20,8 @@
 
 namespace jelly::viewer {
 
-// What the panel edits. Springs and gravity change the running model in place; the integrator,
-// dt and contact coefficients rebuild the simulator from the current state.
+// What the panel edits; a change rebuilds the simulator from the current state (the run goes on
+// with the new integrator, step or coefficients).
 struct LiveSettings {
   std::string integrator;
   Real dt = 0.001;
