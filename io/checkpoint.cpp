@@ -1,8 +1,12 @@
 #include <jelly/io/checkpoint.hpp>
 
+#include <cmath>
+
 #include <jelly/core/errors.hpp>
 #include <jelly/io/detail/checkpoint_h5.hpp>
 #include <jelly/io/detail/h5.hpp>
+#include <jelly/io/detail/json_fields.hpp>
+#include <jelly/io/detail/json_parse.hpp>
 
 namespace jelly {
 
@@ -101,8 +105,12 @@ Checkpoint read_checkpoint(const std::string& path) {
     if (!h5::has_attribute(g.get(), "t")) {
       throw InputError("'" + path + "' has an empty /checkpoint: its run wrote no flush");
     }
-    std::vector<double> x = h5::read_doubles(g.get(), "position");
-    std::vector<double> v = h5::read_doubles(g.get(), "velocity");
+    std::vector<hsize_t> dims;
+    std::vector<double> x = h5::read_doubles(g.get(), "position", &dims);
+    const auto fail = [](const std::string& why) { throw std::runtime_error(why); };
+    if (dims.size() != 2 || dims[1] != 3) fail("position is not [N][3]");
+    std::vector<double> v = h5::read_doubles(g.get(), "velocity", &dims);
+    if (v.size() != x.size() || dims.size() != 2) fail("velocity is not the shape of position");
     cp.state.t = h5::read_double_attribute(g.get(), "t");
     cp.state.x = Eigen::Map<const VecX>(x.data(), static_cast<Eigen::Index>(x.size()));
     cp.state.v = Eigen::Map<const VecX>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -112,6 +120,11 @@ Checkpoint read_checkpoint(const std::string& path) {
     const std::vector<int> particles = h5::read_ints(g.get(), "seed_particle");
     const std::vector<double> normals = h5::read_doubles(g.get(), "seed_normal");
     const std::vector<double> frictions = h5::read_doubles(g.get(), "seed_friction");
+    if (normals.size() != 3 * particles.size() || frictions.size() != particles.size()) {
+      fail("seed_particle, seed_normal and seed_friction hold " + std::to_string(particles.size()) +
+           ", " + std::to_string(normals.size()) + " and " + std::to_string(frictions.size()) +
+           " numbers, not K, 3K and K");
+    }
     for (size_t i = 0; i < particles.size(); ++i) {
       cp.seed_contacts.push_back({particles[i],
                                   Vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]),
@@ -121,6 +134,15 @@ Checkpoint read_checkpoint(const std::string& path) {
       cp.integrator_state = h5::read_doubles(g.get(), "integrator_state");
     cp.integrator = h5::read_string_attribute(g.get(), "integrator");
     cp.dt = h5::read_double_attribute(g.get(), "dt");
+    if (h5::exists(file.get(), "parameters")) {
+      h5::Handle parameters = h5::open_group(file.get(), "parameters");
+      if (h5::has_attribute(parameters.get(), "scene_json")) {
+        cp.scene_json = h5::read_string_attribute(parameters.get(), "scene_json");
+      }
+      if (h5::has_attribute(parameters.get(), "output_interval")) {
+        cp.output_interval = h5::read_double_attribute(parameters.get(), "output_interval");
+      }
+    }
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -137,7 +159,104 @@ void restore(Simulator& sim, const Checkpoint& cp) {
           "the simulator's integrator '" + std::string(sim.integrator().name()) + "'");
   require(cp.dt == sim.options().dt, "checkpoint dt", cp.dt,
           "the simulator's time step (" + to_text(sim.options().dt) + ")");
+  // A run's checkpoint is taken at a frame (next_output is that frame's time, about t) or at its
+  // end (the next frame's time, at most one interval later). Far from t, the first frames would
+  // be emitted one interval at a time across the gap: a hang for an absurd value.
+  const Real t = cp.state.t;
+  require(std::isfinite(t), "checkpoint t", t, "a finite time");
+  const Real interval = cp.output_interval > 0 ? cp.output_interval : 0;
+  const Real slack = 2 * (interval + cp.dt) + 1e-9 * std::abs(t);
+  require(std::isfinite(cp.next_output) && std::abs(cp.next_output - t) <= slack,
+          "checkpoint next_output", cp.next_output,
+          "a time within an output interval of the checkpoint's t = " + to_text(t) + " s");
   sim.restore(cp.snapshot());
+}
+
+namespace {
+
+// The first JSON path at which a and b differ, or "" when they are equal.
+std::string first_difference(const detail::Json& a, const detail::Json& b,
+                             const std::string& path) {
+  if (a.is_object() && b.is_object()) {
+    for (auto it = a.begin(); it != a.end(); ++it) {
+      const std::string child = detail::json_child(path, it.key());
+      const auto other = b.find(it.key());
+      if (other == b.end()) return child;
+      std::string d = first_difference(it.value(), *other, child);
+      if (!d.empty()) return d;
+    }
+    for (auto it = b.begin(); it != b.end(); ++it) {
+      if (a.find(it.key()) == a.end()) return detail::json_child(path, it.key());
+    }
+    return "";
+  }
+  if (a.is_array() && b.is_array() && a.size() == b.size()) {
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      std::string d = first_difference(a[i], b[i], detail::json_element(path, i));
+      if (!d.empty()) return d;
+    }
+    return "";
+  }
+  return a == b ? "" : (path.empty() ? std::string("scene") : path);
+}
+
+const detail::Json* at_path(const detail::Json& j, const std::string& path) {
+  const detail::Json* current = &j;
+  std::string part;
+  for (std::size_t i = 0; i <= path.size(); ++i) {
+    const char c = i < path.size() ? path[i] : '.';
+    if (c != '.' && c != '[' && c != ']') {
+      part += c;
+      continue;
+    }
+    if (part.empty()) continue;
+    if (current->is_array()) {
+      const std::size_t index = std::stoul(part);
+      if (index >= current->size()) return nullptr;
+      current = &(*current)[index];
+    } else {
+      const auto it = current->find(part);
+      if (it == current->end()) return nullptr;
+      current = &*it;
+    }
+    part.clear();
+  }
+  return current;
+}
+
+// The parts of a scene that decide its trajectory, as JSON.
+detail::Json run_defining_json(const Scene& scene) {
+  detail::Json j = detail::parse_json(scene_to_json(scene), "scene");
+  for (const char* key : {"description", "duration", "output_interval", "divergence"}) j.erase(key);
+  return j;
+}
+
+}  // namespace
+
+void check_same_scene(const Checkpoint& cp, const Scene& scene, const std::string& source) {
+  if (cp.scene_json.empty()) {
+    throw InputError("--restart " + source +
+                     ": the file stores no scene (not written by `jelly run`), so it cannot be "
+                     "checked to be a run of this scene");
+  }
+  Scene recorded;
+  try {
+    recorded = parse_scene(cp.scene_json, {}, source + " /parameters scene_json");
+  } catch (const InputError& e) {
+    throw InputError("--restart " + source + ": its stored scene cannot be read: " + e.what());
+  }
+  const detail::Json was = run_defining_json(recorded);
+  const detail::Json now = run_defining_json(scene);
+  const std::string path = first_difference(was, now, "");
+  if (path.empty()) return;
+  const auto text = [&](const detail::Json& j) {
+    const detail::Json* v = at_path(j, path);
+    return v == nullptr ? std::string("nothing") : detail::json_text(*v);
+  };
+  throw InputError("--restart " + source + ": its run had " + path + " = " + text(was) +
+                   ", this scene has " + text(now) +
+                   ": a restart continues the same run (only duration, output_interval, "
+                   "divergence and description may change)");
 }
 
 }  // namespace jelly

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include <jelly/io/scene.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {
@@ -17,6 +18,8 @@ struct Checkpoint {
   std::vector<Real> integrator_state;  // empty in files written before it was stored
   std::string integrator;              // of the run that wrote it
   Real dt = 0;                         // of the run that wrote it
+  Real output_interval = 0;            // of the run that wrote it
+  std::string scene_json;  // the scene of the run that wrote it (empty when none was stored)
 
   SimulatorSnapshot snapshot() const;
 };
@@ -26,8 +29,15 @@ struct Checkpoint {
 Checkpoint read_checkpoint(const std::string& path);
 
 // Continues `sim` from the checkpoint. Throws InputError when the particle count, integrator or
-// time step differ from the run that wrote it (the continuation could not be the same run); use
-// sim.restore(cp.snapshot()) to continue with other settings on purpose.
+// time step differ from the run that wrote it (the continuation could not be the same run), or
+// when its times are not those of a run (t, or the next output time, far from where the run
+// was); use sim.restore(cp.snapshot()) to continue with other settings on purpose.
 void restore(Simulator& sim, const Checkpoint& cp);
+
+// Throws InputError naming the first JSON path (e.g. "springs.structural.ks") at which `scene`
+// differs from the scene the checkpoint's run was recorded with, or when that scene is missing
+// or unreadable: a restart continues the same run. duration, output_interval, divergence and
+// description may differ. `source` names the file in messages.
+void check_same_scene(const Checkpoint& cp, const Scene& scene, const std::string& source);
 
 }  // namespace jelly

@@ -1,8 +1,14 @@
 #include <jelly/io/h5_recorder.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <exception>
@@ -115,10 +121,53 @@ std::string terrain_group_name(size_t index, const Terrain& terrain) {
   return std::to_string(index) + "_" + std::string(terrain.kind());
 }
 
+// Whether `path` exists; throws InputError when it exists and could not be replaced by a file
+// (a directory, a device), or exists and `overwrite` is false.
+bool check_target(const std::string& path, bool overwrite, const std::string& what) {
+  struct stat info {};
+  if (stat(path.c_str(), &info) != 0) return false;
+  if (!S_ISREG(info.st_mode)) {
+    throw InputError("cannot write " + what + " '" + path + "': it exists and is not a file");
+  }
+  if (!overwrite) {
+    throw InputError("cannot write " + what + " '" + path +
+                     "': the file exists (a recorder replaces it only when told to: "
+                     "RecorderOptions::overwrite, jelly run --overwrite)");
+  }
+  if (access(path.c_str(), W_OK) != 0) {
+    throw InputError("cannot write " + what + " '" + path + "': " + std::strerror(errno));
+  }
+  return true;
+}
+
+// Throws InputError unless a file can be created at `path` (which does not exist): it is created
+// and removed again, so that a run learns before it starts that its sidecar could not be written.
+void probe_creatable(const std::string& path, const std::string& what) {
+  const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0) throw InputError("cannot write " + what + " '" + path + "': " + std::strerror(errno));
+  close(fd);
+  std::remove(path.c_str());
+}
+
+// Beside `path`, for a file that replaces it once complete.
+std::string partial_path(const std::string& path) {
+  return path + ".partial-" + std::to_string(static_cast<long>(getpid()));
+}
+
+void move_file(const std::string& from, const std::string& to) {
+  if (std::rename(from.c_str(), to.c_str()) != 0) {
+    throw std::runtime_error("cannot rename '" + from + "' to '" + to +
+                             "': " + std::strerror(errno));
+  }
+}
+
 }  // namespace
 
 struct H5Recorder::Impl {
-  std::string path;
+  std::string path;          // where the recording ends up
+  std::string write_path;    // where it is written: path, or partial_path(path) when replacing
+  std::string sidecar_path;  // the XDMF sidecar, when written
+  bool replacing = false;    // write_path is moved onto path at the first on_finish
   RecorderOptions options;
   Model model;
   int n = 0;
@@ -156,12 +205,37 @@ H5Recorder::Impl::Impl(const std::string& p, const Simulator& sim, RecorderOptio
     : path(p), options(std::move(o)), model(sim.model()), n(sim.model().num_particles()) {
   options.validate();
   if (options.integrator_name.empty()) options.integrator_name = sim.integrator().name();
+  require(!path.empty(), "recording path", "\"\"", "a file name");
+  replacing = check_target(path, options.overwrite, "the recording");
+  if (options.write_xdmf) {
+    sidecar_path = xdmf_path_for(path);
+    if (sidecar_path == path) {
+      throw InputError("cannot write the recording '" + path +
+                       "': its XDMF sidecar would have the same name (name the recording .h5)");
+    }
+  }
+  const bool sidecar_exists =
+      options.write_xdmf && check_target(sidecar_path, options.overwrite, "the XDMF sidecar");
+  write_path = replacing ? partial_path(path) : path;
   {
     std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
     h5::QuietErrors quiet;
-    file = h5::create_file(path);
-    write_static(sim);
-    h5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + path);
+    file = h5::create_file(write_path, /*exclusive=*/true);
+    try {
+      if (options.write_xdmf && !sidecar_exists) probe_creatable(sidecar_path, "the XDMF sidecar");
+      write_static(sim);
+      h5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + write_path);
+    } catch (...) {
+      // A file this recorder created and could not complete (a full disk): not left behind.
+      parameters.reset();
+      for (h5::Series* series : {&step, &time, &position, &velocity}) *series = h5::Series();
+      observables.clear();
+      terrains.clear();
+      checkpoint.reset();
+      file.reset();
+      std::remove(write_path.c_str());
+      throw;
+    }
   }
   current = take_spare();
   current->terrain.resize(terrains.size());
@@ -396,7 +470,10 @@ H5Recorder::~H5Recorder() {
   impl_->stop();
   std::lock_guard<std::recursive_mutex> library(h5::library_mutex());
   h5::QuietErrors quiet;
+  // A replacement that on_finish did not complete is dropped: the old file stays.
+  const std::string unfinished = impl_->replacing ? impl_->write_path : "";
   impl_.reset();  // closes every handle, then the file
+  if (!unfinished.empty()) std::remove(unfinished.c_str());
 }
 
 void H5Recorder::on_frame(const Simulator& sim) {
@@ -443,6 +520,9 @@ void H5Recorder::on_finish(const Simulator& sim, const RunReport& report) {
     }
     h5::check(H5Fflush(m.file.get(), H5F_SCOPE_GLOBAL), "flush " + m.path);
   }
+  // The sidecar under a temporary name first, so that a failure leaves no half-written one; the
+  // recording is moved onto its path only when everything else has been written.
+  std::string sidecar_written;
   if (m.options.write_xdmf) {
     XdmfLayout layout;
     const size_t slash = m.path.find_last_of('/');
@@ -450,8 +530,25 @@ void H5Recorder::on_finish(const Simulator& sim, const RunReport& report) {
     layout.num_particles = m.n;
     layout.num_springs = m.model.springs.size();
     layout.times = m.times;
-    write_xdmf(xdmf_path_for(m.path), layout);
+    sidecar_written = partial_path(m.sidecar_path);
+    try {
+      write_xdmf(sidecar_written, layout);
+    } catch (...) {
+      std::remove(sidecar_written.c_str());
+      throw;
+    }
   }
+  if (m.replacing) {
+    move_file(m.write_path, m.path);
+    m.replacing = false;
+    m.write_path = m.path;
+  }
+  if (!sidecar_written.empty()) move_file(sidecar_written, m.sidecar_path);
+}
+
+void disable_hdf5_exit_cleanup() {
+  std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
+  H5dont_atexit();
 }
 
 const std::string& H5Recorder::path() const { return impl_->path; }

@@ -19,6 +19,12 @@ struct RecorderOptions {
   bool write_xdmf = true;     // <path without .h5>.xdmf beside the file, written at on_finish
   // Compress and write on a second thread, so that recording costs the run little wall time.
   bool background_writer = true;
+  // A recorder never destroys a file it did not create unless told to. false: an existing file at
+  // the path (or at its sidecar's path) is an InputError. true: the recording is written beside
+  // it under a temporary name ("<path>.partial-<pid>") and replaces it only when the first
+  // on_finish() has written it completely; a run that throws or is killed before that leaves the
+  // old file untouched (and, when killed, the partial file).
+  bool overwrite = false;
 
   // Throws InputError for flush_every_frames < 1 or a compression level outside 0..9.
   void validate() const;
@@ -27,7 +33,9 @@ struct RecorderOptions {
 class H5Recorder final : public Observer {
  public:
   // Creates the file and writes the static parts (model, terrains, parameters). Throws
-  // InputError if the path cannot be created (the message names the path and the reason).
+  // InputError if the path cannot be created (the message names the path and the reason), if it
+  // or its sidecar exists without options.overwrite, if the sidecar could not be written (found
+  // now, not after the run), or if the path is its own sidecar's (a name ending in .xdmf).
   H5Recorder(const std::string& path, const Simulator& sim, RecorderOptions options = {});
   // Writes what is pending and closes the file (errors are swallowed here; on_finish reports
   // them).
@@ -37,8 +45,10 @@ class H5Recorder final : public Observer {
 
   void on_frame(const Simulator& sim) override;
   // Writes the pending frames, the run report and the integrator statistics as attributes of
-  // /parameters, the final checkpoint, flushes, and writes the XDMF sidecar. May be called after
-  // each of several run_until() calls. Throws std::runtime_error if a write failed.
+  // /parameters, the final checkpoint, flushes, and writes the XDMF sidecar (under a temporary
+  // name, then renamed); with options.overwrite the first call then moves the recording onto
+  // its path. May be called after each of several run_until() calls. Throws std::runtime_error
+  // if a write failed.
   void on_finish(const Simulator& sim, const RunReport& report) override;
 
   const std::string& path() const;
@@ -51,5 +61,11 @@ class H5Recorder final : public Observer {
 
 // "<path without .h5>.xdmf".
 std::string xdmf_path_for(const std::string& h5_path);
+
+// For programs, first thing in main(): turns off HDF5's own clean-up at exit. A program that
+// closes its recorders and readers itself (their destructors do) loses nothing; after a failed
+// write (a full disk) that clean-up would otherwise loop over the file it cannot flush and print
+// "HDF5: infinite loop closing library" after the program's own message.
+void disable_hdf5_exit_cleanup();
 
 }  // namespace jelly

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include <jelly/core/errors.hpp>
@@ -29,9 +30,18 @@ std::map<std::string, std::string> attributes_of(hid_t object) {
   return map;
 }
 
-std::vector<VecX> split_frames(const std::vector<double>& data, const std::vector<hsize_t>& dims) {
+// Throws std::runtime_error "<what>: <why>" unless ok.
+void expect(bool ok, const std::string& what, const std::string& why) {
+  if (!ok) throw std::runtime_error(what + ": " + why);
+}
+
+std::string count_text(std::size_t n) { return std::to_string(n); }
+
+std::vector<VecX> split_frames(const std::vector<double>& data, const std::vector<hsize_t>& dims,
+                               std::size_t particles, const std::string& what) {
   std::vector<VecX> frames;
-  if (dims.size() != 3 || dims[2] != 3) throw std::runtime_error("frames are not [T][N][3]");
+  expect(dims.size() == 3 && dims[2] == 3 && dims[1] == particles, what,
+         "not [T][" + count_text(particles) + "][3] (one row per particle of the mass dataset)");
   const Eigen::Index size = static_cast<Eigen::Index>(3 * dims[1]);
   for (hsize_t f = 0; f < dims[0]; ++f) {
     frames.emplace_back(Eigen::Map<const VecX>(data.data() + f * size, size));
@@ -44,7 +54,12 @@ Recording read(hid_t file) {
   std::vector<hsize_t> dims;
   std::vector<double> mass = h5::read_doubles(file, "/particles/jelly/mass");
   r.model.mass = Eigen::Map<const VecX>(mass.data(), static_cast<Eigen::Index>(mass.size()));
+  const std::size_t n = mass.size();
+  expect(n <= static_cast<std::size_t>(std::numeric_limits<int>::max() / 3),
+         "/particles/jelly/mass", "too many particles");
   std::vector<double> rest = h5::read_doubles(file, "/particles/jelly/rest_position");
+  expect(rest.size() == 3 * n, "/particles/jelly/rest_position",
+         count_text(rest.size()) + " numbers for " + count_text(n) + " particles");
   r.model.rest_position =
       Eigen::Map<const VecX>(rest.data(), static_cast<Eigen::Index>(rest.size()));
   const std::vector<int> pairs = h5::read_ints(file, "/connectivity/springs");
@@ -52,7 +67,22 @@ Recording read(hid_t file) {
   const std::vector<double> rest_length = h5::read_doubles(file, "/connectivity/rest_length");
   const std::vector<double> ks = h5::read_doubles(file, "/connectivity/ks");
   const std::vector<double> kd = h5::read_doubles(file, "/connectivity/kd");
-  for (size_t i = 0; i < type.size(); ++i) {
+  const std::size_t m = type.size();
+  expect(m <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "/connectivity/type",
+         "too many springs");
+  expect(pairs.size() == 2 * m, "/connectivity/springs",
+         count_text(pairs.size()) + " indices for " + count_text(m) + " springs");
+  for (const auto& [name, size] :
+       {std::pair<const char*, std::size_t>{"rest_length", rest_length.size()},
+        {"ks", ks.size()},
+        {"kd", kd.size()}}) {
+    expect(size == m, std::string("/connectivity/") + name,
+           count_text(size) + " values for " + count_text(m) + " springs");
+  }
+  for (size_t i = 0; i < m; ++i) {
+    expect(type[i] >= 0 && type[i] < kSpringTypeCount, "/connectivity/type",
+           "spring " + count_text(i) + " has type " + std::to_string(type[i]) +
+               " (0 structural, 1 shear, 2 bending)");
     r.model.springs.add(pairs[2 * i], pairs[2 * i + 1], rest_length[i], {ks[i], kd[i]},
                         static_cast<SpringType>(type[i]));
   }
@@ -68,8 +98,15 @@ Recording read(hid_t file) {
 
   r.time = h5::read_doubles(file, "/particles/jelly/position/time");
   r.step = h5::read_longs(file, "/particles/jelly/position/step");
-  r.position = split_frames(h5::read_doubles(file, "/particles/jelly/position/value", &dims), dims);
-  r.velocity = split_frames(h5::read_doubles(file, "/particles/jelly/velocity/value", &dims), dims);
+  try {
+    r.model.validate();
+  } catch (const InputError& e) {
+    throw std::runtime_error(std::string("its model is invalid: ") + e.what());
+  }
+  r.position = split_frames(h5::read_doubles(file, "/particles/jelly/position/value", &dims), dims,
+                            n, "/particles/jelly/position/value");
+  r.velocity = split_frames(h5::read_doubles(file, "/particles/jelly/velocity/value", &dims), dims,
+                            n, "/particles/jelly/velocity/value");
   // A killed run may have flushed one series further than another: keep the common frames.
   const size_t frames =
       std::min({r.time.size(), r.step.size(), r.position.size(), r.velocity.size()});
@@ -81,7 +118,9 @@ Recording read(hid_t file) {
   h5::Handle observables = h5::open_group(file, "/observables");
   for (const std::string& name : member_names(observables.get())) {
     const std::vector<double> v = h5::read_doubles(observables.get(), name + "/value", &dims);
-    const Eigen::Index rows = static_cast<Eigen::Index>(dims.at(0));
+    expect(dims.size() == 1 || (dims.size() == 2 && dims[1] == 3), "/observables/" + name,
+           "not [T] or [T][3]");
+    const Eigen::Index rows = static_cast<Eigen::Index>(dims[0]);
     const Eigen::Index cols = dims.size() > 1 ? static_cast<Eigen::Index>(dims[1]) : 1;
     r.observables[name] =
         Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(

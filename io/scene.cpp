@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/io/detail/json_parse.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>
 
@@ -78,11 +79,7 @@ void Scene::validate() const {
 }
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot read the scene file '" + path + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scene(text.str(), overrides, path);
+  return parse_scene(detail::read_json_file(path, "scene file"), overrides, path);
 }
 
 std::unique_ptr<Terrain> make_terrain(const TerrainSpec& spec) {

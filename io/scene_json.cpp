@@ -5,6 +5,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/io/detail/integrator_options_json.hpp>
 #include <jelly/io/detail/json_fields.hpp>
+#include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/detail/scene_override.hpp>
 #include <jelly/io/scene.hpp>
 
@@ -207,17 +208,7 @@ Json terrain_json(const TerrainSpec& t) {
 
 Scene parse_scene(const std::string& json_text, const std::vector<std::string>& overrides,
                   const std::string& source) {
-  Json j;
-  try {
-    j = Json::parse(json_text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-  } catch (const Json::parse_error& e) {
-    std::string why = e.what();
-    const std::size_t bracket = why.find("] ");
-    if (why.rfind("[json.exception", 0) == 0 && bracket != std::string::npos) {
-      why = why.substr(bracket + 2);
-    }
-    throw InputError(source + " is not valid JSON: " + why);
-  }
+  Json j = detail::parse_json(json_text, source);
   for (const std::string& o : overrides) detail::apply_override(j, o);
   return scene_from_json(j);
 }

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/scene.hpp>
 
 namespace jelly {
@@ -21,6 +22,15 @@ struct PathStep {
   std::size_t index = 0;
 };
 
+// "--set '<assignment>'" for messages, a long one cut short.
+std::string set_name(const std::string& assignment) {
+  constexpr std::size_t kMaxLength = 80;
+  return "--set '" +
+         (assignment.size() > kMaxLength ? assignment.substr(0, kMaxLength - 3) + "..."
+                                         : assignment) +
+         "'";
+}
+
 bool all_digits(const std::string& s) {
   if (s.empty()) return false;
   for (char c : s) {
@@ -31,7 +41,7 @@ bool all_digits(const std::string& s) {
 
 std::vector<PathStep> parse_path(const std::string& path, const std::string& assignment) {
   const auto fail = [&](const std::string& why) -> InputError {
-    return InputError("--set '" + assignment + "': " + why);
+    return InputError(set_name(assignment) + ": " + why);
   };
   std::vector<PathStep> steps;
   std::size_t start = 0;
@@ -70,13 +80,20 @@ std::vector<PathStep> parse_path(const std::string& path, const std::string& ass
 void apply_override(Json& scene, const std::string& assignment) {
   const std::size_t equals = assignment.find('=');
   if (equals == std::string::npos) {
-    throw InputError("--set '" + assignment +
-                     "': expected path=value, e.g. springs.structural.ks=2400");
+    throw InputError(set_name(assignment) +
+                     ": expected path=value, e.g. springs.structural.ks=2400");
   }
   const std::string path = assignment.substr(0, equals);
   const std::string text = assignment.substr(equals + 1);
-  Json value = Json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (value.is_discarded()) value = text;
+  Json value;
+  if (!parse_json_if_json(text, set_name(assignment), &value)) {
+    value = text;
+    try {
+      (void)value.dump();
+    } catch (const Json::exception&) {
+      throw InputError(set_name(assignment) + ": the value is not valid UTF-8 text");
+    }
+  }
 
   Json* current = &scene;
   std::string walked;  // the JSON path reached so far, as messages write it
@@ -84,10 +101,10 @@ void apply_override(Json& scene, const std::string& assignment) {
     const std::string where = walked.empty() ? "the scene" : walked;
     if (step.numeric && (step.bracketed || current->is_array())) {
       if (!current->is_array()) {
-        throw InputError("--set '" + assignment + "': " + where + " is not an array");
+        throw InputError(set_name(assignment) + ": " + where + " is not an array");
       }
       if (step.index >= current->size()) {
-        throw InputError("--set '" + assignment + "': " + json_element(walked, step.index) +
+        throw InputError(set_name(assignment) + ": " + json_element(walked, step.index) +
                          " does not exist (" + where + " has " + std::to_string(current->size()) +
                          (current->size() == 1 ? " element)" : " elements)"));
       }
@@ -97,7 +114,7 @@ void apply_override(Json& scene, const std::string& assignment) {
     }
     if (current->is_null()) *current = Json::object();
     if (!current->is_object()) {
-      throw InputError("--set '" + assignment + "': " + where + " is " + json_text(*current) +
+      throw InputError(set_name(assignment) + ": " + where + " is " + json_text(*current) +
                        ", not an object with a key \"" + step.key + "\"");
     }
     current = &(*current)[step.key];
@@ -109,8 +126,7 @@ void apply_override(Json& scene, const std::string& assignment) {
 }  // namespace detail
 
 std::string apply_override(const std::string& json_text, const std::string& assignment) {
-  detail::Json scene = detail::Json::parse(json_text, nullptr, false, /*ignore_comments=*/true);
-  if (scene.is_discarded()) throw InputError("apply_override: the scene text is not valid JSON");
+  detail::Json scene = detail::parse_json(json_text, "apply_override: the scene text");
   detail::apply_override(scene, assignment);
   return scene.dump(2);
 }

@@ -25,7 +25,18 @@ namespace {
 
 herr_t collect_error(unsigned /*n*/, const H5E_error2_t* error, void* out) {
   auto& messages = *static_cast<std::vector<std::string>*>(out);
-  if (error->desc != nullptr && error->desc[0] != '\0') messages.emplace_back(error->desc);
+  if (error->desc == nullptr || error->desc[0] == '\0') return 0;
+  // The file driver's long report ("... errno = 28, error message = 'No space left on device',
+  // buf = ...") is reduced to the operating system's message.
+  std::string text = error->desc;
+  const std::string key = "error message = '";
+  const size_t start = text.find(key);
+  if (start != std::string::npos) {
+    const size_t end = text.find('\'', start + key.size());
+    text =
+        text.substr(start + key.size(), end == std::string::npos ? end : end - start - key.size());
+  }
+  messages.push_back(std::move(text));
   return 0;
 }
 
@@ -57,8 +68,16 @@ std::vector<T> read_all(hid_t parent, const std::string& name, hid_t memory_type
                         std::vector<hsize_t>* dims_out) {
   Handle dataset = open_dataset(parent, name);
   const std::vector<hsize_t> dims = dataset_dims(dataset.get());
+  // A file can claim any shape (its chunks need not exist): refuse before allocating.
+  const hsize_t limit = kMaxReadBytes / sizeof(T);
   hsize_t count = 1;
-  for (hsize_t d : dims) count *= d;
+  for (hsize_t d : dims) {
+    if (d != 0 && count > limit / d) {
+      throw std::runtime_error("HDF5: dataset " + name + " claims more than " +
+                               std::to_string(kMaxReadBytes >> 30) + " GiB");
+    }
+    count *= d;
+  }
   std::vector<T> data(count);
   if (count > 0) {
     check(H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
@@ -129,21 +148,19 @@ void Handle::reset() {
 
 namespace {
 
-// The operating system's reason quoted in HDF5's "unable to open file" message ("No such file or
-// directory"), or the whole HDF5 text when there is none.
+// The operating system's reason ("No such file or directory": the deepest message, which
+// collect_error reduced to it), or the whole HDF5 text when there is none.
 std::string file_error_reason() {
-  const std::string text = error_text();
-  const std::string key = "error message = '";
-  const size_t start = text.find(key);
-  if (start == std::string::npos) return text;
-  const size_t end = text.find('\'', start + key.size());
-  return text.substr(start + key.size(), end == std::string::npos ? end : end - start - key.size());
+  std::vector<std::string> messages;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, collect_error, &messages);
+  return messages.empty() ? error_text() : messages.back();
 }
 
 }  // namespace
 
-Handle create_file(const std::string& path) {
-  const hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+Handle create_file(const std::string& path, bool exclusive) {
+  const hid_t id =
+      H5Fcreate(path.c_str(), exclusive ? H5F_ACC_EXCL : H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   if (id < 0) throw InputError("cannot create HDF5 file '" + path + "': " + file_error_reason());
   return Handle(id);
 }
@@ -221,7 +238,23 @@ bool has_attribute(hid_t object, const std::string& name) {
 
 namespace {
 
+// Elements of an attribute's dataspace (1 for a scalar).
+hssize_t attribute_points(hid_t attribute) {
+  Handle space(H5Aget_space(attribute), "attribute space");
+  return H5Sget_simple_extent_npoints(space.get());
+}
+
+// Reading a single value of an attribute that holds several would overrun the buffer.
+void require_single(hid_t attribute, const std::string& name) {
+  const hssize_t points = attribute_points(attribute);
+  if (points != 1) {
+    throw std::runtime_error("HDF5: attribute " + name + " holds " + std::to_string(points) +
+                             " values, not one");
+  }
+}
+
 std::string read_string(hid_t attribute, hid_t file_type) {
+  require_single(attribute, "string");
   if (H5Tis_variable_str(file_type) > 0) {
     Handle type(string_type());
     char* text = nullptr;
@@ -241,9 +274,13 @@ std::string read_string(hid_t attribute, hid_t file_type) {
 
 std::string attribute_as_text(hid_t attribute) {
   Handle type(H5Aget_type(attribute), "attribute type");
-  if (H5Tget_class(type.get()) == H5T_STRING) return read_string(attribute, type.get());
-  Handle space(H5Aget_space(attribute), "attribute space");
-  const hssize_t count = H5Sget_simple_extent_npoints(space.get());
+  const hssize_t count = attribute_points(attribute);
+  if (H5Tget_class(type.get()) == H5T_STRING) {
+    return count == 1 ? read_string(attribute, type.get()) : "<array of strings>";
+  }
+  if (count < 0 || static_cast<hsize_t>(count) > kMaxReadBytes / sizeof(double)) {
+    return "<unsupported size>";
+  }
   std::vector<double> values(static_cast<size_t>(std::max<hssize_t>(count, 0)));
   const H5T_class_t type_class = H5Tget_class(type.get());
   if (type_class != H5T_INTEGER && type_class != H5T_FLOAT) return "<unsupported type>";
@@ -276,11 +313,13 @@ std::string read_string_attribute(hid_t object, const std::string& name) {
   if (H5Tget_class(type.get()) != H5T_STRING) {
     throw std::runtime_error("HDF5: attribute " + name + " is not a string");
   }
+  require_single(attribute.get(), name);
   return read_string(attribute.get(), type.get());
 }
 
 double read_double_attribute(hid_t object, const std::string& name) {
   Handle attribute(H5Aopen(object, name.c_str(), H5P_DEFAULT), "open attribute " + name);
+  require_single(attribute.get(), name);
   double value = 0;
   check(H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, &value), "read attribute " + name);
   return value;
@@ -288,6 +327,7 @@ double read_double_attribute(hid_t object, const std::string& name) {
 
 long read_long_attribute(hid_t object, const std::string& name) {
   Handle attribute(H5Aopen(object, name.c_str(), H5P_DEFAULT), "open attribute " + name);
+  require_single(attribute.get(), name);
   long value = 0;
   check(H5Aread(attribute.get(), H5T_NATIVE_LONG, &value), "read attribute " + name);
   return value;

@@ -53,8 +53,9 @@ class Handle {
   hid_t id_ = -1;
 };
 
-// Files. Both throw InputError naming the path and HDF5's reason.
-Handle create_file(const std::string& path);
+// Files. Both throw InputError naming the path and HDF5's reason. `exclusive`: fail when the
+// file exists instead of truncating it.
+Handle create_file(const std::string& path, bool exclusive = false);
 Handle open_file(const std::string& path, bool writable = false);
 
 Handle create_group(hid_t parent, const std::string& name);
@@ -91,7 +92,10 @@ inline void write_dataset(hid_t parent, const std::string& name, const std::vect
 }
 
 std::vector<hsize_t> dataset_dims(hid_t dataset);
-// The whole dataset converted to double / int / long; dims receives its shape.
+// The readers refuse a dataset larger than this (a damaged file can claim any shape).
+constexpr hsize_t kMaxReadBytes = hsize_t{16} << 30;
+// The whole dataset converted to double / int / long; dims receives its shape. Throws
+// std::runtime_error for a missing dataset or one of more than kMaxReadBytes.
 std::vector<double> read_doubles(hid_t parent, const std::string& name,
                                  std::vector<hsize_t>* dims = nullptr);
 std::vector<int> read_ints(hid_t parent, const std::string& name,
