@@ -17,6 +17,7 @@ struct RunArgs {
   std::vector<std::string> sets;  // --set path=value, in order
   std::string restart;            // --restart: checkpoint file
   bool quiet = false;             // --quiet: no progress bar
+  bool overwrite = false;         // --overwrite: replace an existing -o file once complete
 };
 
 // jelly run: load the scene with its overrides, simulate, record, summarise.
@@ -30,6 +31,7 @@ struct FitArgs {
   std::vector<std::string> initial;  // --initial name=value: starting values
   int max_iterations = 50;           // --max-iterations
   std::string write_scene;           // --write-scene: the scene with the fitted values
+  bool overwrite = false;            // --overwrite: replace an existing --write-scene file
 };
 
 // jelly fit RECORDING.h5: the spring and damper coefficients that replay the recording best.

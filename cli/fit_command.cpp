@@ -1,5 +1,11 @@
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 
 #include <jelly/core/errors.hpp>
@@ -25,9 +31,59 @@ std::pair<std::string, Real> parse_initial(const std::string& assignment) {
   return {assignment.substr(0, eq), number};
 }
 
+// --write-scene: checked before the fit (which takes a while) so that a file it would destroy
+// (the recording, or any existing file without --overwrite) or cannot write is an error at once.
+void check_write_scene(const FitArgs& args) {
+  const std::string& path = args.write_scene;
+  struct stat target {
+  }, recording{};
+  if (stat(path.c_str(), &target) == 0) {
+    if (stat(args.recording.c_str(), &recording) == 0 && target.st_dev == recording.st_dev &&
+        target.st_ino == recording.st_ino) {
+      throw InputError("--write-scene " + path + " is the recording: it would be overwritten");
+    }
+    if (!S_ISREG(target.st_mode)) {
+      throw InputError("--write-scene " + path + " exists and is not a file");
+    }
+    if (!args.overwrite) {
+      throw InputError("--write-scene " + path +
+                       " exists (a file this run did not create): pass --overwrite to replace "
+                       "it, or choose another name");
+    }
+    if (access(path.c_str(), W_OK) != 0) {
+      throw InputError("--write-scene " + path + ": " + std::strerror(errno));
+    }
+    return;
+  }
+  const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0) throw InputError("--write-scene " + path + ": " + std::strerror(errno));
+  close(fd);
+  std::remove(path.c_str());
+}
+
+// Writes under a temporary name, then renames: a failure leaves no half-written scene.
+void write_text_file(const std::string& path, const std::string& text) {
+  const std::string partial = path + ".partial-" + std::to_string(static_cast<long>(getpid()));
+  {
+    std::ofstream out(partial);
+    out << text;
+    out.close();
+    if (!out) {
+      std::remove(partial.c_str());
+      throw std::runtime_error("--write-scene " + path + ": cannot write " + partial);
+    }
+  }
+  if (std::rename(partial.c_str(), path.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    std::remove(partial.c_str());
+    throw std::runtime_error("--write-scene " + path + ": " + why);
+  }
+}
+
 }  // namespace
 
 int fit_command(const FitArgs& args) {
+  if (!args.write_scene.empty()) check_write_scene(args);
   const Recording recording = read_recording(args.recording);
   const Trajectory trajectory = trajectory_from_recording(recording);
   FitOptions options;
@@ -44,12 +100,7 @@ int fit_command(const FitArgs& args) {
   const FitResult result = fit_recording(trajectory, options);
   std::fputs(result.report().c_str(), stdout);
   if (!args.write_scene.empty()) {
-    std::ofstream out(args.write_scene);
-    require(static_cast<bool>(out), "--write-scene", args.write_scene,
-            "a file that can be written");
-    out << scene_to_json(fitted_scene(recording, result)) << "\n";
-    require(static_cast<bool>(out), "--write-scene", args.write_scene,
-            "a file that can be written");
+    write_text_file(args.write_scene, scene_to_json(fitted_scene(recording, result)) + "\n");
     std::printf("fitted scene written to %s\n", args.write_scene.c_str());
   }
   return kExitOk;

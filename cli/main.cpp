@@ -3,6 +3,7 @@
 // (render), export surfaces for other tools (export).
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -12,8 +13,16 @@
 
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "output.hpp"
 
 namespace {
+
+// An option given with an empty value ("-o ''") is a mistake, never "not given".
+const CLI::Validator kNonEmpty(
+    [](std::string& value) {
+      return value.empty() ? std::string("an empty value") : std::string();
+    },
+    "", "NONEMPTY");
 
 constexpr const char* kFooter =
     "Exit codes: 0 ok, 2 bad input (scene, option or argument), 3 the run diverged or the solver "
@@ -23,6 +32,7 @@ constexpr const char* kFooter =
 
 int main(int argc, char** argv) {
   using namespace jelly::cli;
+  prepare_output_library();
   CLI::App app{"jelly " JELLY_VERSION_STRING ": mass-spring soft-body simulation", "jelly"};
   app.footer(kFooter);
   app.require_subcommand(1);
@@ -31,36 +41,48 @@ int main(int argc, char** argv) {
   RunArgs run_args;
   CLI::App* run = app.add_subcommand("run", "Simulate a scene (JSON) and print a summary");
   run->add_option("scene", run_args.scene, "Scene file (JSON), e.g. scenes/seed_slope.json")
-      ->required();
+      ->required()
+      ->check(kNonEmpty);
   run->add_option("-o,--output", run_args.output,
-                  "Write the run to this HDF5 file (and an .xdmf beside it)");
+                  "Write the run to this HDF5 file (and an .xdmf beside it); an existing file "
+                  "is an error unless --overwrite")
+      ->check(kNonEmpty);
+  run->add_flag("--overwrite", run_args.overwrite,
+                "Replace an existing -o file (and its .xdmf), once the new recording is complete");
   run->add_option("--integrator", run_args.integrator,
-                  "Integrator name (see `jelly list`); overrides integrator.name");
-  run->add_option("--dt", run_args.dt, "Time step in s; overrides integrator.dt")->type_name("H");
+                  "Integrator name (see `jelly list`); overrides integrator.name")
+      ->check(kNonEmpty);
+  run->add_option("--dt", run_args.dt, "Time step in s; overrides integrator.dt")
+      ->type_name("H")
+      ->check(kNonEmpty);
   run->add_option("--duration", run_args.duration, "Simulated time in s; overrides duration")
-      ->type_name("T");
+      ->type_name("T")
+      ->check(kNonEmpty);
   run->add_option("--set", run_args.sets,
                   "Override a scene field, e.g. --set springs.structural.ks=2400 or "
                   "--set terrains[0].contact.restitution=0.5 (repeatable; the value is JSON, or "
                   "else a string)")
       ->type_name("PATH=VALUE")
-      ->allow_extra_args(false);  // one PATH=VALUE per --set; a scene after it stays positional
+      ->allow_extra_args(false)  // one PATH=VALUE per --set; a scene after it stays positional
+      ->check(kNonEmpty);
   run->add_option("--restart", run_args.restart,
-                  "Start from the last checkpoint of this HDF5 file (same scene)");
+                  "Start from the last checkpoint of this HDF5 file (same scene)")
+      ->check(kNonEmpty);
   run->add_flag("-q,--quiet", run_args.quiet, "No progress bar");
 
   std::string info_path;
   CLI::App* info = app.add_subcommand("info", "Describe an HDF5 file written by `jelly run -o`");
-  info->add_option("file", info_path, "HDF5 file")->required();
+  info->add_option("file", info_path, "HDF5 file")->required()->check(kNonEmpty);
 
   FitArgs fit_args;
   CLI::App* fit = app.add_subcommand(
       "fit", "Fit spring and damper coefficients to a recording (HDF5 from `jelly run -o`)");
-  fit->add_option("recording", fit_args.recording, "HDF5 file")->required();
+  fit->add_option("recording", fit_args.recording, "HDF5 file")->required()->check(kNonEmpty);
   fit->add_option("--free", fit_args.free,
                   "Coefficients to fit: ks,kd (all types together) or per type, e.g. "
                   "ks.structural,ks.shear,ks.bending,kd")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kNonEmpty);
   fit->add_option("--window", fit_args.window,
                   "Multiple-shooting window in s, each replayed from a recorded state; 0 = one "
                   "window")
@@ -69,11 +91,15 @@ int main(int argc, char** argv) {
                   "Starting value, e.g. --initial ks=1400 (repeatable; default: the recording's "
                   "coefficients)")
       ->type_name("NAME=VALUE")
-      ->allow_extra_args(false);
+      ->allow_extra_args(false)
+      ->check(kNonEmpty);
   fit->add_option("--max-iterations", fit_args.max_iterations, "Ceres iterations at most")
       ->capture_default_str();
   fit->add_option("--write-scene", fit_args.write_scene,
-                  "Write the recording's scene with the fitted coefficients to this JSON file");
+                  "Write the recording's scene with the fitted coefficients to this JSON file; an "
+                  "existing file is an error unless --overwrite")
+      ->check(kNonEmpty);
+  fit->add_flag("--overwrite", fit_args.overwrite, "Replace an existing --write-scene file");
 
   CLI::App* list = app.add_subcommand(
       "list", "List the integrators, terrain kinds and contact models, one per line");
@@ -164,6 +190,9 @@ int main(int argc, char** argv) {
   } catch (const jelly::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "error: out of memory\n");
+    return kExitInternalError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitInternalError;

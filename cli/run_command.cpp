@@ -1,5 +1,7 @@
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -7,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <jelly/core/errors.hpp>
+#include <jelly/io/run_limits.hpp>
 #include <jelly/io/scene.hpp>
 
 #include "commands.hpp"
@@ -30,16 +34,103 @@ std::vector<std::string> overrides(const RunArgs& args) {
   return out;
 }
 
+bool exists(const std::string& path, struct stat* info) { return stat(path.c_str(), info) == 0; }
+
+// Whether a and b name the same existing file (also through links or other spellings).
+bool same_file(const std::string& a, const std::string& b) {
+  struct stat x {
+  }, y{};
+  return exists(a, &x) && exists(b, &y) && x.st_dev == y.st_dev && x.st_ino == y.st_ino;
+}
+
+// A run never destroys a file it did not create unless told to (--overwrite), and never the
+// files it reads from: checked before anything is computed.
+void check_output_paths(const RunArgs& args) {
+  const std::string& out = args.output;
+  const std::string sidecar = sidecar_path_for(out);
+  const std::string o = "-o " + out;
+  if (sidecar == out) {
+    throw InputError(o +
+                     ": the recording is an HDF5 file and its XDMF sidecar is written beside it "
+                     "under the same name with .xdmf: name the recording .h5 (e.g. -o " +
+                     out.substr(0, out.size() - 5) + ".h5)");
+  }
+  if (same_file(out, args.scene)) {
+    throw InputError(o + " is the scene file: the recording would overwrite it");
+  }
+  if (same_file(sidecar, args.scene)) {
+    throw InputError(o + ": its XDMF sidecar " + sidecar +
+                     " is the scene file: the run would overwrite it");
+  }
+  if (!args.restart.empty() && same_file(out, args.restart)) {
+    throw InputError(o +
+                     " is the --restart file: the continuation would replace the frames it "
+                     "holds; write it to another file");
+  }
+  struct stat info {};
+  for (const std::string& path : {out, sidecar}) {
+    if (!exists(path, &info)) continue;
+    const std::string what = path == out ? o : o + ": its XDMF sidecar " + path;
+    if (S_ISDIR(info.st_mode)) throw InputError(what + " is a directory");
+    if (!S_ISREG(info.st_mode)) throw InputError(what + " exists and is not a file");
+    if (!args.overwrite) {
+      throw InputError(what +
+                       " exists (a file this run did not create): pass --overwrite to replace it "
+                       "(only once the new recording is complete), or choose another name");
+    }
+  }
+}
+
+// Forwards frames to the recorder; a failure to write (a full disk) stops the run with
+// RecordingFailed instead of leaving it to the simulator's caller as a raw library error.
+struct RecordingFailed {
+  std::string message;
+};
+
+class GuardedRecorder final : public Observer {
+ public:
+  explicit GuardedRecorder(std::unique_ptr<Observer> recorder) : recorder_(std::move(recorder)) {}
+  void on_frame(const Simulator& sim) override {
+    guard([&] { recorder_->on_frame(sim); });
+  }
+  void on_finish(const Simulator& sim, const RunReport& report) override {
+    guard([&] { recorder_->on_finish(sim, report); });
+  }
+
+ private:
+  template <typename F>
+  void guard(F&& f) {
+    try {
+      f();
+    } catch (const std::exception& e) {
+      throw RecordingFailed{e.what()};
+    }
+  }
+  std::unique_ptr<Observer> recorder_;
+};
+
 }  // namespace
 
 int run_command(const RunArgs& args) {
   const Scene scene = load_scene(args.scene, overrides(args));
+  std::shared_ptr<const Checkpoint> checkpoint;
+  if (!args.restart.empty()) checkpoint = read_restart(args.restart, scene);
+  if (!args.output.empty()) check_output_paths(args);
+
+  RunLimits limits;
+  if (!args.output.empty()) limits.disk_bytes = free_disk_bytes(args.output);
+  check_run_limits(scene, checkpoint ? checkpoint_time(*checkpoint) : 0, limits, args.output,
+                   args.restart);
+
   Simulator sim = make_simulator(scene);
-  if (!args.restart.empty()) restore_from_file(sim, args.restart);
+  if (checkpoint) restore_from(sim, *checkpoint, args.restart);
 
   std::unique_ptr<Observer> recorder;
+  struct stat output_info {};
+  const bool replacing = !args.output.empty() && exists(args.output, &output_info);
   if (!args.output.empty()) {
-    recorder = make_recorder(args.output, sim, scene);
+    recorder =
+        std::make_unique<GuardedRecorder>(make_recorder(args.output, sim, scene, args.overwrite));
     sim.add_observer(*recorder);
   }
   std::unique_ptr<ProgressBar> progress;
@@ -48,7 +139,35 @@ int run_command(const RunArgs& args) {
     sim.add_observer(*progress);
   }
 
-  const RunReport report = sim.run_until(scene.duration);
+  const long steps_before = sim.total_steps();
+  const long evaluations_before = sim.force_evaluations();
+  const auto start = std::chrono::steady_clock::now();
+  RunReport report;
+  try {
+    report = sim.run_until(scene.duration);
+  } catch (const RecordingFailed& failure) {
+    // What the run did up to here, then why it stopped.
+    report.t = sim.state().t;
+    report.steps = sim.total_steps() - steps_before;
+    report.force_evaluations = sim.force_evaluations() - evaluations_before;
+    report.statistics = sim.integrator().statistics();
+    report.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (progress) progress->on_finish(sim, report);
+    char headline[160];
+    std::snprintf(headline, sizeof headline,
+                  "stopped at t = %g s after %ld steps: the recording failed", report.t,
+                  report.steps);
+    print_summary(stdout, scene, sim, report, args.output, headline);
+    std::fflush(stdout);
+    recorder.reset();  // closes the file (and drops an unfinished replacement)
+    const bool replaced_nothing = args.overwrite && replacing;
+    std::fprintf(stderr, "error: writing %s failed: %s (%s)\n", args.output.c_str(),
+                 failure.message.c_str(),
+                 replaced_nothing ? "the existing file of that name is left as it was"
+                                  : salvage_note(args.output).c_str());
+    return kExitInternalError;
+  }
   print_summary(stdout, scene, sim, report, args.output);
   std::fflush(stdout);
   if (!report.ok()) {

@@ -5,12 +5,14 @@
 namespace jelly::cli {
 
 void print_summary(std::FILE* out, const Scene& scene, const Simulator& sim,
-                   const RunReport& report, const std::string& output_path) {
+                   const RunReport& report, const std::string& output_path,
+                   const std::string& headline) {
   const Model& m = sim.model();
   const State& s = sim.state();
   const Vec3 com = center_of_mass(m, s);
   const double rate = report.wall_seconds > 0 ? report.steps / report.wall_seconds : 0;
-  std::fprintf(out, "jelly run: %s\n", report.brief().c_str());
+  std::fprintf(out, "jelly run: %s\n",
+               headline.empty() ? report.brief().c_str() : headline.c_str());
   std::fprintf(out, "  integrator      %s, dt = %g s\n", scene.integrator.name.c_str(),
                scene.integrator.dt);
   std::fprintf(out, "  steps           %ld (%.0f steps/s), %ld force evaluations\n", report.steps,

@@ -10,7 +10,9 @@
 
 namespace jelly::cli {
 
+// `headline` replaces the report's own first line (report.brief()) when not empty.
 void print_summary(std::FILE* out, const Scene& scene, const Simulator& sim,
-                   const RunReport& report, const std::string& output_path);
+                   const RunReport& report, const std::string& output_path,
+                   const std::string& headline = "");
 
 }  // namespace jelly::cli

@@ -15,60 +15,15 @@
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
+#include "cli/cli_support.hpp"
+
 namespace jelly {
 namespace {
 
 using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
-
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// A fresh path in the test's temporary directory.
-std::string temp_path(const std::string& suffix) {
-  std::string pattern = ::testing::TempDir() + "jelly_cli_XXXXXX";
-  const int fd = mkstemp(pattern.data());
-  if (fd >= 0) close(fd);
-  std::remove(pattern.c_str());
-  return pattern + suffix;
-}
-
-// Runs `jelly ARGS` with stdout and stderr captured (neither is a terminal).
-Result jelly(const std::string& args) {
-  const std::string out = temp_path(".out");
-  const std::string err = temp_path(".err");
-  const std::string command =
-      std::string("'") + JELLY_CLI + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
-  const int status = std::system(command.c_str());
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_file(out);
-  r.err = read_file(err);
-  std::remove(out.c_str());
-  std::remove(err.c_str());
-  return r;
-}
-
-std::string scene(const std::string& name) { return std::string(JELLY_SCENES_DIR) + "/" + name; }
-
-// The seed slope on a 3x3x3 cube: fast.
-const std::string kSmallSlope = "'" + scene("seed_slope.json") + "' --set cube.n=3";
-
-std::string write_scene(const std::string& text) {
-  const std::string path = temp_path(".json");
-  std::ofstream(path) << text;
-  return path;
-}
+using namespace cli_testing;
 
 TEST(Cli, ListNamesEveryIntegratorTerrainKindAndContactModel) {
   const Result r = jelly("list");

@@ -1,0 +1,321 @@
+// The jelly program as an attacker or a careless user runs it (issue 16): no crash, no hang, no
+// lost file, no silent run, and the documented exit codes. Each test is one class of finding.
+#include <hdf5.h>
+
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "cli/cli_support.hpp"
+
+namespace jelly {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::AnyOf;
+using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::StartsWith;
+using namespace cli_testing;
+
+std::string quoted(const std::string& path) { return "'" + path + "'"; }
+
+bool exists(const std::string& path) {
+  struct stat info {};
+  return stat(path.c_str(), &info) == 0;
+}
+
+// A short recording of the small slope (0.1 s) at `path`.
+void record(const std::string& path, const std::string& extra = "") {
+  const Result r = jelly("run " + kSmallSlope + " --duration 0.1 -q -o " + quoted(path) + extra);
+  ASSERT_EQ(r.code, 0) << r.err;
+}
+
+// Sets attribute `name` of `object` in an HDF5 file to a double or a string.
+void set_attribute(const std::string& path, const std::string& object, const std::string& name,
+                   double value) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t group = H5Oopen(file, object.c_str(), H5P_DEFAULT);
+  const hid_t attribute = H5Aopen(group, name.c_str(), H5P_DEFAULT);
+  H5Awrite(attribute, H5T_NATIVE_DOUBLE, &value);
+  H5Aclose(attribute);
+  H5Oclose(group);
+  H5Fclose(file);
+}
+
+void set_attribute(const std::string& path, const std::string& object, const std::string& name,
+                   const std::string& value) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t group = H5Oopen(file, object.c_str(), H5P_DEFAULT);
+  H5Adelete(group, name.c_str());
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t attribute = H5Acreate2(group, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
+  const char* text = value.c_str();
+  H5Awrite(attribute, type, &text);
+  H5Aclose(attribute);
+  H5Sclose(space);
+  H5Tclose(type);
+  H5Oclose(group);
+  H5Fclose(file);
+}
+
+// ---- Crashes ----
+
+std::string nested(int depth) { return std::string(depth, '[') + std::string(depth, ']'); }
+
+TEST(Crashes, DeeplyNestedJsonInASceneOrASetValueExitsTwo) {
+  const std::string deep = write_scene(R"({"description": )" + nested(100000) +
+                                       R"(, "integrator": {"name": "rk4"}, "duration": 1})");
+  Result r = jelly("run " + quoted(deep));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("deeper than 64 levels at description[0][0]"));
+  r = jelly("run " + kSmallSlope + " --set 'description=" + nested(30000) + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("deeper than 64 levels"));
+}
+
+TEST(Crashes, DeeplyNestedSceneStoredInARecordingExitsTwo) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  set_attribute(file, "/parameters", "scene_json", R"({"description": )" + nested(100000) + "}");
+  Result r = jelly("fit " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("deeper than 64 levels"));
+  r = jelly("run " + kSmallSlope + " --duration 0.2 --restart " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, AllOf(StartsWith("error: --restart "), HasSubstr("deeper than 64 levels")));
+}
+
+// ---- Data loss ----
+
+TEST(DataLoss, ASecondRunDoesNotReplaceAnExistingRecording) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string before = read_file(file);
+  // Not even when the second run would have failed (it diverges here).
+  Result r =
+      jelly("run " + kSmallSlope + " --integrator explicit_euler --dt 0.05 -o " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("exists (a file this run did not create): pass --overwrite"));
+  EXPECT_EQ(read_file(file), before);
+  // With --overwrite it is replaced once the new recording is complete.
+  r = jelly("run " + kSmallSlope + " --duration 0.2 -q --overwrite -o " + quoted(file));
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = jelly("info " + quoted(file));
+  EXPECT_THAT(r.out, HasSubstr("t = 0 .. 0.2"));
+}
+
+TEST(DataLoss, TheSceneFileIsNeverTheOutput) {
+  const std::string scene_file = write_scene(
+      R"({"terrains": [{"kind": "slope"}], "cube": {"n": 3}, "integrator": {"name": "rk4"},
+          "duration": 0.1})");
+  const std::string before = read_file(scene_file);
+  Result r = jelly("run " + quoted(scene_file) + " --overwrite -o " + quoted(scene_file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("is the scene file: the recording would overwrite it"));
+  // Nor its sidecar: scene.xdmf as the scene, -o scene.h5.
+  const std::string xdmf_scene = temp_path(".xdmf");
+  std::rename(scene_file.c_str(), xdmf_scene.c_str());
+  const std::string h5 = xdmf_scene.substr(0, xdmf_scene.size() - 5) + ".h5";
+  r = jelly("run " + quoted(xdmf_scene) + " --overwrite -o " + quoted(h5));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("is the scene file: the run would overwrite it"));
+  EXPECT_EQ(read_file(xdmf_scene), before);
+}
+
+TEST(DataLoss, ARecordingNamedXdmfIsRefused) {
+  const std::string file = temp_path(".xdmf");
+  const Result r = jelly("run " + kSmallSlope + " --duration 0.1 -o " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("name the recording .h5"));
+  EXPECT_FALSE(exists(file));
+}
+
+TEST(DataLoss, ARestartNeverWritesOverItsCheckpointFile) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string before = read_file(file);
+  const Result r = jelly("run " + kSmallSlope + " --duration 0.2 --overwrite --restart " +
+                         quoted(file) + " -o " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("is the --restart file: the continuation would replace the frames"));
+  EXPECT_EQ(read_file(file), before);
+}
+
+TEST(DataLoss, FitWritesNoSceneOverAnExistingFile) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string before = read_file(file);
+  Result r = jelly("fit " + quoted(file) + " --write-scene " + quoted(file) + " --overwrite");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("is the recording: it would be overwritten"));
+  EXPECT_EQ(read_file(file), before);
+  const std::string other = write_scene("{}");
+  r = jelly("fit " + quoted(file) + " --write-scene " + quoted(other));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("exists (a file this run did not create): pass --overwrite"));
+  EXPECT_EQ(read_file(other), "{}");
+}
+
+// ---- Hangs ----
+
+TEST(Hangs, ACharacterDeviceAsTheSceneExitsTwo) {
+  const Result r = jelly("run /dev/zero");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "error: cannot read the scene file '/dev/zero': it is a character device, "
+            "not a file\n");
+}
+
+TEST(Hangs, AbsurdStepAndFrameCountsExitTwoBeforeTheRun) {
+  Result r = jelly("run " + kSmallSlope + " --dt 1e-12");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: integrator.dt = 1e-12 is invalid: a step that is not lost "
+                                "to rounding at t = 5 s"));
+  r = jelly("run " + kSmallSlope + " --dt 1e-9");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: integrator.dt = 1e-09 is invalid: a step giving at most "
+                                "1000000000 steps"));
+  r = jelly("run " + kSmallSlope + " --set output_interval=1e-300");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: output_interval = 1e-300 is invalid"));
+  r = jelly("run " + kSmallSlope + " --duration 1e300");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: integrator.dt = 0.001 is invalid: a step that is not lost "
+                                "to rounding at t = 1e+300 s"));
+}
+
+TEST(Hangs, CheckpointsWithAbsurdTimesExitTwo) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  set_attribute(file, "/checkpoint", "t", -1e300);  // t + dt == t
+  Result r = jelly("run " + kSmallSlope + " --duration 0.2 --restart " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: integrator.dt = 0.001 is invalid: a step that is not lost "
+                                "to rounding at t = 1e+300 s"));
+  record(file, " --overwrite");
+  set_attribute(file, "/checkpoint", "next_output", -1e300);
+  r = jelly("run " + kSmallSlope + " --duration 0.2 --restart " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("checkpoint next_output = -1.0000000000000001e+300 is invalid"));
+}
+
+// ---- Silent runs ----
+
+TEST(SilentRuns, EmptyOptionValuesExitTwo) {
+  for (const std::string option :
+       {"-o", "--duration", "--dt", "--integrator", "--set", "--restart"}) {
+    const Result r = jelly("run " + kSmallSlope + " " + option + " ''");
+    EXPECT_EQ(r.code, 2) << option;
+    EXPECT_THAT(r.err, HasSubstr(": an empty value")) << option;
+  }
+  const Result r = jelly("info ''");
+  EXPECT_EQ(r.code, 2);
+}
+
+TEST(SilentRuns, ATimeStepLongerThanTheDurationExitsTwo) {
+  const Result r = jelly("run " + kSmallSlope + " --dt 1 --duration 0.3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "error: integrator.dt = 1 is invalid: larger than twice the duration (0.3 s): "
+            "the run would take no step\n");
+}
+
+TEST(SilentRuns, DuplicateJsonKeysExitTwo) {
+  const std::string file =
+      write_scene(R"({"integrator": {"name": "rk4"}, "duration": 1, "cube": {"n": 3, "n": 4}})");
+  const Result r = jelly("run " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("the key \"n\" appears twice in cube"));
+}
+
+TEST(SilentRuns, ARestartOfAnotherSceneExitsTwo) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string restart = " --duration 0.2 -q --restart " + quoted(file);
+  Result r = jelly("run " + kSmallSlope + restart + " --set springs.structural.ks=2400");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("its run had springs.structural.ks = 1400.0, this scene has 2400.0: "
+                               "a restart continues the same run"));
+  r = jelly("run " + kSmallSlope + restart + " --set gravity=[0,-1,0]");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("its run had gravity[1] = -9.8, this scene has -1.0"));
+  r = jelly("run " + kSmallSlope + restart + " --set terrains=[]");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("its run had terrains = [{"));
+  // What may change: the duration (that is the point), the output interval, the description.
+  r = jelly("run " + kSmallSlope + restart + " --set output_interval=0.01 --set description=x");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, StartsWith("jelly run: completed at t = 0.2 s after 100 steps"));
+}
+
+TEST(SilentRuns, ARestartAtOrAfterTheDurationExitsTwo) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const Result r = jelly("run " + kSmallSlope + " --duration 0.1 --restart " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: duration = 0.1 is invalid: the run would take no step: "
+                                "it starts at t = 0.1"));
+}
+
+// ---- Wrong exit codes and messages ----
+
+TEST(ExitCodes, ANumberBeyondADoubleExitsTwo) {
+  const Result r = jelly("run " + kSmallSlope + " --set springs.shear.ks=1e999");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("number overflow parsing '1e999'"));
+}
+
+TEST(ExitCodes, ACubeBeyondMemoryExitsTwoWithTheEstimate) {
+  const std::string s = "'" + scene("seed_slope.json") + "'";
+  const Result r = jelly("run " + s + " --set cube.n=400");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: cube.n = 400 is invalid: a cube that fits in memory: the "
+                                "run needs about 100.7 GB (64000000 particles"));
+}
+
+TEST(ExitCodes, AnUnwritableSidecarExitsTwoBeforeTheRun) {
+  const std::string file = temp_path(".h5");
+  const std::string sidecar = file.substr(0, file.size() - 3) + ".xdmf";
+  ASSERT_EQ(mkdir(sidecar.c_str(), 0755), 0);
+  const auto start = std::chrono::steady_clock::now();
+  const Result r = jelly("run " + kSmallSlope + " --duration 2 -o " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr(sidecar + " is a directory"));
+  EXPECT_EQ(r.out, "");  // no run, no summary
+  EXPECT_FALSE(exists(file));
+  rmdir(sidecar.c_str());
+  (void)start;
+}
+
+TEST(ExitCodes, AFullDiskExitsOneWithASummaryAndAClearMessage) {
+  // A file size limit (ulimit -f, with SIGXFSZ ignored) fails the writes as a full disk does.
+  const std::string file = temp_path(".h5");
+  const std::string command = "sh -c \"trap '' XFSZ; ulimit -f 256; exec '" +
+                              std::string(JELLY_CLI) + "' run " + scene("seed_slope.json") +
+                              " --set cube.n=4 --set output_interval=0 --duration 1 -o '" + file +
+                              "'\"";
+  const std::string out = temp_path(".out"), err = temp_path(".err");
+  const int status = std::system((command + " >'" + out + "' 2>'" + err + "'").c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1) << read_file(err);
+  const std::string stdout_text = read_file(out), stderr_text = read_file(err);
+  EXPECT_THAT(stdout_text, StartsWith("jelly run: stopped at t = "));
+  EXPECT_THAT(stdout_text, HasSubstr("the recording failed\n  integrator      rk4"));
+  EXPECT_THAT(stderr_text, StartsWith("error: writing " + file + " failed: "));
+  EXPECT_THAT(stderr_text, HasSubstr("File too large"));
+  // What was flushed may be readable or not (HDF5 is not crash consistent): the message says.
+  EXPECT_THAT(stderr_text, AnyOf(HasSubstr("(it keeps "), HasSubstr("(it cannot be read back: ")));
+  EXPECT_THAT(stderr_text, Not(HasSubstr("infinite loop")));
+  EXPECT_EQ(std::count(stderr_text.begin(), stderr_text.end(), '\n'), 1) << stderr_text;
+}
+
+}  // namespace
+}  // namespace jelly

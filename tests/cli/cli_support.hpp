@@ -1,0 +1,66 @@
+#pragma once
+// Running the jelly program as users do, for the CLI tests: exit code, stdout and stderr.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace jelly::cli_testing {
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+inline std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A fresh path in the test's temporary directory.
+inline std::string temp_path(const std::string& suffix) {
+  std::string pattern = ::testing::TempDir() + "jelly_cli_XXXXXX";
+  const int fd = mkstemp(pattern.data());
+  if (fd >= 0) close(fd);
+  std::remove(pattern.c_str());
+  return pattern + suffix;
+}
+
+// Runs `jelly ARGS` with stdout and stderr captured (neither is a terminal).
+inline Result jelly(const std::string& args) {
+  const std::string out = temp_path(".out");
+  const std::string err = temp_path(".err");
+  const std::string command =
+      std::string("'") + JELLY_CLI + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+  const int status = std::system(command.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_file(out);
+  r.err = read_file(err);
+  std::remove(out.c_str());
+  std::remove(err.c_str());
+  return r;
+}
+
+inline std::string scene(const std::string& name) {
+  return std::string(JELLY_SCENES_DIR) + "/" + name;
+}
+
+// The seed slope on a 3x3x3 cube: fast.
+inline const std::string kSmallSlope = "'" + scene("seed_slope.json") + "' --set cube.n=3";
+
+inline std::string write_scene(const std::string& text) {
+  const std::string path = temp_path(".json");
+  std::ofstream(path) << text;
+  return path;
+}
+
+}  // namespace jelly::cli_testing
