@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <jelly/core/errors.hpp>
+
 namespace jelly::bench {
 
 namespace {
@@ -79,13 +81,13 @@ void write_csv(const std::string& path, const Table& table, const Metadata& meta
 
 Table read_csv(const std::string& path, Metadata* metadata) {
   std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read " + path);
+  if (!in) throw InputError("cannot read " + path);
   std::string line, name, description;
   std::vector<std::string> types;
   Metadata meta;
   int number = 0;
   const auto fail = [&](const std::string& why) {
-    throw std::runtime_error(path + ":" + std::to_string(number) + ": " + why);
+    throw InputError(path + ":" + std::to_string(number) + ": " + why);
   };
   std::vector<std::string> header;
   while (std::getline(in, line)) {

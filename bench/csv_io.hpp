@@ -9,7 +9,7 @@
 namespace jelly::bench {
 
 void write_csv(const std::string& path, const Table& table, const Metadata& metadata);
-// Throws std::runtime_error naming the file and line when it is not a jelly-bench CSV.
+// Throws jelly::InputError naming the file and line when it is not a jelly-bench CSV.
 Table read_csv(const std::string& path, Metadata* metadata = nullptr);
 
 }  // namespace jelly::bench

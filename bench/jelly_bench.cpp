@@ -30,11 +30,17 @@ struct Common {
 
 void add_common(CLI::App* app, Common& c) {
   app->add_option("--out", c.out, "output directory for CSV and HDF5")->capture_default_str();
-  app->add_flag("--quick", c.quick, "small cubes, short horizons, few points (CI)");
+  app->add_flag("--quick", c.quick,
+                "small cubes, short horizons, few points (CI); options given explicitly are kept");
   app->add_option("--shard", c.shard, "run only work items k with k mod N == i")
       ->capture_default_str();
   app->add_option("--integrators", c.integrators, "comma-separated names (default: all registered)")
       ->delimiter(',');
+}
+
+// How often an option was given on the command line (0: its default stands).
+std::size_t given(const CLI::App* command, const std::string& option) {
+  return command->count(option);
 }
 
 }  // namespace
@@ -126,15 +132,31 @@ int main(int argc, char** argv) {
   merge_cmd->add_option("inputs", merge_inputs, "directories or CSV files")->required();
   merge_cmd->add_option("--out", merge_out, "output directory")->capture_default_str();
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::cerr << "error: " << e.what() << "\nRun 'jelly-bench --help' for usage.\n";
+    return 2;
+  }
   try {
     const Metadata metadata = run_metadata(arguments);
     if (merge_cmd->parsed()) {
-      const MergedRun run = merge_csv(merge_inputs);
-      std::vector<Table> tables;
-      for (const auto& [name, table] : run.tables) tables.push_back(table);
-      // Summaries are recomputed from the merged rows (and replace any read back).
-      std::vector<Table> summaries = summary_tables(run.command, tables);
+      // Everything read from the CSV files is input: what is wrong with it is bad input.
+      MergedRun run;
+      std::vector<Table> tables, summaries;
+      try {
+        run = merge_csv(merge_inputs);
+        for (const auto& [name, table] : run.tables) tables.push_back(table);
+        // Summaries are recomputed from the merged rows (and replace any read back).
+        summaries = summary_tables(run.command, tables);
+      } catch (const InputError&) {
+        throw;
+      } catch (const std::bad_alloc&) {
+        throw;
+      } catch (const std::exception& e) {
+        throw InputError(std::string("merge: ") + e.what());
+      }
       for (const Table& summary : summaries) {
         tables.erase(std::remove_if(tables.begin(), tables.end(),
                                     [&](const Table& t) { return t.name() == summary.name(); }),
@@ -153,11 +175,11 @@ int main(int argc, char** argv) {
       command = "stability";
       require(!(kd_given && ratio_given), "--kd", "given with --kd-ratio", "one of the two");
       stability.contact = contact_model_from_name(contact, "--contact");
-      if (common.quick) {
-        stability.n = 4;
-        stability.horizon = 1;
-        if (stability_cmd->count("--ks") == 0) stability.ks = {1400, 5600};
-        stability.bracket.tolerance = std::max(stability.bracket.tolerance, 0.1);
+      if (common.quick) {  // smaller defaults; an option given explicitly is kept
+        if (given(stability_cmd, "--n") == 0) stability.n = 4;
+        if (given(stability_cmd, "--horizon") == 0) stability.horizon = 1;
+        if (given(stability_cmd, "--ks") == 0) stability.ks = {1400, 5600};
+        if (given(stability_cmd, "--tolerance") == 0) stability.bracket.tolerance = 0.1;
       }
       stability.integrators = common.integrators;
       stability.shard = shard;
@@ -166,10 +188,10 @@ int main(int argc, char** argv) {
     } else if (accuracy_cmd->parsed()) {
       command = "accuracy";
       if (common.quick) {
-        accuracy.n = 3;
-        accuracy.t_end = 0.2;
-        if (accuracy_cmd->count("--dt") == 0) accuracy.dts = {1e-3, 5e-4, 2.5e-4};
-        accuracy.drift_t_end = 1;
+        if (given(accuracy_cmd, "--n") == 0) accuracy.n = 3;
+        if (given(accuracy_cmd, "--t-end") == 0) accuracy.t_end = 0.2;
+        if (given(accuracy_cmd, "--dt") == 0) accuracy.dts = {1e-3, 5e-4, 2.5e-4};
+        if (given(accuracy_cmd, "--drift-t-end") == 0) accuracy.drift_t_end = 1;
       }
       accuracy.integrators = common.integrators;
       accuracy.shard = shard;
@@ -177,9 +199,9 @@ int main(int argc, char** argv) {
     } else if (speed_cmd->parsed()) {
       command = "speed";
       if (common.quick) {
-        if (speed_cmd->count("--sizes") == 0) speed.sizes = {3, 5};
-        speed.steps = 20;
-        speed.warmup_steps = 5;
+        if (given(speed_cmd, "--sizes") == 0) speed.sizes = {3, 5};
+        if (given(speed_cmd, "--steps") == 0) speed.steps = 20;
+        speed.warmup_steps = std::min(speed.warmup_steps, 5);
       }
       speed.integrators = common.integrators;
       speed.shard = shard;
@@ -187,8 +209,8 @@ int main(int argc, char** argv) {
     } else if (seed_cmd->parsed()) {
       command = "seed";
       if (common.quick) {
-        seed.n = 4;
-        seed.horizon = 0.5;
+        if (given(seed_cmd, "--n") == 0) seed.n = 4;
+        if (given(seed_cmd, "--horizon") == 0) seed.horizon = 0.5;
       }
       seed.integrators = common.integrators;
       seed.shard = shard;

@@ -54,10 +54,10 @@ MergedRun merge_csv(const std::vector<std::string>& paths) {
     } else if (fs::exists(p)) {
       files.push_back(p);
     } else {
-      throw std::runtime_error("merge: no file or directory " + p);
+      throw InputError("merge: no file or directory " + p);
     }
   }
-  if (files.empty()) throw std::runtime_error("merge: no CSV file found");
+  if (files.empty()) throw InputError("merge: no CSV file found");
 
   struct Part {
     Shard shard;
@@ -75,8 +75,8 @@ MergedRun merge_csv(const std::vector<std::string>& paths) {
       run.command = command;
       run.metadata = meta;
     } else if (command != run.command) {
-      throw std::runtime_error("merge: " + file + " comes from '" + command + "', not '" +
-                               run.command + "'");
+      throw InputError("merge: " + file + " comes from '" + command + "', not '" + run.command +
+                       "'");
     }
     const Shard shard = Shard::parse(meta.count("shard") ? meta["shard"] : "0/1");
     parts[t.name()].push_back({shard, std::move(t), file});
@@ -87,18 +87,17 @@ MergedRun merge_csv(const std::vector<std::string>& paths) {
     std::set<int> seen;
     for (const Part& p : list) {
       if (p.shard.count != count) {
-        throw std::runtime_error("merge: table " + name + " mixes splits into " +
-                                 std::to_string(count) + " and " + std::to_string(p.shard.count) +
-                                 " shards (" + p.file + ")");
+        throw InputError("merge: table " + name + " mixes splits into " + std::to_string(count) +
+                         " and " + std::to_string(p.shard.count) + " shards (" + p.file + ")");
       }
       if (!seen.insert(p.shard.index).second) {
-        throw std::runtime_error("merge: table " + name + " has shard " + p.shard.text() +
-                                 " twice (" + p.file + ")");
+        throw InputError("merge: table " + name + " has shard " + p.shard.text() + " twice (" +
+                         p.file + ")");
       }
     }
     if (static_cast<int>(seen.size()) != count) {
-      throw std::runtime_error("merge: table " + name + " has " + std::to_string(seen.size()) +
-                               " of its " + std::to_string(count) + " shards");
+      throw InputError("merge: table " + name + " has " + std::to_string(seen.size()) + " of its " +
+                       std::to_string(count) + " shards");
     }
     Table merged = list.front().table;
     for (std::size_t i = 1; i < list.size(); ++i) merged.append(list[i].table);

@@ -30,7 +30,7 @@ struct MergedRun {
 // Reads jelly-bench CSV files, given as files or directories (every *.csv inside, or only the
 // *.shard-* ones when there are any), groups them by
 // table, checks that each table has every shard of one split exactly once and that all come from
-// one command, and concatenates the rows in item order. Throws std::runtime_error otherwise.
+// one command, and concatenates the rows in item order. Throws jelly::InputError otherwise.
 MergedRun merge_csv(const std::vector<std::string>& paths);
 
 }  // namespace jelly::bench

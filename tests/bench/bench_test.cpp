@@ -222,7 +222,7 @@ TEST(Shard, MergedShardsEqualUnshardedRun) {
   expect_equal_tables(merged.tables.at("stability"), whole);
   // A missing shard is an error, not a silently shorter table.
   fs::remove(dir / "stability.shard-1-of-3.csv");
-  EXPECT_THROW(merge_csv({dir.string()}), std::runtime_error);
+  EXPECT_THROW(merge_csv({dir.string()}), InputError);
   fs::remove_all(dir);
 }
 

@@ -1,0 +1,95 @@
+// jelly-bench as users run it: bad arguments and bad CSV input exit 2 with "error: ...", and
+// --quick only changes the defaults of options that were not given.
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+namespace fs = std::filesystem;
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class BenchCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "jelly-bench-cli-XXXXXX").string();
+    dir_ = mkdtemp(pattern.data());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result bench(const std::string& args) {
+    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
+    const std::string command = std::string("'") + JELLY_BENCH + "' " + args + " >'" +
+                                out.string() + "' 2>'" + err.string() + "' </dev/null";
+    const int status = std::system(command.c_str());
+    Result r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = read_file(out);
+    r.err = read_file(err);
+    return r;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(BenchCli, CommandLineErrorsExitTwoWithError) {
+  // CLI11's own exit codes (105, 106, 109, ...) are not the project's.
+  for (const std::string args : {"", "stability --bogus", "fly", "speed --steps abc", "merge"}) {
+    const Result r = bench(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_THAT(r.err, StartsWith("error: ")) << args;
+  }
+  const Result help = bench("--help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_THAT(help.out, HasSubstr("stability"));
+}
+
+TEST_F(BenchCli, GarbageCsvExitsTwoWithError) {
+  const fs::path garbage = dir_ / "garbage.csv";
+  std::ofstream(garbage) << "not,a,jelly-bench\ntable\n";
+  Result r = bench("merge '" + garbage.string() + "' --out '" + (dir_ / "out").string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: " + garbage.string() + ":1: not a jelly-bench table"));
+
+  const fs::path bad_number = dir_ / "bad_number.csv";
+  std::ofstream(bad_number) << "# command: speed\n# table: speed\n# types: n\nsteps\nmany\n";
+  r = bench("merge '" + bad_number.string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr(":5: 'many' is not a number"));
+
+  r = bench("merge '" + (dir_ / "missing").string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: merge: no file or directory "));
+}
+
+TEST_F(BenchCli, QuickKeepsOptionsGivenExplicitly) {
+  const Result r = bench("speed --quick --sizes 3 --steps 7 --integrators rk4 --out '" +
+                         (dir_ / "out").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = read_file(dir_ / "out" / "speed.csv");
+  // The row of the one configuration: item 0, rk4, n = 3, ..., steps = 7 (not --quick's 20).
+  EXPECT_THAT(csv, HasSubstr("\n0,rk4,3,27,185,0.001,7,completed,"));
+}
+
+}  // namespace
