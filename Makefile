@@ -27,7 +27,7 @@ test: build
 # scripts/plot.py is there, and the video (jelly render; exit 2 = built without the viewer).
 demo: build
 	@mkdir -p out
-	$(JELLY) run scenes/seed_slope.json --duration 3 -o out/demo.h5
+	$(JELLY) run scenes/seed_slope.json --duration 3 -o out/demo.h5 --overwrite
 	@if [ -f scripts/plot.py ]; then /usr/bin/python3 scripts/plot.py out/demo.h5 -o out/demo.png; \
 	else echo "demo: scripts/plot.py is not in this tree: no plots"; fi
 	@status=0; $(JELLY) render out/demo.h5 -o out/demo.mp4 || status=$$?; \
