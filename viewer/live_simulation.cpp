@@ -1,5 +1,7 @@
 #include <jelly/viewer/live_simulation.hpp>
 
+#include <time.h>
+
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -16,6 +18,13 @@ using Clock = std::chrono::steady_clock;
 
 double now_seconds() {
   return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+}
+
+// CPU time of the calling thread (what a step costs, whatever else runs on the machine).
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 }  // namespace
@@ -186,7 +195,7 @@ bool LiveSimulation::take_commands() {
 
 bool LiveSimulation::step() {
   if (stopped_) return false;
-  const double start = now_seconds();
+  const double start = now_seconds(), start_cpu = thread_cpu_seconds();
   try {
     const StepResult r = sim_->step();
     if (!r.ok) {
@@ -201,6 +210,7 @@ bool LiveSimulation::step() {
     message_ = e.what();
   }
   step_seconds_sum_ += now_seconds() - start;
+  step_cpu_seconds_sum_ += thread_cpu_seconds() - start_cpu;
   ++step_count_;
   if (status_ != RunStatus::kCompleted) {
     stopped_ = true;
@@ -222,8 +232,11 @@ void LiveSimulation::publish() {
     } else if (!sim_playing_) {
       steps_per_second_ = sim_rate_ = 0;
     }
-    if (step_count_ > 0) step_ms_ = 1e3 * step_seconds_sum_ / static_cast<double>(step_count_);
-    step_seconds_sum_ = 0;
+    if (step_count_ > 0) {
+      step_ms_ = 1e3 * step_seconds_sum_ / static_cast<double>(step_count_);
+      step_cpu_ms_ = 1e3 * step_cpu_seconds_sum_ / static_cast<double>(step_count_);
+    }
+    step_seconds_sum_ = step_cpu_seconds_sum_ = 0;
     step_count_ = 0;
     rate_wall_ = now;
     rate_steps_ = steps_;
@@ -242,6 +255,7 @@ void LiveSimulation::publish() {
   f.steps_per_second = steps_per_second_;
   f.sim_seconds_per_second = sim_rate_;
   f.step_milliseconds = step_ms_;
+  f.step_cpu_milliseconds = step_cpu_ms_;
   f.playing = sim_playing_;
   f.status = status_;
   f.message = message_;
@@ -266,7 +280,9 @@ bool LiveSimulation::refresh() {
 void LiveSimulation::advance_to(Real t_end) {
   take_commands();
   const Real dt = sim_->options().dt;
+  sim_playing_ = !stopped_;  // lockstep always plays (for the rates the panel shows)
   while (!stopped_ && sim_->state().t < t_end - 0.5 * dt) step();
+  playing_ = !stopped_;  // (the caller's thread is the UI's in lockstep)
   publish();
 }
 

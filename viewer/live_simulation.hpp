@@ -45,6 +45,7 @@ struct LiveFrame {
   double steps_per_second = 0;        // measured over the last half second of wall time
   double sim_seconds_per_second = 0;  // simulated seconds per wall second, same window
   double step_milliseconds = 0;       // wall time of one step, averaged
+  double step_cpu_milliseconds = 0;   // CPU time of the simulation thread per step, averaged
   bool playing = false;
   RunStatus status = RunStatus::kCompleted;  // kDiverged or kSolverFailed stop the simulation
   std::string message;                       // the divergence guard's or solver's reason
@@ -135,8 +136,8 @@ class LiveSimulation {
   double rate_wall_ = 0;
   long rate_steps_ = 0;
   Real rate_t_ = 0;
-  double steps_per_second_ = 0, sim_rate_ = 0, step_ms_ = 0;
-  double step_seconds_sum_ = 0;
+  double steps_per_second_ = 0, sim_rate_ = 0, step_ms_ = 0, step_cpu_ms_ = 0;
+  double step_seconds_sum_ = 0, step_cpu_seconds_sum_ = 0;
   long step_count_ = 0;
 
   std::thread thread_;

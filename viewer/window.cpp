@@ -1,5 +1,7 @@
 #include <jelly/viewer/window.hpp>
 
+#include <time.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -33,6 +35,13 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// CPU time of the calling thread (with LP_NUM_THREADS=0 llvmpipe draws on it too).
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 std::string glfw_error;  // the last message of GLFW's error callback
@@ -203,7 +212,9 @@ struct ViewerWindow::Impl {
   double render_sum = 0, render_max = 0;
   long render_count = 0;
   Clock::time_point start = Clock::now();
-  double sim_step_ms_sum = 0, sim_rate_sum = 0, sim_steps_per_second_sum = 0;
+  double render_cpu_sum = 0, frame_cpu_sum = 0;
+  double sim_step_ms_sum = 0, sim_step_cpu_ms_sum = 0, sim_rate_sum = 0,
+         sim_steps_per_second_sum = 0;
   long sim_samples = 0;
 
   ~Impl() {
@@ -361,6 +372,7 @@ struct ViewerWindow::Impl {
       com_z.push(static_cast<float>(f.center_of_mass.z()));
       if (f.playing) {
         sim_step_ms_sum += f.step_milliseconds;
+        sim_step_cpu_ms_sum += f.step_cpu_milliseconds;
         sim_rate_sum += f.sim_seconds_per_second;
         sim_steps_per_second_sum += f.steps_per_second;
         ++sim_samples;
@@ -859,6 +871,7 @@ struct ViewerWindow::Impl {
   // ---- Frame -----------------------------------------------------------------------------
 
   bool frame() {
+    const double frame_cpu_start = thread_cpu_seconds();
     glfwPollEvents();
     if (glfwWindowShouldClose(window)) return false;
     const double wall_dt = seconds_since(last_frame_time);
@@ -879,6 +892,7 @@ struct ViewerWindow::Impl {
     }
 
     const auto draw_start = Clock::now();
+    const double draw_cpu_start = thread_cpu_seconds();
     target->resize(fb_width, fb_height);
     target->bind();
     renderer->draw(scene, camera, fb_width, fb_height);
@@ -887,8 +901,10 @@ struct ViewerWindow::Impl {
     if (options.stats) glFinish();
     const double drawn = seconds_since(draw_start);
     render_seconds = 0.9 * render_seconds + 0.1 * drawn;
+    const double drawn_cpu = thread_cpu_seconds() - draw_cpu_start;
     if (frames_shown > 0) {  // the first frame builds the GPU buffers
       render_sum += drawn;
+      render_cpu_sum += drawn_cpu;
       render_max = std::max(render_max, drawn);
       ++render_count;
     }
@@ -906,6 +922,7 @@ struct ViewerWindow::Impl {
     const bool last = options.frames >= 0 && frames_shown >= options.frames;
     if (last && !options.screenshot.empty()) save_screenshot(options.screenshot);
     glfwSwapBuffers(window);
+    if (frames_shown > 0) frame_cpu_sum += thread_cpu_seconds() - frame_cpu_start;
     ++frames_shown;
     if (last) glfwSetWindowShouldClose(window, GLFW_TRUE);
     return true;
@@ -929,17 +946,24 @@ struct ViewerWindow::Impl {
     const double wall = seconds_since(start);
     std::printf("frames: %ld in %.2f s of wall time (%.1f frames/s)\n", frames_shown, wall,
                 static_cast<double>(frames_shown) / wall);
-    if (render_count > 0)
+    if (render_count > 0) {
+      const double n = static_cast<double>(render_count);
       std::printf(
-          "render: %.2f ms per frame on average, %.2f ms at most (%ld frames, %dx%d, "
-          "%d samples)\n",
-          1e3 * render_sum / static_cast<double>(render_count), 1e3 * render_max, render_count,
-          fb_width, fb_height, target->samples());
-    if (live && sim_samples > 0)
-      std::printf("simulation: %.0f steps/s, %.3f ms per step, %.3f simulated s per wall s\n",
-                  sim_steps_per_second_sum / static_cast<double>(sim_samples),
-                  sim_step_ms_sum / static_cast<double>(sim_samples),
-                  sim_rate_sum / static_cast<double>(sim_samples));
+          "render: %.2f ms per frame (wall; %.2f at most), %.2f ms CPU of the window's "
+          "thread (%ld frames, %dx%d, %d samples)\n",
+          1e3 * render_sum / n, 1e3 * render_max, 1e3 * render_cpu_sum / n, render_count, fb_width,
+          fb_height, target->samples());
+      std::printf("frame: %.2f ms CPU of the window's thread (events, drawing, panel, swap)\n",
+                  1e3 * frame_cpu_sum / n);
+    }
+    if (live && sim_samples > 0) {
+      const double n = static_cast<double>(sim_samples);
+      std::printf(
+          "simulation: %.0f steps/s, %.3f simulated s per wall s, %.3f ms per step "
+          "(wall), %.3f ms CPU per step (its thread)\n",
+          sim_steps_per_second_sum / n, sim_rate_sum / n, sim_step_ms_sum / n,
+          sim_step_cpu_ms_sum / n);
+    }
     std::fflush(stdout);
   }
 };
