@@ -30,7 +30,7 @@ demo: build
 	$(JELLY) run scenes/seed_slope.json --duration 3 -o out/demo.h5 --overwrite
 	@if [ -f scripts/plot.py ]; then /usr/bin/python3 scripts/plot.py out/demo.h5 -o out/demo.png; \
 	else echo "demo: scripts/plot.py is not in this tree: no plots"; fi
-	@status=0; $(JELLY) render out/demo.h5 -o out/demo.mp4 || status=$$?; \
+	@status=0; $(JELLY) render out/demo.h5 -o out/demo.mp4 --overwrite || status=$$?; \
 	if [ $$status -eq 2 ]; then echo "demo: no out/demo.mp4 (see above)"; \
 	elif [ $$status -ne 0 ]; then exit $$status; fi
 	@echo "demo: written:"; for f in out/demo.h5 out/demo.xdmf out/demo.png out/demo.mp4; do \

@@ -49,6 +49,7 @@ struct ViewArgs {
   int frames = -1;
   int frame = 0;  // replay: the frame shown first
   bool paused = false, hide_panel = false, particles = false, springs = false, stats = false;
+  bool overwrite = false;  // replace an existing --screenshot file
   double speed = 1;
   int samples = 4;
 };
@@ -65,6 +66,7 @@ struct RenderArgs {
   int samples = 4;
   int crf = 18;
   bool particles = false, springs = false, no_shadows = false;
+  bool overwrite = false;  // replace an existing output (for PNG frames: frame 0)
 };
 // jelly render FILE.h5 -o out.mp4|out.gif|frames/%04d.png: offscreen video.
 int render_command(const RenderArgs& args);
@@ -73,6 +75,7 @@ struct ExportArgs {
   std::string recording;
   std::string obj_sequence;  // folder of one OBJ per frame
   std::string pc2;           // PC2 file (+ the rest surface as .obj beside it)
+  bool overwrite = false;    // replace existing files
 };
 // jelly export FILE.h5 --obj-sequence DIR | --pc2 out.pc2.
 int export_command(const ExportArgs& args);

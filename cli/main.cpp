@@ -131,6 +131,7 @@ int main(int argc, char** argv) {
   view->add_flag("--hide-panel", view_args.hide_panel, "No panel (H toggles it)");
   view->add_flag("--particles", view_args.particles, "Show the particles");
   view->add_flag("--springs", view_args.springs, "Show the structural springs");
+  view->add_flag("--overwrite", view_args.overwrite, "Replace an existing --screenshot file");
   view->add_flag("--stats", view_args.stats,
                  "Print frames per second, render and simulation times at exit");
 
@@ -159,6 +160,8 @@ int main(int argc, char** argv) {
   render->add_flag("--particles", render_args.particles, "Show the particles");
   render->add_flag("--springs", render_args.springs, "Show the structural springs");
   render->add_flag("--no-shadows", render_args.no_shadows, "No shadows");
+  render->add_flag("--overwrite", render_args.overwrite,
+                   "Replace an existing output (an existing file is an error otherwise)");
 
   ExportArgs export_args;
   CLI::App* export_cmd = app.add_subcommand(
@@ -169,6 +172,8 @@ int main(int argc, char** argv) {
                          "Folder for frame_0000.obj, frame_0001.obj, ...");
   export_cmd->add_option("--pc2", export_args.pc2,
                          "PC2 point cache (the rest surface goes beside it as .obj)");
+  export_cmd->add_flag("--overwrite", export_args.overwrite,
+                       "Replace existing files (an existing file is an error otherwise)");
 
   try {
     app.parse(argc, argv);

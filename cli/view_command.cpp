@@ -1,6 +1,7 @@
 // jelly view, jelly render, jelly export: the viewer layer's commands. The window and the
 // offscreen renderer are optional parts of the build (JELLY_HAVE_WINDOW, JELLY_HAVE_RENDER).
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include <jelly/viewer/exports.hpp>
 #ifdef JELLY_HAVE_RENDER
 #include <jelly/viewer/render_video.hpp>
+#include <jelly/viewer/video_writer.hpp>
 #endif
 #ifdef JELLY_HAVE_WINDOW
 #include <jelly/viewer/window.hpp>
@@ -23,6 +25,20 @@
 namespace jelly::cli {
 
 namespace {
+
+// Commands never destroy a file they did not create unless told to (--overwrite), nor the
+// recording they read.
+void check_new_file(const std::string& flag, const std::string& path, bool overwrite,
+                    const std::string& input) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) return;
+  if (!input.empty() && std::filesystem::equivalent(path, input, error))
+    throw InputError(flag + " " + path + " is the recording it is made from");
+  if (!overwrite)
+    throw InputError(flag + " " + path +
+                     " exists (a file this command did not create): pass --overwrite to replace "
+                     "it, or choose another name");
+}
 
 bool is_recording(const std::string& path) {
   const auto dot = path.rfind('.');
@@ -49,6 +65,8 @@ int view_command(const ViewArgs& args) {
   require(args.samples >= 1 && args.samples <= 16, "--samples", args.samples, "1 to 16");
   if (!args.screenshot.empty() && args.frames < 0)
     throw InputError("--screenshot", args.screenshot, "used with --frames N (the frame to save)");
+  if (!args.screenshot.empty())
+    check_new_file("--screenshot", args.screenshot, args.overwrite, args.file);
   viewer::ViewOptions options;
   options.width = args.width;
   options.height = args.height;
@@ -106,6 +124,13 @@ int render_command(const RenderArgs& args) {
   options.shadows = !args.no_shadows;
   require(args.fps >= 0, "--fps", args.fps, "> 0 frames per second (0: the recording's rate)");
   require(args.crf >= 0 && args.crf <= 51, "--crf", args.crf, "0 to 51");
+  if (viewer::video_format(args.output, "-o") == viewer::VideoFormat::kPngSequence) {
+    std::vector<char> first(args.output.size() + 32);
+    std::snprintf(first.data(), first.size(), args.output.c_str(), 0);
+    check_new_file("-o", first.data(), args.overwrite, args.recording);
+  } else {
+    check_new_file("-o", args.output, args.overwrite, args.recording);
+  }
   const viewer::RenderVideoReport r = viewer::render_video(args.recording, args.output, options);
   std::printf(
       "rendered %d frames of %dx%d to %s in %.2f s (%.1f ms per frame: drawing %.1f, "
@@ -127,6 +152,14 @@ int render_command(const RenderArgs& args) {
 int export_command(const ExportArgs& args) {
   if (args.obj_sequence.empty() && args.pc2.empty())
     throw InputError("jelly export", args.recording, "--obj-sequence DIR and/or --pc2 FILE.pc2");
+  if (!args.obj_sequence.empty())
+    check_new_file("--obj-sequence", args.obj_sequence + "/frame_0000.obj", args.overwrite, "");
+  if (!args.pc2.empty()) {
+    check_new_file("--pc2", args.pc2, args.overwrite, args.recording);
+    check_new_file("--pc2 (its rest surface)",
+                   std::filesystem::path(args.pc2).replace_extension(".obj").string(),
+                   args.overwrite, args.recording);
+  }
   const Recording recording = read_recording(args.recording);
   if (!args.obj_sequence.empty()) {
     const int files = viewer::export_obj_sequence(recording, args.obj_sequence);

@@ -144,6 +144,16 @@ TEST(RenderCli, WritesVideosFfprobeConfirms) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("frames/000.png")));
   EXPECT_TRUE(std::filesystem::exists(dir.file("frames/009.png")));
   EXPECT_FALSE(std::filesystem::exists(dir.file("frames/010.png")));
+  // An existing output is kept unless --overwrite.
+  r = testing::run(jelly + "render '" + dir.file("r.h5") + "' -o '" + dir.file("v.mp4") +
+                       "' --width 160 --height 120",
+                   dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
+  r = testing::run(jelly + "render '" + dir.file("r.h5") + "' -o '" + dir.file("v.mp4") +
+                       "' --width 160 --height 120 --end 0 --overwrite",
+                   dir);
+  EXPECT_EQ(r.code, 0) << r.err;
   // Bad outputs and sizes are input errors.
   for (const std::string bad :
        {"-o x.avi", "-o 'f%d%d.png'", "-o v.mp4 --width 161", "-o '/nonexistent/dir/v.mp4'"}) {

@@ -200,6 +200,13 @@ TEST(Export, CliWritesBothAndRejectsNothingToDo) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("seq/frame_0003.obj")));
   EXPECT_TRUE(std::filesystem::exists(dir.file("c.obj")));
   EXPECT_EQ(read_pc2(dir.file("c.pc2")).samples.size(), 4u);
+  const std::string again = jelly + "export '" + h5 + "' --pc2 '" + dir.file("c.pc2") + "'";
+  r = testing::run(again, dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
+  EXPECT_EQ(testing::run(again + " --overwrite", dir).code, 0);
+  r = testing::run(jelly + "export '" + h5 + "' --obj-sequence '" + dir.file("seq") + "'", dir);
+  EXPECT_EQ(r.code, 2);
   r = testing::run(jelly + "export '" + h5 + "'", dir);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--obj-sequence"), std::string::npos) << r.err;

@@ -26,8 +26,8 @@ const std::string kSlope = JELLY_SCENES_DIR "/seed_slope.json";
 std::string jelly() { return std::string("'") + JELLY_CLI + "' "; }
 
 std::string view_args(int width = kWidth, int height = kHeight) {
-  return " --hide-panel --camera " + std::string(kCamera) + " --width " + std::to_string(width) +
-         " --height " + std::to_string(height);
+  return " --overwrite --hide-panel --camera " + std::string(kCamera) + " --width " +
+         std::to_string(width) + " --height " + std::to_string(height);
 }
 
 // Checks that the screenshot shows the jelly inside the projection of `x` and nowhere else.
