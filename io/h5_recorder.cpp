@@ -19,7 +19,7 @@
 #include <jelly/core/measures.hpp>
 #include <jelly/io/detail/checkpoint_h5.hpp>
 #include <jelly/io/detail/h5.hpp>
-#include <jelly/io/xdmf.hpp>
+#include <jelly/io/detail/xdmf_h5.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 #include <jelly/version.hpp>
@@ -30,6 +30,7 @@ void RecorderOptions::validate() const {
   require(flush_every_frames >= 1, "flush_every_frames", flush_every_frames, "an integer >= 1");
   require(compression_level >= 0 && compression_level <= 9, "compression_level", compression_level,
           "an integer in 0..9 (0 = off)");
+  xdmf.validate();
 }
 
 std::string xdmf_path_for(const std::string& h5_path) {
@@ -175,7 +176,6 @@ struct H5Recorder::Impl {
   h5::Series step, time, position, velocity;
   std::vector<h5::Series> observables, terrains;
   std::unique_ptr<h5::CheckpointWriter> checkpoint;
-  std::vector<double> times;  // every frame's time, for the XDMF sidecar
   long frames_received = 0;
 
   // Writer-thread side: the HDF5 work and the observables happen there, under the library mutex.
@@ -337,6 +337,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       if (const auto* elevator = dynamic_cast<const Elevator*>(&terrain)) {
         h5::write_attribute(t.get(), "size_x", elevator->spec().size_x);
         h5::write_attribute(t.get(), "size_z", elevator->spec().size_z);
+        h5::write_attribute(t.get(), "thickness", elevator->spec().thickness);
         h5::write_attribute(t.get(), "mass", elevator->spec().mass);
       }
       h5::Handle pos = h5::create_group(t.get(), "position");
@@ -489,7 +490,6 @@ void H5Recorder::on_frame(const Simulator& sim) {
     b.terrain[i].insert(b.terrain[i].end(), p.data(), p.data() + 3);
   }
   ++b.frames;
-  m.times.push_back(s.t);
   ++m.frames_received;
   if (static_cast<int>(b.frames) >= m.options.flush_every_frames) {
     b.checkpoint = sim.snapshot();
@@ -524,15 +524,16 @@ void H5Recorder::on_finish(const Simulator& sim, const RunReport& report) {
   // recording is moved onto its path only when everything else has been written.
   std::string sidecar_written;
   if (m.options.write_xdmf) {
-    XdmfLayout layout;
-    const size_t slash = m.path.find_last_of('/');
-    layout.h5_file = slash == std::string::npos ? m.path : m.path.substr(slash + 1);
-    layout.num_particles = m.n;
-    layout.num_springs = m.model.springs.size();
-    layout.times = m.times;
+    std::string text;
+    {
+      std::lock_guard<std::recursive_mutex> library(h5::library_mutex());
+      h5::QuietErrors quiet;
+      text = update_xdmf(m.file.get(), m.path, m.options.xdmf);
+      h5::check(H5Fflush(m.file.get(), H5F_SCOPE_GLOBAL), "flush " + m.path);
+    }
     sidecar_written = partial_path(m.sidecar_path);
     try {
-      write_xdmf(sidecar_written, layout);
+      write_text_file(sidecar_written, text);
     } catch (...) {
       std::remove(sidecar_written.c_str());
       throw;

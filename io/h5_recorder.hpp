@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include <jelly/io/xdmf.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {
@@ -17,6 +18,7 @@ struct RecorderOptions {
   int flush_every_frames = 10;
   int compression_level = 4;  // deflate (with byte shuffle) of the time series, 0 = off
   bool write_xdmf = true;     // <path without .h5>.xdmf beside the file, written at on_finish
+  XdmfOptions xdmf;           // what the sidecar shows (io/xdmf.hpp)
   // Compress and write on a second thread, so that recording costs the run little wall time.
   bool background_writer = true;
   // A recorder never destroys a file it did not create unless told to. false: an existing file at

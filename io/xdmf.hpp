@@ -1,27 +1,33 @@
 #pragma once
-// The XDMF sidecar of a recording: a temporal collection of one uniform grid per frame, whose
-// topology (a polyline per spring), geometry and attributes point into the HDF5 file, so that
-// ParaView's "XDMF Reader" shows the jelly and its springs as a time series. (The "Xdmf3 Reader"
-// variants of ParaView 5.11 load no points from HyperSlab geometry; docs/output.md.)
+// The XDMF sidecar of a recording, for ParaView: <path without .h5>.xdmf beside the .h5.
+//
+// Every ParaView XDMF reader opens it (Xdmf3ReaderS, the default, Xdmf3ReaderT and the older
+// "XDMF Reader"), from any working directory. The Xdmf3 readers of VTK read no HyperSlab or
+// Function DataItem (vtkXdmf3DataSet asks such an array for its number type before reading it,
+// gets "None" and drops it), and the XDMF Reader reports an error for any Geometry whose first
+// DataItem has no text of its own, so every DataItem of the sidecar names one whole HDF5
+// dataset. What the recording does not hold in that form is written into it, under /xdmf: one
+// HDF5 virtual dataset per frame viewing that frame of /particles/<body>/position/value (no
+// copy), the derived arrays (speed per particle, strain per spring) and the terrain meshes.
+// docs/output.md describes the sidecar and the /xdmf group.
 #include <string>
-#include <vector>
-
-#include <jelly/core/types.hpp>
 
 namespace jelly {
 
-struct XdmfLayout {
-  std::string h5_file;  // as referenced from the .xdmf: usually the file name alone (beside it)
-  int num_particles = 0;
-  int num_springs = 0;
-  std::vector<Real> times;  // one per recorded frame
+struct XdmfOptions {
+  // Strain of every spring at every frame (|xa - xb| / rest length - 1) as a cell array: float32
+  // [T][M], the largest part of /xdmf (with the seed cube about 28 KB a frame, compressed).
+  bool strain = true;
+  int compression_level = 1;  // deflate (with byte shuffle) of the derived arrays, 0 = off
+
+  // Throws InputError for a compression level outside 0..9.
+  void validate() const;
 };
 
-std::string xdmf_text(const XdmfLayout& layout);
-// Throws InputError naming the path if it cannot be written.
-void write_xdmf(const std::string& xdmf_path, const XdmfLayout& layout);
-// Writes <h5 path without .h5>.xdmf for an existing recording (e.g. one whose run was killed
-// before it could write its own). Throws InputError for a missing or invalid file.
-void write_xdmf_for_recording(const std::string& h5_path);
+// Writes the sidecar of the recording at h5_path and what it needs under /xdmf in the recording
+// (opened for writing). Called again after more frames were recorded (or on a file whose run
+// was killed), it adds what the new frames need and rewrites the sidecar. Returns the sidecar's
+// path. Throws InputError for a missing or invalid file or options.
+std::string write_xdmf_for_recording(const std::string& h5_path, const XdmfOptions& options = {});
 
 }  // namespace jelly

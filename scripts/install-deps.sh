@@ -9,9 +9,13 @@ packages=(
   libceres-dev libgtest-dev libgmock-dev googletest libbenchmark-dev nlohmann-json3-dev libcli11-dev
   python3-h5py python3-matplotlib python3-numpy ffmpeg clang-format ccache
   # the viewer (jelly view / render): OpenGL through GLVND, Mesa's EGL and software drivers
-  # (llvmpipe), GLFW, Dear ImGui with its backends, stb for PNG; Xvfb for its tests
+  # (llvmpipe), GLFW, Dear ImGui with its backends, stb for PNG; Xvfb for its tests (and for the
+  # test jelly_paraview's screenshot)
   libglfw3-dev libimgui-dev libstb-dev libopengl-dev libegl-dev libegl-mesa0 libglx-mesa0
   libgl1-mesa-dri xvfb xauth
+  # Only for the test jelly_paraview (tests/io/paraview_test.py), which skips without them:
+  # pvpython (python3-paraview, only recommended by paraview).
+  paraview python3-paraview
 )
 
 missing=()

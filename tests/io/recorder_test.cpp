@@ -9,7 +9,6 @@
 #include <jelly/core/measures.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
-#include <jelly/io/xdmf.hpp>
 
 #include "io/io_support.hpp"
 
@@ -222,50 +221,6 @@ TEST(Errors, MissingOrInvalidFileNamesTheFile) {
   RecorderOptions options;
   options.flush_every_frames = 0;
   EXPECT_THROW(options.validate(), InputError);
-}
-
-// The sidecar is well-formed XML with one uniform grid per frame, each pointing at its slab.
-TEST(Xdmf, WellFormedTemporalCollection) {
-  TempDir dir;
-  const std::string path = dir.file("run.h5");
-  record_slope(path);
-  const std::string xdmf = dir.file("run.xdmf");
-  ASSERT_TRUE(std::filesystem::exists(xdmf));
-  std::ifstream in(xdmf);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("run.h5:/particles/jelly/position/value"), std::string::npos);
-  EXPECT_NE(text.find(">25 0 0 1 1 1 1 27 3<"), std::string::npos);  // the last frame
-  if (!testing::python_has("xml.etree.ElementTree")) GTEST_SKIP() << "no /usr/bin/python3";
-  const std::string check =
-      "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1])."
-      "getroot(); c = r.find('Domain/Grid'); assert c.get('CollectionType') == 'Temporal'; "
-      "g = c.findall('Grid'); assert len(g) == 26, len(g); "
-      "assert all(x.find('Topology').get('TopologyType') == 'Polyline' and "
-      "x.find('Geometry/DataItem').get('ItemType') == 'HyperSlab' and "
-      "len(x.findall('Attribute')) == 3 for x in g)\" " +
-      xdmf;
-  EXPECT_EQ(std::system(check.c_str()), 0);
-
-  // Rewritten from the file alone, the sidecar is the same.
-  std::filesystem::remove(xdmf);
-  write_xdmf_for_recording(path);
-  std::ifstream again(xdmf);
-  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>()),
-            text);
-}
-
-// ParaView's XDMF Reader shows every frame, bit for bit (when ParaView is installed; it is not a
-// dependency of jelly).
-TEST(Xdmf, ParaViewReadsEveryFrame) {
-  if (!std::filesystem::exists("/usr/bin/pvbatch"))
-    GTEST_SKIP() << "ParaView (pvbatch) not installed";
-  TempDir dir;
-  const std::string path = dir.file("run.h5");
-  record_slope(path);
-  const std::string command = "/usr/bin/pvbatch --force-offscreen-rendering " JELLY_SOURCE_DIR
-                              "/tests/io/paraview_check.py " +
-                              dir.file("run.xdmf") + " " + path + " 2>&1 | grep -v '^$'";
-  EXPECT_EQ(std::system(command.c_str()), 0);
 }
 
 }  // namespace

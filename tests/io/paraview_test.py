@@ -1,0 +1,69 @@
+"""The ParaView test (ctest jelly_paraview): records each seed scene with the jelly program and
+checks the recordings in Debian's ParaView (tests/io/paraview_check.py under pvpython, in a
+virtual X server for the screenshot). Exit status 77 (ctest: skipped) when pvpython is absent.
+
+    /usr/bin/python3 tests/io/paraview_test.py --jelly build/cli/jelly [--screenshot out.png]
+"""
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES = os.path.join(HERE, "..", "..", "scenes")
+# Each seed scene, long enough to see its impact (and kept short: every frame is compared).
+RUNS = [("seed_slope", 2.0), ("seed_elevator", 2.0), ("drop_coulomb", 1.5)]
+# What a reader says when it cannot read something: the sidecar must not cause any of these.
+COMPLAINT = re.compile(r"ERR\||WARN\||error|warning|skipping|HDF5-DIAG|cannot|failed", re.I)
+SKIP = 77
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--jelly", required=True, help="the jelly program")
+    parser.add_argument("--screenshot", help="where to save the screenshot (PNG)")
+    args = parser.parse_args()
+    pvpython = shutil.which("pvpython")
+    if pvpython is None:
+        print("SKIPPED: ParaView's pvpython is not installed (Debian: apt-get install paraview; "
+              "scripts/install-deps.sh installs it)")
+        return SKIP
+    with tempfile.TemporaryDirectory(prefix="jelly-paraview-") as tmp:
+        xdmfs = []
+        for scene, seconds in RUNS:
+            h5 = os.path.join(tmp, scene + ".h5")
+            subprocess.run([args.jelly, "run", os.path.join(SCENES, scene + ".json"), "--duration",
+                            str(seconds), "-o", h5, "--quiet"], check=True,
+                           stdout=subprocess.DEVNULL)
+            # Relative to the working directory below: the sidecar must find its .h5 by itself.
+            xdmfs.append(os.path.join("..", scene + ".xdmf"))
+        elsewhere = os.path.join(tmp, "elsewhere")
+        os.mkdir(elsewhere)
+        command = [pvpython, "--force-offscreen-rendering", os.path.join(HERE, "paraview_check.py")]
+        command += xdmfs
+        if args.screenshot:
+            xvfb_run = shutil.which("xvfb-run")
+            if xvfb_run is None and not os.environ.get("DISPLAY"):
+                print("no screenshot: neither xvfb-run (Debian: xvfb) nor a DISPLAY")
+            else:
+                command += ["--screenshot", os.path.abspath(args.screenshot)]
+                if xvfb_run:
+                    # -noreset: without it Xvfb resets when ParaView closes its first connection
+                    # and ParaView's next one can fail ("bad X server connection").
+                    command = [xvfb_run, "-a", "-s", "-screen 0 1280x1024x24 -noreset"] + command
+        result = subprocess.run(command, cwd=elsewhere, stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, text=True, timeout=300)
+    complaints = [line for line in result.stdout.splitlines()
+                  if line.strip() and not line.startswith("paraview_check:") and
+                  COMPLAINT.search(line)]
+    print(result.stdout, end="")
+    for line in complaints:
+        print("FAIL: ParaView complained:", line)
+    return 1 if result.returncode or complaints else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,264 @@
+// The XDMF sidecar (io/xdmf.hpp): every DataItem names a whole dataset of the recording, the
+// per-frame views read as the recorded frames, the derived arrays are what they claim, and the
+// sidecar is the same whether written at the end of a run, in several runs or from the file
+// alone. (That ParaView's readers open it: the ctest jelly_paraview, tests/io/paraview_test.py.)
+#include <gtest/gtest.h>
+
+#include <hdf5.h>
+
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <vector>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/io/h5_recorder.hpp>
+#include <jelly/io/xdmf.hpp>
+#include <jelly/terrain/elevator.hpp>
+
+#include "io/io_support.hpp"
+
+namespace jelly {
+namespace {
+
+using testing::TempDir;
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A dataset of the file read as doubles (any numeric type), with its dimensions.
+std::vector<double> read(hid_t file, const std::string& path,
+                         std::vector<hsize_t>* dims = nullptr) {
+  const hid_t d = H5Dopen2(file, path.c_str(), H5P_DEFAULT);
+  EXPECT_GE(d, 0) << path;
+  if (d < 0) return {};
+  const hid_t s = H5Dget_space(d);
+  std::vector<hsize_t> shape(H5Sget_simple_extent_ndims(s));
+  H5Sget_simple_extent_dims(s, shape.data(), nullptr);
+  hsize_t size = 1;
+  for (hsize_t n : shape) size *= n;
+  std::vector<double> values(size);
+  EXPECT_GE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0) << path;
+  H5Sclose(s);
+  H5Dclose(d);
+  if (dims) *dims = shape;
+  return values;
+}
+
+// Records `seconds` of a small cube on the slope (or the seed elevator) to `path`.
+void record(const std::string& path, RecorderOptions options = {}, bool elevator = false,
+            std::vector<double> stops = {0.5}) {
+  const Model cube = build_cube(testing::small_cube(3, 1.0, Vec3(-0.5, 1.2, -0.5)));
+  Simulator sim = elevator ? testing::make_sim(cube, rest_state(cube), "rk4", 1e-3, 0.02)
+                           : testing::slope_sim();
+  if (elevator) sim.add_terrain(std::make_unique<Elevator>());
+  H5Recorder recorder(path, sim, options);
+  sim.add_observer(recorder);
+  for (double t : stops) ASSERT_TRUE(sim.run_until(t).ok());
+}
+
+struct Item {
+  std::string dims, path;
+};
+
+// Every DataItem of the sidecar that names a dataset ("run.h5:/path").
+std::vector<Item> hdf_items(const std::string& text) {
+  static const std::regex item(
+      R"re(<DataItem Dimensions="([0-9 ]+)" NumberType="\w+" Precision="\d" Format="HDF">([^<:]+):([^<]+)</DataItem>)re");
+  std::vector<Item> items;
+  for (std::sregex_iterator it(text.begin(), text.end(), item), end; it != end; ++it) {
+    EXPECT_EQ((*it)[2], "run.h5");
+    items.push_back({(*it)[1], (*it)[3]});
+  }
+  return items;
+}
+
+TEST(Xdmf, EveryDataItemNamesAWholeDatasetOfTheRecording) {
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  record(path);
+  const std::string text = read_text(dir.file("run.xdmf"));
+  // No HyperSlab or Function items: VTK's Xdmf3 readers read none of them.
+  EXPECT_EQ(text.find("HyperSlab"), std::string::npos);
+  EXPECT_EQ(text.find("Function"), std::string::npos);
+  // One temporal collection per body and per terrain, 26 frames each.
+  EXPECT_NE(text.find(R"(<Grid Name="jelly" GridType="Collection" CollectionType="Temporal">)"),
+            std::string::npos);
+  EXPECT_NE(text.find(R"(<Grid Name="0_plane" GridType="Collection" CollectionType="Temporal">)"),
+            std::string::npos);
+  size_t times = 0;
+  for (size_t at = text.find("<Time "); at != std::string::npos; at = text.find("<Time ", at + 1))
+    ++times;
+  EXPECT_EQ(times, 2u * 26);
+
+  const std::vector<Item> items = hdf_items(text);
+  ASSERT_GT(items.size(), 26u * 10);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  size_t checked = 0;
+  for (const Item& item : items) {
+    if (checked++ % 7 != 0 && item.path.find("/25") == std::string::npos) continue;  // a sample
+    std::vector<hsize_t> dims;
+    read(file, item.path, &dims);
+    std::string shape;
+    for (hsize_t d : dims) shape += (shape.empty() ? "" : " ") + std::to_string(d);
+    EXPECT_EQ(shape, item.dims) << item.path;
+  }
+  H5Fclose(file);
+
+  if (!testing::python_has("xml.etree.ElementTree")) GTEST_SKIP() << "no /usr/bin/python3";
+  const std::string parse =
+      "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; "
+      "E.parse(sys.argv[1])\" " +
+      dir.file("run.xdmf");
+  EXPECT_EQ(std::system(parse.c_str()), 0);
+}
+
+TEST(Xdmf, ViewsAreTheRecordedFramesAndDerivedArraysWhatTheyClaim) {
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  record(path);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  std::vector<hsize_t> dims;
+  const std::vector<double> x = read(file, "/particles/jelly/position/value", &dims);
+  const std::vector<double> v = read(file, "/particles/jelly/velocity/value");
+  ASSERT_EQ(dims.size(), 3u);
+  const hsize_t frames = dims[0], n = dims[1];
+  const std::vector<double> ends = read(file, "/connectivity/springs");
+  const std::vector<double> rest = read(file, "/connectivity/rest_length");
+  const hsize_t m = rest.size();
+  for (hsize_t f : {hsize_t{0}, hsize_t{13}, frames - 1}) {
+    const std::string k = std::to_string(f);
+    const std::vector<double> xf(x.begin() + 3 * n * f, x.begin() + 3 * n * (f + 1));
+    const std::vector<double> vf(v.begin() + 3 * n * f, v.begin() + 3 * n * (f + 1));
+    EXPECT_EQ(read(file, "/xdmf/particles/jelly/frame/position/" + k), xf) << f;
+    EXPECT_EQ(read(file, "/xdmf/particles/jelly/frame/velocity/" + k), vf) << f;
+    const std::vector<double> speed = read(file, "/xdmf/particles/jelly/frame/speed/" + k);
+    ASSERT_EQ(speed.size(), n);
+    for (hsize_t i = 0; i < n; ++i) {
+      const double s = std::sqrt(vf[3 * i] * vf[3 * i] + vf[3 * i + 1] * vf[3 * i + 1] +
+                                 vf[3 * i + 2] * vf[3 * i + 2]);
+      EXPECT_NEAR(speed[i], s, 1e-6 * (1 + s)) << "frame " << f << " particle " << i;
+    }
+    const std::vector<double> strain = read(file, "/xdmf/particles/jelly/frame/strain/" + k);
+    ASSERT_EQ(strain.size(), m);
+    for (hsize_t s = 0; s < m; ++s) {
+      const double* a = xf.data() + 3 * static_cast<hsize_t>(ends[2 * s]);
+      const double* b = xf.data() + 3 * static_cast<hsize_t>(ends[2 * s + 1]);
+      const double length =
+          std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                    (a[2] - b[2]) * (a[2] - b[2]));
+      EXPECT_NEAR(strain[s], length / rest[s] - 1, 2e-5) << "frame " << f << " spring " << s;
+    }
+  }
+  // The plane: a quad (2 triangles) in the plane, not moving.
+  std::vector<hsize_t> quad;
+  const std::vector<double> corners = read(file, "/xdmf/terrain/0_plane/vertices", &quad);
+  EXPECT_EQ(quad, (std::vector<hsize_t>{4, 3}));
+  const Vec3 normal(std::sin(20 * M_PI / 180), std::cos(20 * M_PI / 180), 0);
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_NEAR(normal.dot(Vec3(corners[3 * c], corners[3 * c + 1], corners[3 * c + 2])), 0, 1e-12);
+  }
+  EXPECT_EQ(read(file, "/xdmf/terrain/0_plane/triangles").size(), 6u);
+  H5Fclose(file);
+}
+
+TEST(Xdmf, TheElevatorIsABoxAtItsRecordedHeight) {
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  record(path, {}, true);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  std::vector<hsize_t> dims;
+  const std::vector<double> platform = read(file, "/terrain/0_elevator/position/value", &dims);
+  const hsize_t frames = dims[0];
+  ASSERT_GT(platform[3 * (frames - 1) + 1], platform[1] + 0.1);  // it moved
+  for (hsize_t f : {hsize_t{0}, frames / 2, frames - 1}) {
+    std::vector<hsize_t> box;
+    const std::vector<double> corners =
+        read(file, "/xdmf/terrain/0_elevator/frame/position/" + std::to_string(f), &box);
+    ASSERT_EQ(box, (std::vector<hsize_t>{8, 3}));
+    double top = -1e300, bottom = 1e300;
+    for (int c = 0; c < 8; ++c) {
+      top = std::max(top, corners[3 * c + 1]);
+      bottom = std::min(bottom, corners[3 * c + 1]);
+      EXPECT_NEAR(std::abs(corners[3 * c]), 2.5, 1e-12);  // the 5 x 5 m platform
+    }
+    EXPECT_NEAR(top, platform[3 * f + 1], 1e-12) << f;
+    EXPECT_NEAR(top - bottom, ElevatorSpec{}.thickness, 1e-12);
+  }
+  EXPECT_EQ(read(file, "/xdmf/terrain/0_elevator/triangles").size(), 36u);
+  // Its speed: 3 m/s^2 from rest, about 3 t.
+  const std::vector<double> speed =
+      read(file, "/xdmf/terrain/0_elevator/frame/speed/" + std::to_string(frames - 1));
+  EXPECT_NEAR(speed[0], 3 * 0.5, 0.05);
+  H5Fclose(file);
+}
+
+// The sidecar after a run in three parts, or written from the file alone after a run without
+// one, is the one a single run writes.
+TEST(Xdmf, SameSidecarInPartsOrFromTheFileAlone) {
+  TempDir whole, parts, later;
+  record(whole.file("run.h5"));
+  record(parts.file("run.h5"), {}, false, {0.1, 0.3, 0.5});
+  RecorderOptions no_sidecar;
+  no_sidecar.write_xdmf = false;
+  record(later.file("run.h5"), no_sidecar);
+  EXPECT_FALSE(std::filesystem::exists(later.file("run.xdmf")));
+  EXPECT_EQ(write_xdmf_for_recording(later.file("run.h5")), later.file("run.xdmf"));
+  const std::string text = read_text(whole.file("run.xdmf"));
+  EXPECT_EQ(read_text(parts.file("run.xdmf")), text);
+  EXPECT_EQ(read_text(later.file("run.xdmf")), text);
+  // And once more changes nothing.
+  write_xdmf_for_recording(later.file("run.h5"));
+  EXPECT_EQ(read_text(later.file("run.xdmf")), text);
+
+  // Equal, but for strain's rounding (scale-offset rounds relative to each chunk's minimum).
+  const hid_t a = H5Fopen(whole.file("run.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t b = H5Fopen(parts.file("run.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  for (const char* dataset :
+       {"/xdmf/particles/jelly/speed", "/xdmf/particles/jelly/frame/position/25"}) {
+    EXPECT_EQ(read(a, dataset), read(b, dataset)) << dataset;
+  }
+  const std::vector<double> strain_a = read(a, "/xdmf/particles/jelly/strain");
+  const std::vector<double> strain_b = read(b, "/xdmf/particles/jelly/strain");
+  ASSERT_EQ(strain_a.size(), strain_b.size());
+  for (size_t i = 0; i < strain_a.size(); ++i) ASSERT_NEAR(strain_a[i], strain_b[i], 2e-5) << i;
+  H5Fclose(a);
+  H5Fclose(b);
+}
+
+TEST(Xdmf, WithoutStrain) {
+  TempDir dir;
+  RecorderOptions options;
+  options.xdmf.strain = false;
+  record(dir.file("run.h5"), options);
+  const std::string text = read_text(dir.file("run.xdmf"));
+  EXPECT_EQ(text.find("strain"), std::string::npos);
+  EXPECT_NE(text.find("Name=\"speed\""), std::string::npos);
+  const hid_t file = H5Fopen(dir.file("run.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_EQ(H5Lexists(file, "/xdmf/particles/jelly/strain", H5P_DEFAULT), 0);
+  H5Fclose(file);
+}
+
+TEST(Xdmf, ErrorsNameTheFileOrOption) {
+  TempDir dir;
+  try {
+    write_xdmf_for_recording(dir.file("missing.h5"));
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.h5"), std::string::npos) << e.what();
+  }
+  XdmfOptions options;
+  options.compression_level = 10;
+  EXPECT_THROW(options.validate(), InputError);
+  RecorderOptions recorder;
+  recorder.xdmf.compression_level = -1;
+  EXPECT_THROW(recorder.validate(), InputError);
+}
+
+}  // namespace
+}  // namespace jelly
