@@ -53,6 +53,7 @@ Eigen::Matrix4f Camera::projection(float aspect) const {
   const float t = 1.0f / std::tan(0.5f * fov_y_degrees * kDegrees);
   Eigen::Matrix4f m = Eigen::Matrix4f::Zero();
   m(0, 0) = t / aspect;
+  m(0, 2) = -shift_x;  // x_ndc = t / aspect * x / -z + shift_x
   m(1, 1) = t;
   m(2, 2) = (f + n) / (n - f);
   m(2, 3) = 2 * f * n / (n - f);
@@ -73,7 +74,7 @@ std::optional<Eigen::Vector2f> Camera::project(const Eigen::Vector3f& p, int wid
 void Camera::ray(float px, float py, int width, int height, Eigen::Vector3f& origin,
                  Eigen::Vector3f& direction) const {
   const float aspect = static_cast<float>(width) / static_cast<float>(height);
-  const float x = 2 * px / static_cast<float>(width) - 1;
+  const float x = 2 * px / static_cast<float>(width) - 1 - shift_x;
   const float y = 1 - 2 * py / static_cast<float>(height);
   const float t = std::tan(0.5f * fov_y_degrees * kDegrees);
   direction = (forward() + x * t * aspect * right() + y * t * up()).normalized();

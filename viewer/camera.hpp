@@ -16,6 +16,9 @@ struct Camera {
   float yaw_degrees = -35;   // about +y; 0 looks along -z
   float pitch_degrees = 20;  // above the horizontal, in (-89, 89)
   float fov_y_degrees = 40;  // vertical field of view
+  // The picture's centre moved right by this fraction of its half-width (an off-centre
+  // projection: the window shifts the view away from its panel).
+  float shift_x = 0;
 
   Eigen::Vector3f eye() const;
   // Unit vectors of the camera's frame in the world.

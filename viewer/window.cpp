@@ -200,6 +200,9 @@ struct ViewerWindow::Impl {
   std::vector<std::pair<std::string, std::vector<float>>> series;  // observables per frame
   Clock::time_point last_frame_time = Clock::now();
 
+  float panel_right = 0;  // the panel's right edge in pixels, 0 when hidden or collapsed
+  bool follow = false;    // the camera's target follows the bodies
+
   // Mouse.
   enum class Drag { kNone, kOrbit, kPan, kParticle } drag = Drag::kNone;
   double mouse_x = 0, mouse_y = 0;
@@ -619,6 +622,7 @@ struct ViewerWindow::Impl {
       ImGui::RadioButton("strain", &coloring, 1);
       scene.spring_coloring = coloring ? SpringColoring::kStrain : SpringColoring::kType;
     }
+    ImGui::Checkbox("follow the bodies", &follow);
     ImGui::Checkbox("shadows", &renderer->options().shadows);
     ImGui::SameLine();
     ImGui::Checkbox("grid", &renderer->options().grid);
@@ -860,11 +864,14 @@ struct ViewerWindow::Impl {
     ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(360, static_cast<float>(std::max(200, fb_height - 16))),
                              ImGuiCond_FirstUseEver);
-    ImGui::Begin(live ? "jelly view" : "jelly replay");
-    if (live)
-      live_panel();
-    else
-      replay_panel();
+    const bool open = ImGui::Begin(live ? "jelly view" : "jelly replay");
+    if (open) {
+      if (live)
+        live_panel();
+      else
+        replay_panel();
+    }
+    panel_right = open ? ImGui::GetWindowPos().x + ImGui::GetWindowSize().x : 0.0f;
     ImGui::End();
   }
 
@@ -891,6 +898,16 @@ struct ViewerWindow::Impl {
       scene.drag_to = drag_target;
     }
 
+    // The view's centre in the part of the window the panel leaves free; the camera follows.
+    camera.shift_x =
+        options.hide_panel
+            ? 0.0f
+            : std::clamp(panel_right * pixel_scale() / static_cast<float>(fb_width), 0.0f, 0.5f);
+    if (follow && positions.size() >= 3) {
+      Vec3 lo, hi;
+      bounds_of(positions, lo, hi);
+      camera.target += 0.1f * ((0.5 * (lo + hi)).cast<float>() - camera.target);
+    }
     const auto draw_start = Clock::now();
     const double draw_cpu_start = thread_cpu_seconds();
     target->resize(fb_width, fb_height);

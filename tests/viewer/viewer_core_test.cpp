@@ -114,6 +114,12 @@ TEST(Camera, ProjectsTheTargetToTheCentreAndRaysBack) {
   ASSERT_TRUE(p);
   EXPECT_NEAR(p->x(), 100, 1e-2);
   EXPECT_NEAR(p->y(), 50, 1e-2);
+  // Shifted (the window's panel), the centre moves right and rays follow.
+  c.shift_x = 0.25f;
+  EXPECT_NEAR(c.project(c.target, 640, 480)->x(), 320 + 0.25 * 320, 1e-3);
+  c.ray(500, 70, 640, 480, o, d);
+  EXPECT_NEAR(c.project(o + 5.0f * d, 640, 480)->x(), 500, 1e-2);
+  c.shift_x = 0;
   // Up in the world is up in the picture; behind the camera is nothing.
   EXPECT_LT(c.project(c.target + Eigen::Vector3f(0, 1, 0), 640, 480)->y(), 240);
   EXPECT_FALSE(c.project(c.eye() - c.forward(), 640, 480));
