@@ -1,8 +1,12 @@
 #include <jelly/io/xdmf.hpp>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -851,8 +855,20 @@ std::string write_xdmf_for_recording(const std::string& h5_path, const XdmfOptio
   } catch (const std::exception& e) {
     throw InputError("cannot write the XDMF views into '" + h5_path + "': " + e.what());
   }
+  // Under a temporary name first: a failure leaves the old sidecar (or none), never half of one.
   const std::string xdmf_path = xdmf_path_for(h5_path);
-  write_text_file(xdmf_path, text);
+  const std::string partial = xdmf_path + ".partial-" + std::to_string(static_cast<long>(getpid()));
+  try {
+    write_text_file(partial, text);
+  } catch (...) {
+    std::remove(partial.c_str());
+    throw;
+  }
+  if (std::rename(partial.c_str(), xdmf_path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    std::remove(partial.c_str());
+    throw InputError("cannot write XDMF file '" + xdmf_path + "': " + reason);
+  }
   return xdmf_path;
 }
 
