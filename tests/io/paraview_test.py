@@ -15,7 +15,7 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = os.path.join(HERE, "..", "..", "scenes")
 # Each seed scene, long enough to see its impact (and kept short: every frame is compared).
-RUNS = [("seed_slope", 2.0), ("seed_elevator", 2.0), ("drop_coulomb", 1.5)]
+RUNS = [("seed_slope", 1.5), ("seed_elevator", 1.5), ("drop_coulomb", 1.2)]
 # What a reader says when it cannot read something: the sidecar must not cause any of these.
 COMPLAINT = re.compile(r"ERR\||WARN\||error|warning|skipping|HDF5-DIAG|cannot|failed", re.I)
 SKIP = 77
