@@ -6,6 +6,7 @@ virtual X server for the screenshot). Exit status 77 (ctest: skipped) when pvpyt
 """
 import argparse
 import os
+import random
 import re
 import shutil
 import subprocess
@@ -18,6 +19,8 @@ SCENES = os.path.join(HERE, "..", "..", "scenes")
 RUNS = [("seed_slope", 1.5), ("seed_elevator", 1.5), ("drop_coulomb", 1.2)]
 # What a reader says when it cannot read something: the sidecar must not cause any of these.
 COMPLAINT = re.compile(r"ERR\||WARN\||error|warning|skipping|HDF5-DIAG|cannot|failed", re.I)
+# What says that the X server, not ParaView, failed (then the check runs again on another display).
+X_FAILED = re.compile(r"bad X server connection|Xvfb failed to start|cannot open display")
 SKIP = 77
 
 
@@ -44,18 +47,25 @@ def main():
         os.mkdir(elsewhere)
         command = [pvpython, "--force-offscreen-rendering", os.path.join(HERE, "paraview_check.py")]
         command += xdmfs
+        xvfb_run = shutil.which("xvfb-run") if args.screenshot else None
         if args.screenshot:
-            xvfb_run = shutil.which("xvfb-run")
             if xvfb_run is None and not os.environ.get("DISPLAY"):
                 print("no screenshot: neither xvfb-run (Debian: xvfb) nor a DISPLAY")
             else:
                 command += ["--screenshot", os.path.abspath(args.screenshot)]
-                if xvfb_run:
-                    # -noreset: without it Xvfb resets when ParaView closes its first connection
-                    # and ParaView's next one can fail ("bad X server connection").
-                    command = [xvfb_run, "-a", "-s", "-screen 0 1280x1024x24 -noreset"] + command
-        result = subprocess.run(command, cwd=elsewhere, stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, text=True, timeout=300)
+        for attempt in range(3):
+            run = command
+            if xvfb_run and "--screenshot" in command:
+                # From a random display number: `xvfb-run -a` alone starts at :99 and races with
+                # other users of the machine. -noreset: without it Xvfb resets when ParaView closes
+                # its first connection, and ParaView's next one can fail.
+                run = [xvfb_run, "-a", "-n", str(random.randint(100, 899)), "-s",
+                       "-screen 0 1280x1024x24 -noreset"] + command
+            result = subprocess.run(run, cwd=elsewhere, stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT, text=True, timeout=300)
+            if result.returncode == 0 or not X_FAILED.search(result.stdout) or attempt == 2:
+                break
+            print(f"the X server failed (attempt {attempt + 1}), trying another display")
     complaints = [line for line in result.stdout.splitlines()
                   if line.strip() and not line.startswith("paraview_check:") and
                   COMPLAINT.search(line)]
