@@ -8,8 +8,10 @@ JELLY = $(BUILD)/cli/jelly
 
 all: build
 
+# `make test` also installs what only tests need (ParaView for jelly_paraview).
 deps:
-	bash scripts/install-deps.sh
+	bash scripts/install-deps.sh $(DEPS_FLAGS)
+test: DEPS_FLAGS = --tests
 
 # ccache, when installed (install-deps does), makes rebuilds after a checkout cheap.
 LAUNCHER := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)

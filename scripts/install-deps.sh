@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs, with apt, the Debian packages jelly needs that are missing. Idempotent: a machine
 # that already has everything is left untouched and nothing is downloaded.
+#   install-deps.sh           what building, running and `make demo` need
+#   install-deps.sh --tests   and what only tests need (`make test` and CI pass it)
 set -euo pipefail
 
 packages=(
@@ -13,10 +15,15 @@ packages=(
   # test jelly_paraview's screenshot)
   libglfw3-dev libimgui-dev libstb-dev libopengl-dev libegl-dev libegl-mesa0 libglx-mesa0
   libgl1-mesa-dri xvfb xauth
-  # Only for the test jelly_paraview (tests/io/paraview_test.py), which skips without them:
-  # pvpython (python3-paraview, only recommended by paraview).
-  paraview python3-paraview
 )
+if [ "${1:-}" = "--tests" ]; then
+  # The test jelly_paraview (tests/io/paraview_test.py; it skips without them): ParaView and its
+  # pvpython (python3-paraview, only recommended by paraview). About 120 MB to download.
+  packages+=(paraview python3-paraview)
+elif [ $# -gt 0 ]; then
+  echo "usage: $0 [--tests]" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do
