@@ -47,7 +47,7 @@ RenderVideoReport render_video(const std::string& recording_path, const std::str
   Renderer renderer(render_options);
   RenderTarget target(options.width, options.height, options.samples);
   RenderScene scene = view.make_scene(frames.front());
-  scene.show_particles = options.particles;
+  scene.show_particles = scene.show_particles || options.particles;
   scene.show_springs = options.springs;
   std::vector<std::uint8_t> pixels;
   for (const int k : frames) {

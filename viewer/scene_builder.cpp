@@ -98,6 +98,10 @@ RenderScene SceneBuilder::make_scene(const VecX& x, Real t) const {
     scene.terrains.push_back(std::move(view));
   }
   scene.particles.assign(static_cast<size_t>(3 * num_particles_), 0.0f);
+  // Bodies without a surface are seen as their particles.
+  bool any_surface = false;
+  for (const BodySurface& s : surfaces_) any_surface = any_surface || !s.triangles.empty();
+  scene.show_particles = !any_surface;
   scene.particle_radius = particle_radius_;
   scene.springs = springs_;
   scene.spring_rest_length = rest_length_;

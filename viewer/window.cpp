@@ -312,7 +312,7 @@ struct ViewerWindow::Impl {
     const RenderScene old = std::move(scene);
     scene = builder->make_scene(positions, 0);
     if (!first) {
-      scene.show_particles = old.show_particles;
+      scene.show_particles = old.show_particles || scene.show_particles;
       scene.show_springs = old.show_springs;
       scene.show_surfaces = old.show_surfaces;
       scene.show_structural_only = old.show_structural_only;
@@ -342,7 +342,7 @@ struct ViewerWindow::Impl {
     speed = static_cast<float>(options.speed > 0 ? options.speed : 1);
     max_speed = options.speed <= 0;
     make_builder();
-    scene.show_particles = options.particles;
+    scene.show_particles = scene.show_particles || options.particles;
     scene.show_springs = options.springs;
     if (!options.camera.empty()) {
       camera.parse(options.camera);
@@ -392,7 +392,7 @@ struct ViewerWindow::Impl {
     replay_time = replay->recording().time[replay_frame];
     replay_playing = !options.paused && options.frames < 0 && options.screenshot.empty();
     scene = replay->make_scene(replay_frame);
-    scene.show_particles = options.particles;
+    scene.show_particles = scene.show_particles || options.particles;
     scene.show_springs = options.springs;
     positions = replay->recording().position[replay_frame];
     camera = replay->default_camera(aspect());
