@@ -66,7 +66,6 @@ struct RenderScene {
   // The mouse drag: a line from the dragged particle to its target.
   bool drag = false;
   Vec3f drag_from = Vec3f::Zero(), drag_to = Vec3f::Zero();
-  int highlight_particle = -1;
 
   // Axis-aligned bounds of the particles this frame (lo > hi when there are none).
   void particle_bounds(Vec3f& lo, Vec3f& hi) const;
