@@ -50,8 +50,10 @@ Scene LiveSettings::applied_to(Scene scene) const {
   return scene;
 }
 
-LiveSimulation::LiveSimulation(Scene scene, bool threaded)
-    : scene_(std::move(scene)), settings_(LiveSettings::of(scene_)) {
+LiveSimulation::LiveSimulation(Scene scene, bool threaded, std::function<void()> on_publish)
+    : scene_(std::move(scene)),
+      settings_(LiveSettings::of(scene_)),
+      on_publish_(std::move(on_publish)) {
   scene_.validate();
   sim_scene_ = scene_;
   rebuild(sim_scene_, false);
@@ -264,6 +266,7 @@ void LiveSimulation::publish() {
     std::swap(back_, middle_);
     fresh_ = true;
   }
+  if (on_publish_) on_publish_();
 }
 
 bool LiveSimulation::refresh() {

@@ -7,6 +7,7 @@
 #include <array>
 #include <atomic>
 #include <condition_variable>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -54,8 +55,9 @@ struct LiveFrame {
 class LiveSimulation {
  public:
   // threaded: steps on its own thread while playing; otherwise only advance_to() steps.
-  // Throws InputError for an invalid scene.
-  LiveSimulation(Scene scene, bool threaded);
+  // on_publish (may be empty) is called on the simulating thread after each published frame
+  // (the window wakes up with it). Throws InputError for an invalid scene.
+  LiveSimulation(Scene scene, bool threaded, std::function<void()> on_publish = {});
   ~LiveSimulation();
   LiveSimulation(const LiveSimulation&) = delete;
   LiveSimulation& operator=(const LiveSimulation&) = delete;
@@ -140,6 +142,7 @@ class LiveSimulation {
   double step_seconds_sum_ = 0, step_cpu_seconds_sum_ = 0;
   long step_count_ = 0;
 
+  std::function<void()> on_publish_;
   std::thread thread_;
 };
 

@@ -337,7 +337,8 @@ struct ViewerWindow::Impl {
     scene_path = path;
     std::snprintf(path_buffer, sizeof path_buffer, "%s", path.c_str());
     scene_files = scenes_beside(path);
-    live = std::make_unique<LiveSimulation>(s, !options.lockstep);
+    // Each published frame wakes the window if it sleeps (paused, waiting for events).
+    live = std::make_unique<LiveSimulation>(s, !options.lockstep, [] { glfwPostEmptyEvent(); });
     live->set_speed(options.speed);
     speed = static_cast<float>(options.speed > 0 ? options.speed : 1);
     max_speed = options.speed <= 0;
@@ -879,7 +880,14 @@ struct ViewerWindow::Impl {
 
   bool frame() {
     const double frame_cpu_start = thread_cpu_seconds();
-    glfwPollEvents();
+    // Nothing moves while paused: sleep until an event (or a quarter second) instead of
+    // drawing the same picture again.
+    const bool moving = options.lockstep || options.frames >= 0 || drag != Drag::kNone ||
+                        frames_shown < 2 || (live ? live->playing() : replay_playing);
+    if (moving)
+      glfwPollEvents();
+    else
+      glfwWaitEventsTimeout(0.25);
     if (glfwWindowShouldClose(window)) return false;
     const double wall_dt = seconds_since(last_frame_time);
     last_frame_time = Clock::now();
