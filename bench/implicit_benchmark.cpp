@@ -13,7 +13,7 @@
 #include <random>
 #include <tuple>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>

@@ -1,9 +1,10 @@
 #include <cstdio>
 #include <string>
 
-#include <jelly/io/scene.hpp>
+#include <jelly/geometry/body_kinds.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/contact_params.hpp>
+#include <jelly/terrain/terrain_kinds.hpp>
 
 #include "commands.hpp"
 #include "exit_codes.hpp"
@@ -12,43 +13,23 @@ namespace jelly::cli {
 
 namespace {
 
-const char* terrain_description(TerrainKind kind) {
-  switch (kind) {
-    case TerrainKind::kPlane:
-      return "a fixed plane: point, normal";
-    case TerrainKind::kSlope:
-      return "a fixed plane tilted about z: angle_degrees, point";
-    case TerrainKind::kElevator:
-      return "a moving platform: center, size_x, size_z, thickness, mass, motion";
-  }
-  return "";
-}
-
-const char* contact_description(ContactModel model) {
-  switch (model) {
-    case ContactModel::kCoulomb:
-      return "projection, restitution above a resting speed, Coulomb friction (default)";
-    case ContactModel::kSeed:
-      return "the seed report's rules: reflection within epsilon, friction -mu N v_t";
-  }
-  return "";
-}
-
-void line(const std::string& kind, std::string_view name, std::string_view description) {
-  std::printf("%-10s %-18s %.*s\n", kind.c_str(), std::string(name).c_str(),
-              static_cast<int>(description.size()), description.data());
+void line(std::string_view kind, std::string_view name, std::string_view description) {
+  std::printf("%-10.*s %-18.*s %.*s\n", static_cast<int>(kind.size()), kind.data(),
+              static_cast<int>(name.size()), name.data(), static_cast<int>(description.size()),
+              description.data());
 }
 
 }  // namespace
 
+// Every kind a scene can name, read from the registries.
 int list_command() {
   for (const IntegratorInfo& info : integrator_infos())
     line("integrator", info.name, info.description);
-  for (TerrainKind kind : terrain_kinds()) {
-    line("terrain", terrain_kind_name(kind), terrain_description(kind));
-  }
-  for (ContactModel model : {ContactModel::kCoulomb, ContactModel::kSeed}) {
-    line("contact", contact_model_name(model), contact_description(model));
+  for (const BodyKindInfo& k : body_kinds()) line("body", k.name, k.description);
+  for (const TerrainKindInfo& k : terrain_kinds()) line("terrain", k.name, k.description);
+  for (const EnumName<ContactModel>& m : contact_models()) line("contact", m.name, m.description);
+  for (const EnumName<ExternalForceKind>& k : external_force_kinds()) {
+    line("force", k.name, k.description);
   }
   return kExitOk;
 }

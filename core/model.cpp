@@ -7,40 +7,52 @@
 
 namespace jelly {
 
-std::string_view spring_type_name(SpringType type) {
-  switch (type) {
-    case SpringType::kStructural:
-      return "structural";
-    case SpringType::kShear:
-      return "shear";
-    case SpringType::kBending:
-      return "bending";
+int Model::add_body(const std::string& name, BodyPart part, Real radius) {
+  require(!name.empty(), "body.name", "\"\"", "a non-empty name");
+  require(find_body(name) == nullptr, "body.name", "\"" + name + "\"",
+          "a name no other body of the model has");
+  const int n = part.num_particles();
+  require(n > 0, "bodies." + name + ".particles", n, "at least one particle");
+  require(part.position.size() == 3 * n, "bodies." + name + ".position.size", part.position.size(),
+          "3 x the number of particles");
+  const int first = num_particles();
+  Body body;
+  body.name = name;
+  body.kind = part.kind;
+  body.first_particle = first;
+  body.num_particles = n;
+  body.first_spring = springs.size();
+  body.num_springs = part.springs.size();
+  body.spacing = part.spacing;
+  body.radius = radius > 0 ? radius : 0.5 * part.spacing;
+  body.surface = std::move(part.surface);
+  body.surface.shift_particles(first);
+  body.groups = std::move(part.groups);
+  for (ParticleGroup& g : body.groups) {
+    for (int& p : g.particles) p += first;
   }
-  return "unknown";
+
+  mass.conservativeResize(first + n);
+  mass.tail(n) = part.mass;
+  rest_position.conservativeResize(3 * (first + n));
+  rest_position.tail(3 * n) = part.position;
+  springs.append(part.springs, first);
+  bodies.push_back(std::move(body));
+  return num_bodies() - 1;
 }
 
-void Springs::add(int a_index, int b_index, Real rest, SpringCoefficients c, SpringType t) {
-  a.push_back(a_index);
-  b.push_back(b_index);
-  rest_length.push_back(rest);
-  ks.push_back(c.ks);
-  kd.push_back(c.kd);
-  type.push_back(t);
-}
-
-int Springs::count(SpringType t) const {
-  int n = 0;
-  for (SpringType s : type) n += (s == t);
-  return n;
-}
-
-void Springs::set_coefficients(SpringType t, SpringCoefficients c) {
-  for (int s = 0; s < size(); ++s) {
-    if (type[s] == t) {
-      ks[s] = c.ks;
-      kd[s] = c.kd;
-    }
+const Body* Model::find_body(std::string_view name) const {
+  for (const Body& b : bodies) {
+    if (b.name == name) return &b;
   }
+  return nullptr;
+}
+
+const Body& Model::body_of(int particle) const {
+  for (const Body& b : bodies) {
+    if (b.contains(particle)) return b;
+  }
+  throw InputError("particle", std::to_string(particle), "a particle of one of the bodies");
 }
 
 void Model::validate() const {
@@ -65,6 +77,34 @@ void Model::validate() const {
     require(std::isfinite(springs.kd[s]) && springs.kd[s] >= 0, at + ".kd", springs.kd[s],
             "a finite damping >= 0");
   }
+  // Bodies, when there are any, cover the particles and springs in order.
+  int next_particle = 0, next_spring = 0;
+  for (const Body& b : bodies) {
+    const std::string at = "bodies." + b.name;
+    require(b.first_particle == next_particle && b.num_particles > 0, at + ".first_particle",
+            b.first_particle, "the particles after the previous body's");
+    require(b.first_spring == next_spring && b.num_springs >= 0, at + ".first_spring",
+            b.first_spring, "the springs after the previous body's");
+    next_particle = b.end_particle();
+    next_spring = b.end_spring();
+    b.surface.validate(n, at + ".surface");
+  }
+  if (!bodies.empty()) {
+    require(next_particle == n, "bodies", next_particle, "bodies covering all particles");
+    require(next_spring == springs.size(), "bodies", next_spring, "bodies covering all springs");
+  }
+  pins.validate(n);
+  for (std::size_t k = 0; k < external_forces.size(); ++k) {
+    external_forces[k].validate(n, "external_forces[" + std::to_string(k) + "].");
+  }
+}
+
+State rest_state(const Model& model) {
+  State state;
+  state.t = 0;
+  state.x = model.rest_position;
+  state.v = VecX::Zero(model.num_dofs());
+  return state;
 }
 
 }  // namespace jelly

@@ -116,7 +116,7 @@ StepResult ImplicitEulerCeres::do_step(const Dynamics& dynamics, State& state, R
   const Eigen::Index n = model.num_dofs();
   ensure_size(m.f, n);
   ensure_size(m.f_springs, n);
-  dynamics.forces(state.x, state.v, m.f);
+  dynamics.forces(state.t + h, state.x, state.v, m.f);
   m.f_springs.setZero();
   add_spring_forces(model, state.x, state.v, m.f_springs);
   for (int i = 0; i < model.num_particles(); ++i) {

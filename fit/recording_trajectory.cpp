@@ -22,11 +22,11 @@ Trajectory trajectory_from_recording(const Recording& recording) {
   t.times = recording.time;
   t.positions = recording.position;
   if (recording.velocity.size() == recording.position.size()) t.velocities = recording.velocity;
-  const std::vector<TerrainSpec> specs = scene.terrains;
+  const std::vector<PolymorphicValue<TerrainSpec>> specs = scene.terrains;
   if (!specs.empty()) {
     t.terrains = [specs] {
       Terrains terrains;
-      for (const TerrainSpec& spec : specs) terrains.push_back(make_terrain(spec));
+      for (const auto& spec : specs) terrains.push_back(spec->make());
       return terrains;
     };
   }
@@ -39,7 +39,7 @@ Trajectory trajectory_from_recording(const Recording& recording) {
 
 Scene fitted_scene(const Recording& recording, const FitResult& result) {
   Scene scene = recording_scene(recording);
-  apply_fit(scene.cube, result);
+  for (BodySpec& body : scene.bodies) apply_fit(body.material, result);
   return scene;
 }
 

@@ -14,7 +14,7 @@ namespace jelly {
 // scene is invalid. The coefficients of the returned model are those of the recording's scene.
 Trajectory trajectory_from_recording(const Recording& recording);
 
-// The recording's scene with the fitted coefficients written into its cube's spring types.
+// The recording's scene with the fitted coefficients written into every body's spring types.
 Scene fitted_scene(const Recording& recording, const FitResult& result);
 
 }  // namespace jelly

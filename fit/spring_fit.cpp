@@ -466,14 +466,22 @@ void apply_fit(Model& model, const FitResult& result) {
   for (const FittedParameter& p : result.parameters) set_parameter(model, p.parameter, p.value);
 }
 
-void apply_fit(CubeSpec& spec, const FitResult& result) {
+namespace {
+
+void apply_fit(std::array<SpringCoefficients, kSpringTypeCount>& springs, const FitResult& result) {
   for (const FittedParameter& p : result.parameters) {
     for (SpringType t : kTypes) {
       if (!p.parameter.applies_to(t)) continue;
-      SpringCoefficients& c = spec.springs[static_cast<int>(t)];
+      SpringCoefficients& c = springs[static_cast<int>(t)];
       (p.parameter.quantity == FitParameter::Quantity::kKs ? c.ks : c.kd) = p.value;
     }
   }
 }
+
+}  // namespace
+
+void apply_fit(Material& material, const FitResult& result) { apply_fit(material.springs, result); }
+
+void apply_fit(CubeSpec& spec, const FitResult& result) { apply_fit(spec.springs, result); }
 
 }  // namespace jelly

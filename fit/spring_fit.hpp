@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/fit/trajectory.hpp>
 
@@ -102,6 +102,7 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options 
 
 // Writes the fitted values into every spring they apply to.
 void apply_fit(Model& model, const FitResult& result);
+void apply_fit(Material& material, const FitResult& result);
 void apply_fit(CubeSpec& spec, const FitResult& result);
 
 // 1/2 sum over the windows of |x_replay - x_recorded|^2 with the model's current coefficients.

@@ -5,7 +5,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/io/detail/checkpoint_h5.hpp>
 #include <jelly/io/detail/h5.hpp>
-#include <jelly/io/detail/json_fields.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 
 namespace jelly {
@@ -175,24 +175,24 @@ void restore(Simulator& sim, const Checkpoint& cp) {
 namespace {
 
 // The first JSON path at which a and b differ, or "" when they are equal.
-std::string first_difference(const detail::Json& a, const detail::Json& b,
+std::string first_difference(const Json& a, const Json& b,
                              const std::string& path) {
   if (a.is_object() && b.is_object()) {
     for (auto it = a.begin(); it != a.end(); ++it) {
-      const std::string child = detail::json_child(path, it.key());
+      const std::string child = json_child(path, it.key());
       const auto other = b.find(it.key());
       if (other == b.end()) return child;
       std::string d = first_difference(it.value(), *other, child);
       if (!d.empty()) return d;
     }
     for (auto it = b.begin(); it != b.end(); ++it) {
-      if (a.find(it.key()) == a.end()) return detail::json_child(path, it.key());
+      if (a.find(it.key()) == a.end()) return json_child(path, it.key());
     }
     return "";
   }
   if (a.is_array() && b.is_array() && a.size() == b.size()) {
     for (std::size_t i = 0; i < a.size(); ++i) {
-      std::string d = first_difference(a[i], b[i], detail::json_element(path, i));
+      std::string d = first_difference(a[i], b[i], json_element(path, i));
       if (!d.empty()) return d;
     }
     return "";
@@ -200,8 +200,8 @@ std::string first_difference(const detail::Json& a, const detail::Json& b,
   return a == b ? "" : (path.empty() ? std::string("scene") : path);
 }
 
-const detail::Json* at_path(const detail::Json& j, const std::string& path) {
-  const detail::Json* current = &j;
+const Json* at_path(const Json& j, const std::string& path) {
+  const Json* current = &j;
   std::string part;
   for (std::size_t i = 0; i <= path.size(); ++i) {
     const char c = i < path.size() ? path[i] : '.';
@@ -225,8 +225,8 @@ const detail::Json* at_path(const detail::Json& j, const std::string& path) {
 }
 
 // The parts of a scene that decide its trajectory, as JSON.
-detail::Json run_defining_json(const Scene& scene) {
-  detail::Json j = detail::parse_json(scene_to_json(scene), "scene");
+Json run_defining_json(const Scene& scene) {
+  Json j = detail::parse_json(scene_to_json(scene), "scene");
   for (const char* key : {"description", "duration", "output_interval", "divergence"}) j.erase(key);
   return j;
 }
@@ -245,13 +245,13 @@ void check_same_scene(const Checkpoint& cp, const Scene& scene, const std::strin
   } catch (const InputError& e) {
     throw InputError("--restart " + source + ": its stored scene cannot be read: " + e.what());
   }
-  const detail::Json was = run_defining_json(recorded);
-  const detail::Json now = run_defining_json(scene);
+  const Json was = run_defining_json(recorded);
+  const Json now = run_defining_json(scene);
   const std::string path = first_difference(was, now, "");
   if (path.empty()) return;
-  const auto text = [&](const detail::Json& j) {
-    const detail::Json* v = at_path(j, path);
-    return v == nullptr ? std::string("nothing") : detail::json_text(*v);
+  const auto text = [&](const Json& j) {
+    const Json* v = at_path(j, path);
+    return v == nullptr ? std::string("nothing") : json_text(*v);
   };
   throw InputError("--restart " + source + ": its run had " + path + " = " + text(was) +
                    ", this scene has " + text(now) +

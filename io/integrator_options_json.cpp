@@ -34,7 +34,7 @@ void parse_arkode(JsonFields& f, ArkodeOptions& o) {
   o.method = f.string_or("method", o.method);
   o.max_step = f.number_or("max_step", o.max_step);
   o.linear_solver = f.string_or("linear_solver", o.linear_solver);
-  o.max_steps = f.integer_or("max_steps", static_cast<int>(o.max_steps));
+  o.max_steps = f.long_or("max_steps", o.max_steps);
 }
 
 }  // namespace

@@ -8,50 +8,10 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/plane.hpp>
 
 namespace jelly {
 
-std::string_view terrain_kind_name(TerrainKind kind) {
-  switch (kind) {
-    case TerrainKind::kPlane:
-      return "plane";
-    case TerrainKind::kSlope:
-      return "slope";
-    case TerrainKind::kElevator:
-      return "elevator";
-  }
-  return "unknown";
-}
-
-const std::vector<TerrainKind>& terrain_kinds() {
-  static const std::vector<TerrainKind> kinds{TerrainKind::kPlane, TerrainKind::kSlope,
-                                              TerrainKind::kElevator};
-  return kinds;
-}
-
 namespace {
-
-void validate_terrain(const TerrainSpec& t, const std::string& prefix) {
-  switch (t.kind) {
-    case TerrainKind::kPlane:
-      require(t.plane.point.allFinite(), prefix + "point", t.plane.point.transpose(),
-              "finite coordinates");
-      require(t.plane.normal.allFinite() && t.plane.normal.norm() > 1e-12, prefix + "normal",
-              t.plane.normal.transpose(), "a finite, non-zero vector");
-      break;
-    case TerrainKind::kSlope:
-      require(std::isfinite(t.slope.angle_degrees) && std::abs(t.slope.angle_degrees) < 90,
-              prefix + "angle_degrees", t.slope.angle_degrees, "an angle in (-90, 90) degrees");
-      require(t.slope.point.allFinite(), prefix + "point", t.slope.point.transpose(),
-              "finite coordinates");
-      break;
-    case TerrainKind::kElevator:
-      t.elevator.validate(prefix);
-      break;
-  }
-  t.contact.validate(prefix + "contact.");
-}
 
 SimulatorOptions simulator_options(const Scene& scene) {
   SimulatorOptions options;
@@ -61,12 +21,73 @@ SimulatorOptions simulator_options(const Scene& scene) {
   return options;
 }
 
+std::string body_prefix(std::size_t i) { return "bodies[" + std::to_string(i) + "]."; }
+
 }  // namespace
 
+BodySpec cube_body(const CubeSpec& cube, const std::string& name) {
+  BodySpec b;
+  b.name = name;
+  b.shape = cube.shape();
+  b.material = cube.material();
+  return b;
+}
+
+BodySpec Scene::seed_cube_body() { return cube_body(CubeSpec{}); }
+
+CubeSpec Scene::cube(int index) const {
+  require(index >= 0 && index < static_cast<int>(bodies.size()), "bodies", index,
+          "the index of a body of the scene");
+  const BodySpec& b = bodies[index];
+  require(b.shape && b.shape.is<CubeShape>(), body_prefix(index) + "kind",
+          "\"" + std::string(b.kind()) + "\"", "\"cube\"");
+  const CubeShape& s = b.shape.as<CubeShape>();
+  CubeSpec c;
+  c.n = s.n;
+  c.edge_length = s.edge_length;
+  c.origin = s.origin;
+  c.particle_mass = b.material.particle_mass;
+  c.springs = b.material.springs;
+  c.gravity = gravity;
+  return c;
+}
+
+void Scene::set_cube(const CubeSpec& cube, int index) {
+  require(index >= 0 && index < static_cast<int>(bodies.size()), "bodies", index,
+          "the index of a body of the scene");
+  const std::string name = bodies[index].name;
+  const Real radius = bodies[index].radius;
+  std::vector<PinSpec> pins = std::move(bodies[index].pins);
+  std::vector<ExternalForceSpec> forces = std::move(bodies[index].forces);
+  bodies[index] = cube_body(cube, name);
+  bodies[index].radius = radius;
+  bodies[index].pins = std::move(pins);
+  bodies[index].forces = std::move(forces);
+  gravity = cube.gravity;
+}
+
 void Scene::validate() const {
-  cube.validate();  // its field names are the scene's JSON paths: cube.n, springs.shear.kd, ...
+  require(!bodies.empty(), "bodies", "[]", "at least one body");
+  long particles = 0;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    bodies[i].validate(body_prefix(i));
+    for (std::size_t j = 0; j < i; ++j) {
+      require(bodies[j].name != bodies[i].name, body_prefix(i) + "name",
+              "\"" + bodies[i].name + "\"",
+              "a name no other body has (bodies[" + std::to_string(j) + "] has it)");
+    }
+    particles += bodies[i].shape->estimated_particles();
+  }
+  require(max_particles > 0, "max_particles", max_particles, "a number of particles > 0");
+  require(particles <= max_particles, "bodies", std::to_string(particles) + " particles",
+          "at most max_particles = " + std::to_string(max_particles) +
+              " (raise max_particles if the memory allows)");
+  require(gravity.allFinite(), "gravity", gravity.transpose(), "finite components");
   for (std::size_t i = 0; i < terrains.size(); ++i) {
-    validate_terrain(terrains[i], "terrains[" + std::to_string(i) + "].");
+    const std::string prefix = "terrains[" + std::to_string(i) + "].";
+    require(static_cast<bool>(terrains[i]), prefix + "kind", "none", "a terrain kind");
+    terrains[i]->validate(prefix);
+    terrains[i]->contact.validate(prefix + "contact.");
   }
   const std::vector<std::string> names = integrator_names();
   std::string known;
@@ -82,27 +103,25 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   return parse_scene(detail::read_json_file(path, "scene file"), overrides, path);
 }
 
-std::unique_ptr<Terrain> make_terrain(const TerrainSpec& spec) {
-  switch (spec.kind) {
-    case TerrainKind::kPlane:
-      return std::make_unique<Plane>(spec.plane.point, spec.plane.normal, spec.contact);
-    case TerrainKind::kSlope:
-      return std::make_unique<Plane>(
-          Plane::slope(spec.slope.angle_degrees, spec.slope.point, spec.contact));
-    case TerrainKind::kElevator:
-      return std::make_unique<Elevator>(spec.elevator, spec.contact);
+std::unique_ptr<Terrain> make_terrain(const TerrainSpec& spec) { return spec.make(); }
+
+Model make_model(const Scene& scene) {
+  scene.validate();
+  Model model;
+  model.gravity = scene.gravity;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    add_body(model, scene.bodies[i], body_prefix(i));
   }
-  throw InputError("terrain.kind", std::to_string(static_cast<int>(spec.kind)), "a TerrainKind");
+  return model;
 }
 
 Simulator make_simulator(const Scene& scene) {
-  scene.validate();
-  Model model = build_cube(scene.cube);
+  Model model = make_model(scene);
   State state = rest_state(model);
   Simulator sim(std::move(model), std::move(state),
                 make_integrator(scene.integrator.name, scene.integrator.options),
                 simulator_options(scene));
-  for (const TerrainSpec& t : scene.terrains) sim.add_terrain(make_terrain(t));
+  for (const auto& t : scene.terrains) sim.add_terrain(t->make());
   return sim;
 }
 

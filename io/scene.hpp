@@ -1,47 +1,23 @@
 #pragma once
-// A scene: everything a run needs (cube, springs, gravity, terrains with their contact, the
-// integrator, duration, output interval, divergence limits), read from and written to JSON with
-// strict validation. The JSON format is described in docs/scenes.md.
+// A scene: everything a run needs (bodies with their materials, pins and forces, gravity,
+// terrains with their contact, the integrator, duration, output interval, divergence limits),
+// read from and written to JSON with strict validation. The JSON format is in docs/scenes.md.
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/core/polymorphic_value.hpp>
+#include <jelly/geometry/body_spec.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/divergence_guard.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/contact_params.hpp>
-#include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/terrain.hpp>
+#include <jelly/terrain/terrain_spec.hpp>
 
 namespace jelly {
-
-enum class TerrainKind { kPlane, kSlope, kElevator };
-std::string_view terrain_kind_name(TerrainKind kind);
-// Every terrain kind a scene can name, in the order of TerrainKind.
-const std::vector<TerrainKind>& terrain_kinds();
-
-// A fixed plane through `point` with outward normal `normal` (need not be unit length).
-struct PlaneSpec {
-  Vec3 point = Vec3::Zero();
-  Vec3 normal = Vec3::UnitY();
-};
-
-// A plane through `point` tilted by `angle_degrees` about z: normal (sin a, cos a, 0).
-struct SlopeSpec {
-  Real angle_degrees = 20;
-  Vec3 point = Vec3::Zero();
-};
-
-// One terrain of a scene: only the spec that matches `kind` is used.
-struct TerrainSpec {
-  TerrainKind kind = TerrainKind::kPlane;
-  PlaneSpec plane;
-  SlopeSpec slope;
-  ElevatorSpec elevator;
-  ContactParams contact;
-};
 
 struct IntegratorSpec {
   std::string name;  // a name from integrator_names(); required in a scene file
@@ -51,17 +27,33 @@ struct IntegratorSpec {
 
 struct Scene {
   std::string description;  // free text, not used by the solver
-  CubeSpec cube;            // the lattice, the springs of each type and gravity
-  std::vector<TerrainSpec> terrains;
+  // The bodies, in order (their particles follow each other in the model). A scene file
+  // without "bodies" holds one cube named "jelly" described by its "cube" and "springs" keys.
+  std::vector<BodySpec> bodies{seed_cube_body()};
+  Vec3 gravity{0, -9.8, 0};
+  std::vector<PolymorphicValue<TerrainSpec>> terrains;
   IntegratorSpec integrator;
   Real duration = 5;                // s simulated by `jelly run`; required in a scene file
   Real output_interval = 1.0 / 60;  // s between recorded frames; 0 = every step
   DivergenceGuard divergence;
+  // Most particles the bodies may have together (a guard against a spacing or n that would
+  // exhaust memory).
+  long max_particles = 2'000'000;
 
   // Throws InputError naming the JSON path of the first invalid field (e.g.
   // "terrains[0].contact.restitution"), its value and what is allowed.
   void validate() const;
+
+  // The seed's cube body: CubeSpec{} as body "jelly".
+  static BodySpec seed_cube_body();
+  // A scene's cube body as a CubeSpec with the scene's gravity (one-cube scenes, tests); throws
+  // InputError when body `index` is not a cube.
+  CubeSpec cube(int index = 0) const;
+  void set_cube(const CubeSpec& cube, int index = 0);
 };
+
+// A body of kind "cube" from a CubeSpec (its gravity is the scene's, not the body's).
+BodySpec cube_body(const CubeSpec& cube, const std::string& name = "jelly");
 
 // Reads and validates a scene file, applying `overrides` ("springs.structural.ks=2400", see
 // apply_override) to the JSON before it is validated. Throws InputError for a file that cannot
@@ -84,8 +76,10 @@ std::string apply_override(const std::string& json_text, const std::string& assi
 
 // The terrain a spec describes, with its contact parameters.
 std::unique_ptr<Terrain> make_terrain(const TerrainSpec& spec);
-// The cube at rest, its terrains, the named integrator and the simulator options of the scene.
-// The caller runs it: sim.run_until(scene.duration).
+// The scene's model: its bodies (with pins and external forces) and gravity.
+Model make_model(const Scene& scene);
+// The bodies at rest, the terrains, the named integrator and the simulator options of the
+// scene. The caller runs it: sim.run_until(scene.duration).
 Simulator make_simulator(const Scene& scene);
 
 }  // namespace jelly

@@ -3,99 +3,58 @@
 #include <limits>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/detail/integrator_options_json.hpp>
-#include <jelly/io/detail/json_fields.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/detail/scene_override.hpp>
 #include <jelly/io/scene.hpp>
+#include <jelly/terrain/terrain_kinds.hpp>
 
 namespace jelly {
 
 namespace {
 
-using detail::Json;
-using detail::json_element;
-using detail::JsonFields;
-
-constexpr const char* kSpringKeys[kSpringTypeCount] = {"structural", "shear", "bending"};
-
-Json vec3_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
-
-ContactParams parse_contact(const Json& j, const std::string& path) {
+std::unique_ptr<TerrainSpec> read_terrain(const Json& j, const std::string& path) {
   JsonFields f(j, path);
-  ContactParams c;
-  c.model = contact_model_from_name(f.string_or("model", std::string(contact_model_name(c.model))),
-                                    f.path("model"));
-  c.restitution = f.number_or("restitution", c.restitution);
-  c.friction = f.number_or("friction", c.friction);
-  c.static_friction = f.number_or("static_friction", c.static_friction);
-  c.epsilon = f.number_or("epsilon", c.epsilon);
-  c.resting_speed = f.number_or("resting_speed", c.resting_speed);
-  f.reject_unknown();
-  c.validate(path + ".");
-  return c;
-}
-
-ElevatorMotion parse_motion(const Json& j, const std::string& path) {
-  if (j.is_string() && j.get<std::string>() == "seed") return ElevatorMotion::seed();
-  if (!j.is_array()) {
-    throw InputError(path, detail::json_text(j),
-                     "\"seed\" or a list of phases [{\"duration\": 2, \"acceleration\": 3, "
-                     "\"stop_at_end\": true}, ...]");
-  }
-  std::vector<MotionPhase> phases;
-  for (std::size_t i = 0; i < j.size(); ++i) {
-    JsonFields f(j[i], json_element(path, i));
-    MotionPhase p;
-    p.duration = f.number("duration");
-    p.acceleration = f.number("acceleration");
-    p.stop_at_end = f.boolean_or("stop_at_end", p.stop_at_end);
-    f.reject_unknown();
-    phases.push_back(p);
-  }
-  return ElevatorMotion(std::move(phases), path);
-}
-
-Real parse_mass(const Json& j, const std::string& path) {
-  if (j.is_string() && j.get<std::string>() == "inf") return std::numeric_limits<Real>::infinity();
-  if (!j.is_number()) throw InputError(path, detail::json_text(j), "a number or \"inf\"");
-  return j.get<Real>();
-}
-
-TerrainSpec parse_terrain(const Json& j, const std::string& path) {
-  JsonFields f(j, path);
-  TerrainSpec t;
   const std::string kind = f.string("kind");
-  std::string kinds;
-  bool found = false;
-  for (TerrainKind k : terrain_kinds()) {
-    kinds += (kinds.empty() ? "\"" : ", \"") + std::string(terrain_kind_name(k)) + "\"";
-    if (terrain_kind_name(k) == kind) t.kind = k, found = true;
+  std::unique_ptr<TerrainSpec> t = find_terrain_kind(kind, f.path("kind")).read(f);
+  if (const Json* c = f.value("contact")) {
+    JsonFields g(*c, f.path("contact"));
+    t->contact = ContactParams::read(g);
   }
-  if (!found) throw InputError(f.path("kind"), "\"" + kind + "\"", "one of " + kinds);
-  switch (t.kind) {
-    case TerrainKind::kPlane:
-      t.plane.point = f.vec3_or("point", t.plane.point);
-      t.plane.normal = f.vec3_or("normal", t.plane.normal);
-      break;
-    case TerrainKind::kSlope:
-      t.slope.angle_degrees = f.number_or("angle_degrees", t.slope.angle_degrees);
-      t.slope.point = f.vec3_or("point", t.slope.point);
-      break;
-    case TerrainKind::kElevator: {
-      ElevatorSpec& e = t.elevator;
-      e.center = f.vec3_or("center", e.center);
-      e.size_x = f.number_or("size_x", e.size_x);
-      e.size_z = f.number_or("size_z", e.size_z);
-      e.thickness = f.number_or("thickness", e.thickness);
-      if (const Json* m = f.value("mass")) e.mass = parse_mass(*m, f.path("mass"));
-      if (const Json* m = f.value("motion")) e.motion = parse_motion(*m, f.path("motion"));
-      break;
-    }
-  }
-  if (const Json* c = f.value("contact")) t.contact = parse_contact(*c, f.path("contact"));
   f.reject_unknown();
   return t;
+}
+
+Json terrain_json(const TerrainSpec& t) {
+  Json j;
+  j["kind"] = std::string(t.kind());
+  t.write(j);
+  j["contact"] = t.contact.to_json();
+  return j;
+}
+
+// The one-body form of the seed scenes: "cube" and "springs" at the top.
+BodySpec read_legacy_cube(JsonFields& root) {
+  BodySpec body = Scene::seed_cube_body();
+  CubeShape& shape = body.shape.as<CubeShape>();
+  if (const Json* c = root.value("cube")) {
+    JsonFields f(*c, "cube");
+    shape.n = f.integer_or("n", shape.n);
+    shape.edge_length = f.number_or("edge_length", shape.edge_length);
+    shape.origin = f.vec3_or("origin", shape.origin);
+    body.material.particle_mass = f.number_or("particle_mass", body.material.particle_mass);
+    f.reject_unknown();
+    shape.validate("cube.");
+    require(std::isfinite(body.material.particle_mass) && body.material.particle_mass > 0,
+            "cube.particle_mass", body.material.particle_mass, "a finite mass > 0");
+  }
+  if (const Json* sp = root.value("springs")) {
+    JsonFields f(*sp, "springs");
+    read_springs(f, body.material.springs);
+    body.material.validate("");
+  }
+  return body;
 }
 
 Scene scene_from_json(const Json& j) {
@@ -103,34 +62,32 @@ Scene scene_from_json(const Json& j) {
   Scene s;
   s.description = root.string_or("description", s.description);
 
-  if (const Json* c = root.value("cube")) {
-    JsonFields f(*c, "cube");
-    s.cube.n = f.integer_or("n", s.cube.n);
-    s.cube.edge_length = f.number_or("edge_length", s.cube.edge_length);
-    s.cube.origin = f.vec3_or("origin", s.cube.origin);
-    s.cube.particle_mass = f.number_or("particle_mass", s.cube.particle_mass);
-    f.reject_unknown();
-  }
-  if (const Json* sp = root.value("springs")) {
-    JsonFields f(*sp, "springs");
-    for (int t = 0; t < kSpringTypeCount; ++t) {
-      if (const Json* one = f.value(kSpringKeys[t])) {
-        JsonFields g(*one, f.path(kSpringKeys[t]));
-        s.cube.springs[t].ks = g.number_or("ks", s.cube.springs[t].ks);
-        s.cube.springs[t].kd = g.number_or("kd", s.cube.springs[t].kd);
-        g.reject_unknown();
-      }
+  if (const Json* bodies = root.value("bodies")) {
+    if (root.has("cube") || root.has("springs")) {
+      throw InputError(
+          "bodies and cube/springs are both given: a scene with \"bodies\" gives each body's "
+          "kind and springs inside it (\"cube\" and \"springs\" are the one-body form)");
     }
-    f.reject_unknown();
+    if (!bodies->is_array()) {
+      throw InputError("bodies", json_text(*bodies), "a list of bodies [{\"kind\": ...}, ...]");
+    }
+    s.bodies.clear();
+    for (std::size_t i = 0; i < bodies->size(); ++i) {
+      JsonFields f((*bodies)[i], json_element("bodies", i));
+      s.bodies.push_back(BodySpec::read(f));
+    }
+  } else {
+    s.bodies = {read_legacy_cube(root)};
   }
-  s.cube.gravity = root.vec3_or("gravity", s.cube.gravity);
+  s.gravity = root.vec3_or("gravity", s.gravity);
+  s.max_particles = root.long_or("max_particles", s.max_particles);
 
   if (const Json* ts = root.value("terrains")) {
     if (!ts->is_array()) {
-      throw InputError("terrains", detail::json_text(*ts), "a list of terrains [{...}, ...]");
+      throw InputError("terrains", json_text(*ts), "a list of terrains [{...}, ...]");
     }
     for (std::size_t i = 0; i < ts->size(); ++i) {
-      s.terrains.push_back(parse_terrain((*ts)[i], json_element("terrains", i)));
+      s.terrains.emplace_back(read_terrain((*ts)[i], json_element("terrains", i)));
     }
   }
 
@@ -160,50 +117,6 @@ Scene scene_from_json(const Json& j) {
   return s;
 }
 
-Json contact_json(const ContactParams& c) {
-  Json j;
-  j["model"] = std::string(contact_model_name(c.model));
-  j["restitution"] = c.restitution;
-  j["friction"] = c.friction;
-  j["static_friction"] = c.static_friction;
-  j["epsilon"] = c.epsilon;
-  j["resting_speed"] = c.resting_speed;
-  return j;
-}
-
-Json terrain_json(const TerrainSpec& t) {
-  Json j;
-  j["kind"] = std::string(terrain_kind_name(t.kind));
-  switch (t.kind) {
-    case TerrainKind::kPlane:
-      j["point"] = vec3_json(t.plane.point);
-      j["normal"] = vec3_json(t.plane.normal);
-      break;
-    case TerrainKind::kSlope:
-      j["angle_degrees"] = t.slope.angle_degrees;
-      j["point"] = vec3_json(t.slope.point);
-      break;
-    case TerrainKind::kElevator: {
-      const ElevatorSpec& e = t.elevator;
-      j["center"] = vec3_json(e.center);
-      j["size_x"] = e.size_x;
-      j["size_z"] = e.size_z;
-      j["thickness"] = e.thickness;
-      j["mass"] = std::isinf(e.mass) ? Json("inf") : Json(e.mass);
-      Json motion = Json::array();
-      for (const MotionPhase& p : e.motion.phases()) {
-        motion.push_back({{"duration", p.duration},
-                          {"acceleration", p.acceleration},
-                          {"stop_at_end", p.stop_at_end}});
-      }
-      j["motion"] = motion;
-      break;
-    }
-  }
-  j["contact"] = contact_json(t.contact);
-  return j;
-}
-
 }  // namespace
 
 Scene parse_scene(const std::string& json_text, const std::vector<std::string>& overrides,
@@ -216,18 +129,12 @@ Scene parse_scene(const std::string& json_text, const std::vector<std::string>& 
 std::string scene_to_json(const Scene& s) {
   Json j;
   j["description"] = s.description;
-  j["cube"] = {{"n", s.cube.n},
-               {"edge_length", s.cube.edge_length},
-               {"origin", vec3_json(s.cube.origin)},
-               {"particle_mass", s.cube.particle_mass}};
-  Json springs;
-  for (int t = 0; t < kSpringTypeCount; ++t) {
-    springs[kSpringKeys[t]] = {{"ks", s.cube.springs[t].ks}, {"kd", s.cube.springs[t].kd}};
-  }
-  j["springs"] = springs;
-  j["gravity"] = vec3_json(s.cube.gravity);
+  j["bodies"] = Json::array();
+  for (const BodySpec& b : s.bodies) j["bodies"].push_back(b.to_json());
+  j["gravity"] = json_of(s.gravity);
+  j["max_particles"] = s.max_particles;
   j["terrains"] = Json::array();
-  for (const TerrainSpec& t : s.terrains) j["terrains"].push_back(terrain_json(t));
+  for (const auto& t : s.terrains) j["terrains"].push_back(terrain_json(*t));
   j["integrator"] = {
       {"name", s.integrator.name},
       {"dt", s.integrator.dt},

@@ -126,7 +126,7 @@ void apply_override(Json& scene, const std::string& assignment) {
 }  // namespace detail
 
 std::string apply_override(const std::string& json_text, const std::string& assignment) {
-  detail::Json scene = detail::parse_json(json_text, "apply_override: the scene text");
+  Json scene = detail::parse_json(json_text, "apply_override: the scene text");
   detail::apply_override(scene, assignment);
   return scene.dump(2);
 }

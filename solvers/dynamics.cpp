@@ -5,18 +5,21 @@
 
 namespace jelly {
 
-void Dynamics::forces(const VecX& x, const VecX& v, VecX& f) const {
+void Dynamics::forces(Real t, const VecX& x, const VecX& v, VecX& f) const {
   ++evaluations_;
   if (bands_)
     bands_->compute_forces(*model_, x, v, f);
   else
     compute_forces(*model_, x, v, f);
   if (anchors_) add_anchor_forces(*anchors_, x, v, f);
+  if (!model_->external_forces.empty()) {
+    add_external_forces(model_->external_forces, model_->mass, t, v, f);
+  }
   contacts_->add_forces(v, f);
 }
 
-void Dynamics::acceleration(const VecX& x, const VecX& v, VecX& a) const {
-  forces(x, v, a);
+void Dynamics::acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const {
+  forces(t, x, v, a);
   const Real* m = model_->mass.data();
   Real* pa = a.data();
   for (int i = 0; i < model_->num_particles(); ++i) {
@@ -25,6 +28,7 @@ void Dynamics::acceleration(const VecX& x, const VecX& v, VecX& a) const {
     pa[3 * i + 1] *= inv;
     pa[3 * i + 2] *= inv;
   }
+  if (!model_->pins.empty()) model_->pins.apply_acceleration(t, a);
 }
 
 }  // namespace jelly

@@ -1,7 +1,8 @@
 #pragma once
-// The right-hand side every integrator sees: the model's forces (gravity, springs, dampers) plus
-// the contact forces active during the current step and the anchor springs (external pulls),
-// and the accelerations M^-1 f.
+// The right-hand side every integrator sees: the model's forces (gravity, springs, dampers,
+// external forces at time t) plus the contact forces active during the current step and the
+// anchor springs (external pulls), and the accelerations M^-1 f, with pinned particles following
+// their paths.
 #include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
@@ -23,10 +24,11 @@ class Dynamics {
         bands_(bands),
         anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr) {}
 
-  // f(x, v): size 3N, no allocation.
-  void forces(const VecX& x, const VecX& v, VecX& f) const;
-  // a = M^-1 f(x, v).
-  void acceleration(const VecX& x, const VecX& v, VecX& a) const;
+  // f(t, x, v): size 3N, no allocation. Pinned particles get the forces as if free (an
+  // implicit method constrains them itself).
+  void forces(Real t, const VecX& x, const VecX& v, VecX& f) const;
+  // a = M^-1 f(t, x, v), except that pinned particles get their path's acceleration.
+  void acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const;
 
   const Model& model() const { return *model_; }
   const ContactSolver& contacts() const { return *contacts_; }

@@ -90,6 +90,7 @@ StepResult Simulator::step() {
   if (!result.ok) return result;
   resolve_contact_after_step(*integrator_, contacts_, model_, terrains_, before_, state_,
                              options_.dt);
+  if (!model_.pins.empty()) model_.pins.apply(state_.t, state_.x, state_.v);
   ++total_steps_;
   return result;
 }

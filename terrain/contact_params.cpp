@@ -6,14 +6,20 @@
 
 namespace jelly {
 
-std::string_view contact_model_name(ContactModel model) {
-  return model == ContactModel::kSeed ? "seed" : "coulomb";
+const std::vector<EnumName<ContactModel>>& contact_models() {
+  static const std::vector<EnumName<ContactModel>> table{
+      {ContactModel::kCoulomb, "coulomb",
+       "projection, restitution above a resting speed, Coulomb friction (default)"},
+      {ContactModel::kSeed, "seed",
+       "the seed report's rules: reflection within epsilon, friction -mu N v_t"},
+  };
+  return table;
 }
 
+std::string_view contact_model_name(ContactModel model) { return name_of(contact_models(), model); }
+
 ContactModel contact_model_from_name(std::string_view name, std::string_view field) {
-  if (name == "coulomb") return ContactModel::kCoulomb;
-  if (name == "seed") return ContactModel::kSeed;
-  throw InputError(field, "\"" + std::string(name) + "\"", "one of \"coulomb\", \"seed\"");
+  return value_of(contact_models(), name, field);
 }
 
 void ContactParams::validate(const std::string& prefix) const {
@@ -27,6 +33,31 @@ void ContactParams::validate(const std::string& prefix) const {
           "a finite distance > 0");
   require(std::isfinite(resting_speed) && resting_speed >= 0, prefix + "resting_speed",
           resting_speed, "a finite speed >= 0");
+}
+
+ContactParams ContactParams::read(JsonFields& f) {
+  ContactParams c;
+  c.model = contact_model_from_name(f.string_or("model", std::string(contact_model_name(c.model))),
+                                    f.path("model"));
+  c.restitution = f.number_or("restitution", c.restitution);
+  c.friction = f.number_or("friction", c.friction);
+  c.static_friction = f.number_or("static_friction", c.static_friction);
+  c.epsilon = f.number_or("epsilon", c.epsilon);
+  c.resting_speed = f.number_or("resting_speed", c.resting_speed);
+  f.reject_unknown();
+  c.validate(f.prefix());
+  return c;
+}
+
+Json ContactParams::to_json() const {
+  Json j;
+  j["model"] = std::string(contact_model_name(model));
+  j["restitution"] = restitution;
+  j["friction"] = friction;
+  j["static_friction"] = static_friction;
+  j["epsilon"] = epsilon;
+  j["resting_speed"] = resting_speed;
+  return j;
 }
 
 }  // namespace jelly

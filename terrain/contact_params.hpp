@@ -2,7 +2,10 @@
 // How a terrain answers a particle that touches it: the contact model and its coefficients.
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include <jelly/core/enum_names.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {
@@ -15,8 +18,10 @@ enum class ContactModel {
   // force cancelling the inward force, and friction -mu N v_t proportional to the speed.
   kSeed,
 };
+// Every contact model with its name and description.
+const std::vector<EnumName<ContactModel>>& contact_models();
 std::string_view contact_model_name(ContactModel model);
-// Throws InputError for a name other than "coulomb" or "seed".
+// Throws InputError naming `field` for an unknown name.
 ContactModel contact_model_from_name(std::string_view name, std::string_view field);
 
 struct ContactParams {
@@ -30,8 +35,11 @@ struct ContactParams {
   // down by gravity and its springs) is absorbed, so that a resting jelly does not jitter.
   Real resting_speed = 0.05;
 
-  // Throws InputError naming `prefix`.field for a value out of range.
+  // Throws InputError naming `prefix`field for a value out of range.
   void validate(const std::string& prefix) const;
+  // Reads the keys of a scene's "contact" object (missing keys keep their defaults), validated.
+  static ContactParams read(JsonFields& fields);
+  Json to_json() const;
 };
 
 }  // namespace jelly

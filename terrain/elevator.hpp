@@ -4,20 +4,27 @@
 // does not touch it and falls past.
 #include <string>
 
-#include <jelly/terrain/elevator_motion.hpp>
+#include <jelly/core/elevator_motion.hpp>
 #include <jelly/terrain/terrain.hpp>
+#include <jelly/terrain/terrain_spec.hpp>
 
 namespace jelly {
 
-struct ElevatorSpec {
+// Scene kind "elevator".
+struct ElevatorSpec final : TerrainSpecOf<ElevatorSpec> {
   Vec3 center{0, 1, 0};  // platform centre at t = 0
   Real size_x = 5;       // footprint along x (m), > 0
   Real size_z = 5;       // footprint along z (m), > 0
   Real thickness = 1;    // how deep below the surface a particle still counts as touching (m)
   Real mass = 1;         // kg, the platform mass of the seed collision formula
   ElevatorMotion motion = ElevatorMotion::seed();
+
+  std::string_view kind() const override { return "elevator"; }
   // Throws InputError naming `prefix`field (a scene passes its JSON path, "terrains[0].").
-  void validate(const std::string& prefix = "elevator.") const;
+  void validate(const std::string& prefix) const override;
+  std::unique_ptr<Terrain> make() const override;
+  void write(Json& object) const override;
+  static std::unique_ptr<TerrainSpec> read(JsonFields& fields);
 };
 
 class Elevator final : public Terrain {
@@ -35,6 +42,8 @@ class Elevator final : public Terrain {
     return Vec3(spec_.center.x(), height(t), spec_.center.z());
   }
   Real mass() const override { return spec_.mass; }
+  // The platform: size_x by thickness by size_z, its top face at the surface.
+  TriangleMesh render_mesh() const override;
 
   Real height(Real t) const { return spec_.center.y() + spec_.motion.offset(t); }
   const ElevatorSpec& spec() const { return spec_; }

@@ -1,6 +1,7 @@
 #pragma once
 // A fixed infinite plane (half-space): the floor, or the seed's 20-degree slope.
 #include <jelly/terrain/terrain.hpp>
+#include <jelly/terrain/terrain_spec.hpp>
 
 namespace jelly {
 
@@ -19,13 +20,41 @@ class Plane final : public Terrain {
   Vec3 surface_velocity(const Vec3& /*p*/, Real /*t*/) const override { return Vec3::Zero(); }
   bool can_contact(const Vec3& /*p*/, Real /*t*/) const override { return true; }
   Vec3 position(Real /*t*/) const override { return point_; }
+  // A square of side kRenderSize centred at the point.
+  TriangleMesh render_mesh() const override;
 
   const Vec3& point() const { return point_; }
   const Vec3& unit_normal() const { return normal_; }
 
+  static constexpr Real kRenderSize = 20;
+
  private:
   Vec3 point_;
   Vec3 normal_;
+};
+
+// Scene kind "plane": a fixed plane through `point` with outward `normal` (any length > 0).
+struct PlaneSpec final : TerrainSpecOf<PlaneSpec> {
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitY();
+
+  std::string_view kind() const override { return "plane"; }
+  void validate(const std::string& prefix) const override;
+  std::unique_ptr<Terrain> make() const override;
+  void write(Json& object) const override;
+  static std::unique_ptr<TerrainSpec> read(JsonFields& fields);
+};
+
+// Scene kind "slope": a plane through `point` tilted by `angle_degrees` about z.
+struct SlopeSpec final : TerrainSpecOf<SlopeSpec> {
+  Real angle_degrees = 20;
+  Vec3 point = Vec3::Zero();
+
+  std::string_view kind() const override { return "slope"; }
+  void validate(const std::string& prefix) const override;
+  std::unique_ptr<Terrain> make() const override;
+  void write(Json& object) const override;
+  static std::unique_ptr<TerrainSpec> read(JsonFields& fields);
 };
 
 }  // namespace jelly

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include <jelly/core/types.hpp>
+#include <jelly/geometry/triangle_mesh.hpp>
 #include <jelly/terrain/contact_params.hpp>
 
 namespace jelly {
@@ -28,6 +29,10 @@ class Terrain {
   virtual Vec3 position(Real t) const = 0;
   // Mass in the seed collision formula; infinite for a fixed terrain.
   virtual Real mass() const { return std::numeric_limits<Real>::infinity(); }
+  // The terrain's shape for drawing and export, in its own frame (a plane: a large square).
+  virtual TriangleMesh render_mesh() const = 0;
+  // Where render_mesh() is at time t: its rigid placement in the world.
+  virtual Eigen::Isometry3d pose(Real t) const;
 
   const ContactParams& contact() const { return contact_; }
   void set_contact(const ContactParams& contact);

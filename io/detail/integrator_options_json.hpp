@@ -2,7 +2,7 @@
 // The "integrator.options" object of a scene <-> IntegratorOptions. Internal to io/.
 #include <string>
 
-#include <jelly/io/detail/json_fields.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly::detail {

@@ -4,7 +4,7 @@
 // number within a double's range. Internal to io/.
 #include <string>
 
-#include <jelly/io/detail/json_fields.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly::detail {
 

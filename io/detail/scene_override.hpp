@@ -2,7 +2,7 @@
 // Applies "path=value" assignments (jelly run --set) to scene JSON. Internal to io/.
 #include <string>
 
-#include <jelly/io/detail/json_fields.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly::detail {
 

@@ -18,14 +18,14 @@ ContextPtr make_context() {
   return ContextPtr(context);
 }
 
-int rhs(realtype /*t*/, N_Vector y, N_Vector ydot, void* user_data) {
+int rhs(realtype t, N_Vector y, N_Vector ydot, void* user_data) {
   auto& d = *static_cast<RhsData*>(user_data);
   const Eigen::Index n = d.x.size();
   const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
   Eigen::Map<VecX> yd(N_VGetArrayPointer(ydot), 2 * n);
   d.x = yy.head(n);
   d.v = yy.tail(n);
-  d.dynamics->acceleration(d.x, d.v, d.a);
+  d.dynamics->acceleration(t, d.x, d.v, d.a);
   yd.head(n) = d.v;
   yd.tail(n) = d.a;
   return d.a.allFinite() ? 0 : 1;

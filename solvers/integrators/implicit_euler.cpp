@@ -242,7 +242,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   const Real* m = model.mass.data();
   // (M - h D - h^2 K) dv = h (f + h K v); K v comes out of the assembly.
   const auto start = Clock::now();
-  dynamics.forces(s.x, s.v, f_);
+  dynamics.forces(s.t + h, s.x, s.v, f_);
   if (!have_dv_) {  // first guess for CG: the explicit step h M^-1 f; later the last dv
     for (int i = 0; i < np; ++i) dv_.segment<3>(3 * i) = (h / m[i]) * f_.segment<3>(3 * i);
   }
@@ -286,7 +286,7 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
   converged_ = false;
   for (int k = 1;; ++k) {
     x1_ = s.x + h * v1_;
-    dynamics.forces(x1_, v1_, f_);
+    dynamics.forces(s.t + h, x1_, v1_, f_);
     for (int i = 0; i < np; ++i)
       g_.segment<3>(3 * i) =
           m[i] * (v1_.segment<3>(3 * i) - s.v.segment<3>(3 * i)) - h * f_.segment<3>(3 * i);

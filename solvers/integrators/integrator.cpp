@@ -12,7 +12,11 @@ StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
   require(state.x.size() == n && state.v.size() == n, "state.size", state.x.size(),
           "3 x the number of particles (" + std::to_string(n) + ")");
   StepResult result = do_step(dynamics, state, h);
-  if (result.ok) ++steps_;
+  if (!result.ok) return result;
+  // Pinned particles end the step exactly on their paths, whatever the method did with them.
+  const Pins& pins = dynamics.model().pins;
+  if (!pins.empty()) pins.apply(state.t, state.x, state.v);
+  ++steps_;
   return result;
 }
 

@@ -12,7 +12,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <jelly/geometry/body_kinds.hpp>
 #include <jelly/io/scene.hpp>
+#include <jelly/terrain/terrain_kinds.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 #include "cli/cli_support.hpp"
@@ -32,11 +34,15 @@ TEST(Cli, ListNamesEveryIntegratorTerrainKindAndContactModel) {
   for (const std::string& name : integrator_names()) {
     EXPECT_THAT(r.out, HasSubstr("integrator " + name + " ")) << name;
   }
-  for (TerrainKind kind : terrain_kinds()) {
-    EXPECT_THAT(r.out, HasSubstr("\nterrain    " + std::string(terrain_kind_name(kind)) + " "));
+  for (const TerrainKindInfo& kind : terrain_kinds()) {
+    EXPECT_THAT(r.out, HasSubstr("\nterrain    " + std::string(kind.name) + " "));
   }
-  EXPECT_THAT(r.out, HasSubstr("\ncontact    coulomb "));
-  EXPECT_THAT(r.out, HasSubstr("\ncontact    seed "));
+  for (const BodyKindInfo& kind : body_kinds()) {
+    EXPECT_THAT(r.out, HasSubstr("\nbody       " + std::string(kind.name) + " "));
+  }
+  for (const EnumName<ContactModel>& model : contact_models()) {
+    EXPECT_THAT(r.out, HasSubstr("\ncontact    " + std::string(model.name) + " "));
+  }
 }
 
 TEST(Cli, AShortGoodRunExitsZeroWithASummary) {
@@ -231,7 +237,7 @@ TEST(Cli, FitRecoversTheCoefficientsOfARecording) {
   r = jelly("fit '" + file + "' --initial ks=1400 --initial kd=30 --write-scene '" + fitted + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   const Scene s = load_scene(fitted);
-  for (const SpringCoefficients& c : s.cube.springs) {
+  for (const SpringCoefficients& c : s.cube().springs) {
     EXPECT_NEAR(c.ks, 1000, 10);  // within 1 %
     EXPECT_NEAR(c.kd, 20, 0.2);
   }

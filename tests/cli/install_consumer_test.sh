@@ -10,7 +10,7 @@ prefix=$work/prefix
 
 "$cmake" --install "$build_dir" --prefix "$prefix" >"$work/install.log"
 
-for f in include/jelly/jelly.hpp include/jelly/io/scene.hpp include/jelly/core/cube.hpp \
+for f in include/jelly/jelly.hpp include/jelly/io/scene.hpp include/jelly/geometry/cube.hpp \
          bin/jelly share/jelly/scenes/seed_slope.json; do
   [ -e "$prefix/$f" ] || { echo "missing from the install: $f"; exit 1; }
 done

@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/core/measures.hpp>
 

@@ -4,7 +4,7 @@
 
 #include <Eigen/Dense>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/forces.hpp>
 

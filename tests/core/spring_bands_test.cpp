@@ -3,7 +3,7 @@
 
 #include <random>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/forces.hpp>
 

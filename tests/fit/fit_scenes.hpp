@@ -5,7 +5,7 @@
 #include <memory>
 #include <random>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/fit/trajectory.hpp>
 #include <jelly/terrain/plane.hpp>
 

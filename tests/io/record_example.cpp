@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/solvers/integrators/registry.hpp>

@@ -14,7 +14,7 @@
 #include <sys/resource.h>
 #include <time.h>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>

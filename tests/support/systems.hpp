@@ -5,7 +5,7 @@
 
 #include <Eigen/Geometry>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/integrators/registry.hpp>

@@ -6,7 +6,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/viewer/detail/gl.hpp>
 #include <jelly/viewer/image_io.hpp>

@@ -8,7 +8,7 @@
 #include <map>
 #include <thread>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/io/export.hpp>

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/viewer/image_io.hpp>

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <iostream>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/arkode/arkode_dirk.hpp>

@@ -5,7 +5,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/core/measures.hpp>

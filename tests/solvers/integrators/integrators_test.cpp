@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include <jelly/core/cube.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Cholesky>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/core/measures.hpp>

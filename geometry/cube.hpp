@@ -5,9 +5,26 @@
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
+#include <jelly/geometry/body_shape.hpp>
 
 namespace jelly {
 
+// Body kind "cube": n particles per edge, edge_length, origin = position of particle (0, 0, 0).
+struct CubeShape final : BodyShapeOf<CubeShape> {
+  int n = 10;                                   // particles per edge, >= 2
+  Real edge_length = 4;                         // m, > 0
+  Vec3 origin{-20.0 / 9, 61.0 / 9, -20.0 / 9};  // position of particle (0, 0, 0)
+
+  std::string_view kind() const override { return "cube"; }
+  void validate(const std::string& prefix) const override;
+  BodyPart build(const Material& material, const std::string& prefix) const override;
+  long estimated_particles() const override { return static_cast<long>(n) * n * n; }
+  void write(Json& object) const override;
+  static std::unique_ptr<BodyShape> read(JsonFields& fields);
+};
+
+// The seed scene's one cube with its material and gravity, for building a one-body model in
+// code.
 struct CubeSpec {
   int n = 10;                                   // particles per edge, >= 2
   Real edge_length = 4;                         // m, > 0
@@ -18,19 +35,18 @@ struct CubeSpec {
       SpringCoefficients{1400, 50}, SpringCoefficients{1400, 50}, SpringCoefficients{1400, 50}};
   Vec3 gravity{0, -9.8, 0};
 
-  // Throws InputError naming the first invalid field.
+  CubeShape shape() const;
+  Material material() const;
+  // Throws InputError naming the first invalid field (cube.n, springs.shear.kd, gravity).
   void validate() const;
 };
 
 // Particle (i, j, k) of the lattice has index (i * n + j) * n + k and sits at
 // origin + (i, j, k) * edge_length / (n - 1). Springs: structural to the +x, +y, +z neighbours;
 // shear along the 6 face and 4 body diagonals of each unit cell; bending to the axis neighbours
-// at distance 2. For n = 10: 2700 + 7776 + 2400 = 12,876 springs.
+// at distance 2. For n = 10: 2700 + 7776 + 2400 = 12,876 springs. One body, named "jelly".
 Model build_cube(const CubeSpec& spec);
 
 inline int cube_index(int n, int i, int j, int k) { return (i * n + j) * n + k; }
-
-// The model at rest in its construction pose, at time 0.
-State rest_state(const Model& model);
 
 }  // namespace jelly

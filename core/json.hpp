@@ -1,7 +1,8 @@
 #pragma once
-// Strict reading of one JSON object: typed fields with defaults or required, every key the
-// caller reads is known, any other key is an InputError naming its JSON path. Internal to io/
-// (not installed): the public API passes JSON as text.
+// JSON as jelly reads and writes it (nlohmann's ordered_json) and the strict reading of one
+// object: typed fields with defaults or required, every key the caller reads is known, any
+// other key is an InputError naming its JSON path. Every kind of the registries (body kinds,
+// terrain kinds, integrator options) reads and writes itself with these.
 #include <string>
 #include <string_view>
 #include <vector>
@@ -10,7 +11,7 @@
 
 #include <jelly/core/types.hpp>
 
-namespace jelly::detail {
+namespace jelly {
 
 // Ordered, so that written scenes keep the order of the format (cube, springs, ...).
 using Json = nlohmann::ordered_json;
@@ -31,12 +32,15 @@ class JsonFields {
   // The JSON path of a key of this object.
   std::string path(std::string_view key) const;
   const std::string& path() const { return path_; }
+  // The path as a prefix of its keys' paths: "terrains[0]." ("" at the root).
+  std::string prefix() const { return path_.empty() ? std::string() : path_ + "."; }
 
   // Each getter marks `key` as known. The `_or` variants return `fallback` for a missing key;
   // the others throw InputError "<path> is required".
   Real number(std::string_view key);
   Real number_or(std::string_view key, Real fallback);
   int integer_or(std::string_view key, int fallback);
+  long long long_or(std::string_view key, long long fallback);
   bool boolean_or(std::string_view key, bool fallback);
   std::string string(std::string_view key);
   std::string string_or(std::string_view key, const std::string& fallback);
@@ -59,6 +63,9 @@ class JsonFields {
 // Typed conversions of a single value at `path`; throw InputError naming path, value and type.
 Real json_number(const Json& value, const std::string& path);
 int json_integer(const Json& value, const std::string& path);
+long long json_long(const Json& value, const std::string& path);
 Vec3 json_vec3(const Json& value, const std::string& path);
+// A vector as a JSON array [x, y, z].
+Json json_of(const Vec3& v);
 
-}  // namespace jelly::detail
+}  // namespace jelly

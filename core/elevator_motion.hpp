@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include <jelly/core/json.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {
@@ -22,6 +23,11 @@ class ElevatorMotion {
   // (a scene passes its JSON path, "terrains[0].motion").
   explicit ElevatorMotion(std::vector<MotionPhase> phases = {}, std::string_view field = "motion");
   static ElevatorMotion seed();
+  // Scene JSON: "seed" or a list of phases [{"duration": 2, "acceleration": 3, "stop_at_end":
+  // true}, ...]. Throws InputError naming `path`.
+  static ElevatorMotion read(const Json& j, const std::string& path);
+  // The list of phases.
+  Json to_json() const;
 
   // Height offset from the start, velocity and acceleration along +y at time t >= 0.
   Real offset(Real t) const;

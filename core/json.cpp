@@ -1,4 +1,4 @@
-#include <jelly/io/detail/json_fields.hpp>
+#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <jelly/core/errors.hpp>
 
-namespace jelly::detail {
+namespace jelly {
 
 std::string json_child(const std::string& path, std::string_view key) {
   return path.empty() ? std::string(key) : path + "." + std::string(key);
@@ -37,6 +37,22 @@ int json_integer(const Json& value, const std::string& path) {
   } else if (value.is_number_float()) {
     const double d = value.get<double>();
     if (std::floor(d) == d && std::abs(d) < 2e9) return static_cast<int>(d);
+  }
+  throw InputError(path, json_text(value), "an integer");
+}
+
+long long json_long(const Json& value, const std::string& path) {
+  if (value.is_number_integer()) {
+    if (value.is_number_unsigned() &&
+        value.get<unsigned long long>() >
+            static_cast<unsigned long long>(std::numeric_limits<long long>::max())) {
+      throw InputError(path, json_text(value), "an integer below 2^63");
+    }
+    return value.get<long long>();
+  }
+  if (value.is_number_float()) {
+    const double d = value.get<double>();
+    if (std::floor(d) == d && std::abs(d) < 9e18) return static_cast<long long>(d);
   }
   throw InputError(path, json_text(value), "an integer");
 }
@@ -86,6 +102,11 @@ int JsonFields::integer_or(std::string_view key, int fallback) {
   return v == nullptr ? fallback : json_integer(*v, path(key));
 }
 
+long long JsonFields::long_or(std::string_view key, long long fallback) {
+  const Json* v = find(key);
+  return v == nullptr ? fallback : json_long(*v, path(key));
+}
+
 bool JsonFields::boolean_or(std::string_view key, bool fallback) {
   const Json* v = find(key);
   if (v == nullptr) return fallback;
@@ -126,4 +147,6 @@ void JsonFields::reject_unknown() const {
   }
 }
 
-}  // namespace jelly::detail
+Json json_of(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace jelly

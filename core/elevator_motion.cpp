@@ -1,4 +1,4 @@
-#include <jelly/terrain/elevator_motion.hpp>
+#include <jelly/core/elevator_motion.hpp>
 
 #include <cmath>
 #include <string>
@@ -48,5 +48,35 @@ ElevatorMotion::Sample ElevatorMotion::sample(Real t) const {
 Real ElevatorMotion::offset(Real t) const { return sample(t).offset; }
 Real ElevatorMotion::velocity(Real t) const { return sample(t).velocity; }
 Real ElevatorMotion::acceleration(Real t) const { return sample(t).acceleration; }
+
+ElevatorMotion ElevatorMotion::read(const Json& j, const std::string& path) {
+  if (j.is_string() && j.get<std::string>() == "seed") return ElevatorMotion::seed();
+  if (!j.is_array()) {
+    throw InputError(path, json_text(j),
+                     "\"seed\" or a list of phases [{\"duration\": 2, \"acceleration\": 3, "
+                     "\"stop_at_end\": true}, ...]");
+  }
+  std::vector<MotionPhase> phases;
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    JsonFields f(j[i], json_element(path, i));
+    MotionPhase p;
+    p.duration = f.number("duration");
+    p.acceleration = f.number("acceleration");
+    p.stop_at_end = f.boolean_or("stop_at_end", p.stop_at_end);
+    f.reject_unknown();
+    phases.push_back(p);
+  }
+  return ElevatorMotion(std::move(phases), path);
+}
+
+Json ElevatorMotion::to_json() const {
+  Json phases = Json::array();
+  for (const MotionPhase& p : phases_) {
+    phases.push_back({{"duration", p.duration},
+                      {"acceleration", p.acceleration},
+                      {"stop_at_end", p.stop_at_end}});
+  }
+  return phases;
+}
 
 }  // namespace jelly

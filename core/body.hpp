@@ -1,0 +1,49 @@
+#pragma once
+// A body of the model: a named range of particles and springs with its own material and render
+// surface; and BodyPart, what a body builder (geometry/) returns before it joins a model.
+#include <string>
+#include <vector>
+
+#include <jelly/core/springs.hpp>
+#include <jelly/core/surface.hpp>
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+// Particles of a body chosen by name (a mesh's vertex group, a lattice corner), body-local.
+struct ParticleGroup {
+  std::string name;
+  std::vector<int> particles;
+};
+
+// What a body builder makes: particles, springs and surface with indices local to the part.
+struct BodyPart {
+  std::string kind;  // the body kind that built it ("cube", "box", "cloth", ...)
+  VecX mass;         // [n] kg
+  VecX position;     // [3n] rest positions (m)
+  Springs springs;   // local particle indices
+  Surface surface;   // local particle indices
+  Real spacing = 0;  // typical distance between neighbouring particles (m)
+  std::vector<ParticleGroup> groups;
+
+  int num_particles() const { return static_cast<int>(mass.size()); }
+};
+
+struct Body {
+  std::string name;  // unique in the model; the HDF5 group /particles/<name>
+  std::string kind;
+  int first_particle = 0, num_particles = 0;
+  int first_spring = 0, num_springs = 0;
+  Real spacing = 0;                   // typical distance between neighbouring particles (m)
+  Real radius = 0;                    // contact radius of its particles (m)
+  Surface surface;                    // global particle indices
+  std::vector<ParticleGroup> groups;  // global particle indices
+
+  int end_particle() const { return first_particle + num_particles; }
+  int end_spring() const { return first_spring + num_springs; }
+  bool contains(int particle) const {
+    return particle >= first_particle && particle < end_particle();
+  }
+};
+
+}  // namespace jelly

@@ -1,0 +1,79 @@
+#include <jelly/core/pins.hpp>
+
+#include <algorithm>
+#include <string>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+int Pins::add_path(Path p) {
+  paths.push_back(std::move(p));
+  return static_cast<int>(paths.size()) - 1;
+}
+
+void Pins::add(int particle, const Vec3& anchor, int path_index) {
+  if (std::find(particles.begin(), particles.end(), particle) != particles.end()) return;
+  particles.push_back(particle);
+  anchors.push_back(anchor);
+  path.push_back(path_index);
+}
+
+void Pins::add_fixed(int particle, const Vec3& anchor) {
+  int fixed = -1;
+  for (int p = 0; p < static_cast<int>(paths.size()); ++p) {
+    if (paths[p].is_fixed()) fixed = p;
+  }
+  if (fixed < 0) fixed = add_path(Path());
+  add(particle, anchor, fixed);
+}
+
+bool Pins::all_fixed() const {
+  return std::all_of(path.begin(), path.end(), [&](int p) { return paths[p].is_fixed(); });
+}
+
+Vec3 Pins::position(int k, Real t) const {
+  const Path& p = paths[path[k]];
+  return p.is_fixed() ? anchors[k] : Vec3(anchors[k] + p.sample(t).offset);
+}
+
+void Pins::apply(Real t, VecX& x, VecX& v) const {
+  for (int k = 0; k < size(); ++k) {
+    const int i = particles[k];
+    const Path& p = paths[path[k]];
+    if (p.is_fixed()) {
+      particle(x, i) = anchors[k];
+      particle(v, i).setZero();
+    } else {
+      const PathSample s = p.sample(t);
+      particle(x, i) = anchors[k] + s.offset;
+      particle(v, i) = s.velocity;
+    }
+  }
+}
+
+void Pins::apply_acceleration(Real t, VecX& a) const {
+  for (int k = 0; k < size(); ++k) {
+    const Path& p = paths[path[k]];
+    particle(a, particles[k]) = p.is_fixed() ? Vec3::Zero() : p.sample(t).acceleration;
+  }
+}
+
+void Pins::shift_particles(int shift) {
+  for (int& p : particles) p += shift;
+}
+
+void Pins::validate(int num_particles) const {
+  require(anchors.size() == particles.size() && path.size() == particles.size(), "pins.size",
+          anchors.size(), "one anchor and one path per pinned particle");
+  for (int k = 0; k < size(); ++k) {
+    const std::string at = "pins[" + std::to_string(k) + "]";
+    require(particles[k] >= 0 && particles[k] < num_particles, at + ".particle", particles[k],
+            "a particle index in [0, " + std::to_string(num_particles) + ")");
+    require(anchors[k].allFinite(), at + ".anchor", anchors[k].transpose(), "finite coordinates");
+    require(path[k] >= 0 && path[k] < static_cast<int>(paths.size()), at + ".path", path[k],
+            "a path index");
+  }
+}
+
+}  // namespace jelly

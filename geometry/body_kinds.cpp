@@ -1,0 +1,32 @@
+#include <jelly/geometry/body_kinds.hpp>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/geometry/box.hpp>
+#include <jelly/geometry/cloth.hpp>
+#include <jelly/geometry/cube.hpp>
+
+namespace jelly {
+
+const std::vector<BodyKindInfo>& body_kinds() {
+  static const std::vector<BodyKindInfo> kinds{
+      {"box", "a lattice filling a box: nx, ny, nz, size, position (centre), rotation_degrees",
+       &BoxShape::read},
+      {"cloth",
+       "a sheet in its local x-z plane: nu, nv, size_u, size_v, position, rotation_degrees",
+       &ClothShape::read},
+      {"cube", "the seed's lattice: n per edge, edge_length, origin (corner particle)",
+       &CubeShape::read},
+  };
+  return kinds;
+}
+
+const BodyKindInfo& find_body_kind(std::string_view name, const std::string& field) {
+  std::string known;
+  for (const BodyKindInfo& k : body_kinds()) {
+    if (k.name == name) return k;
+    known += (known.empty() ? "\"" : ", \"") + std::string(k.name) + "\"";
+  }
+  throw InputError(field, "\"" + std::string(name) + "\"", "one of " + known);
+}
+
+}  // namespace jelly

@@ -1,0 +1,73 @@
+#pragma once
+// What a scene says of one body: its name, kind-specific shape, material, contact radius,
+// pinned particles and external forces; and how it joins a model (add_body).
+#include <string>
+#include <vector>
+
+#include <jelly/core/external_force.hpp>
+#include <jelly/core/json.hpp>
+#include <jelly/core/model.hpp>
+#include <jelly/core/path.hpp>
+#include <jelly/core/polymorphic_value.hpp>
+#include <jelly/geometry/body_shape.hpp>
+#include <jelly/geometry/lattice.hpp>
+
+namespace jelly {
+
+// Particles of a body chosen by body-local index, by a box region of the rest pose (world
+// coordinates) and/or by a named group of the body (a mesh's vertex group, a cloth corner);
+// together: the union. Nothing chosen = every particle of the body.
+struct ParticleSelection {
+  std::vector<int> indices;
+  bool has_region = false;
+  Eigen::AlignedBox3d region;
+  std::string group;
+
+  bool selects_all() const { return indices.empty() && !has_region && group.empty(); }
+  // Global particle indices, sorted. Throws InputError naming `prefix`field for an index out of
+  // range, an unknown group, or a selection that holds no particle.
+  std::vector<int> resolve(const Model& model, const Body& body, const std::string& prefix) const;
+  // Reads the keys "indices", "region" ({"min": [...], "max": [...]}) and "group".
+  static ParticleSelection read(JsonFields& fields);
+  void write(Json& object) const;
+};
+
+struct PinSpec {
+  ParticleSelection select;
+  Path path;  // fixed by default
+};
+
+struct ExternalForceSpec {
+  ExternalForceKind kind = ExternalForceKind::kConstant;
+  ParticleSelection select;
+  Vec3 vector = Vec3::Zero();  // "force" (N) or, for wind, "velocity" (m/s)
+  Real drag = 0, gust = 0, gust_frequency = 0, start = 0;
+  Real end = std::numeric_limits<Real>::infinity();
+};
+
+struct BodySpec {
+  std::string name = "jelly";
+  PolymorphicValue<BodyShape> shape;  // the kind's own parameters
+  Material material;
+  Real radius = 0;  // contact radius of its particles (m); 0 = half the lattice spacing
+  std::vector<PinSpec> pins;
+  std::vector<ExternalForceSpec> forces;
+
+  std::string_view kind() const { return shape ? shape->kind() : std::string_view(); }
+  // Throws InputError naming `prefix`field ("bodies[0].").
+  void validate(const std::string& prefix) const;
+  // A scene's body object: kind, name, the kind's keys, springs, particle_mass, density, radius,
+  // pins, forces.
+  static BodySpec read(JsonFields& fields);
+  Json to_json() const;
+};
+
+// Builds the body, adds it to the model, then its pins and external forces. Throws InputError
+// naming `prefix`field.
+void add_body(Model& model, const BodySpec& spec, const std::string& prefix);
+
+// Reads a scene's "springs" object ({"structural": {"ks": .., "kd": ..}, ...}) into `springs`.
+void read_springs(JsonFields& fields, std::array<SpringCoefficients, kSpringTypeCount>& springs);
+Json springs_json(const std::array<SpringCoefficients, kSpringTypeCount>& springs);
+
+}  // namespace jelly

@@ -1,0 +1,24 @@
+#include <jelly/geometry/pose.hpp>
+
+#include <cmath>
+#include <string>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+Eigen::Matrix3d Pose::rotation() const {
+  const Vec3 r = rotation_degrees * (M_PI / 180);
+  return (Eigen::AngleAxisd(r.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(r.y(), Vec3::UnitY()) *
+          Eigen::AngleAxisd(r.x(), Vec3::UnitX()))
+      .toRotationMatrix();
+}
+
+void Pose::validate(const std::string& prefix) const {
+  require(position.allFinite(), prefix + "position", position.transpose(), "finite coordinates");
+  require(rotation_degrees.allFinite(), prefix + "rotation_degrees", rotation_degrees.transpose(),
+          "finite angles (degrees)");
+  require(std::isfinite(scale) && scale > 0, prefix + "scale", scale, "a finite scale > 0");
+}
+
+}  // namespace jelly

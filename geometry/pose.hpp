@@ -1,0 +1,19 @@
+#pragma once
+// Where a body or mesh is placed: scaled, then rotated (degrees about x, then y, then z), then
+// moved by `position`.
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+struct Pose {
+  Vec3 position = Vec3::Zero();
+  Vec3 rotation_degrees = Vec3::Zero();  // about x, then y, then z (axes fixed in space)
+  Real scale = 1;
+
+  Eigen::Matrix3d rotation() const;
+  Vec3 apply(const Vec3& p) const { return position + scale * (rotation() * p); }
+  // Throws InputError naming `prefix`field for non-finite values or a scale <= 0.
+  void validate(const std::string& prefix) const;
+};
+
+}  // namespace jelly

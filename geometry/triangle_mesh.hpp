@@ -1,0 +1,35 @@
+#pragma once
+// A triangle mesh: vertex positions and triangles over them (counter-clockwise seen from
+// outside), for obstacles, render shapes and the meshes bodies are made from.
+#include <string>
+#include <vector>
+
+#include <jelly/core/surface.hpp>
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+struct TriangleMesh {
+  std::vector<Vec3> vertices;
+  std::vector<Triangle> triangles;
+
+  int num_vertices() const { return static_cast<int>(vertices.size()); }
+  int num_triangles() const { return static_cast<int>(triangles.size()); }
+  Eigen::AlignedBox3d bounds() const;
+  // Adds a quad as two triangles a-b-c, a-c-d.
+  void add_quad(int a, int b, int c, int d);
+  // Appends `other`.
+  void append(const TriangleMesh& other);
+};
+
+// Meshes of simple shapes, centred at the origin, for drawing and tests.
+TriangleMesh box_mesh(const Vec3& size);
+// A square of side `size` in the plane through the origin with the given unit normal.
+TriangleMesh square_mesh(const Vec3& normal, Real size);
+TriangleMesh sphere_mesh(Real radius, int rings = 16, int segments = 32);
+// Along y, from -height/2 to +height/2, capped.
+TriangleMesh cylinder_mesh(Real radius, Real height, int segments = 32);
+// Along y: a cylinder of the given height between two hemispheres.
+TriangleMesh capsule_mesh(Real radius, Real height, int rings = 8, int segments = 32);
+
+}  // namespace jelly
