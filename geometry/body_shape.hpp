@@ -26,6 +26,9 @@ class BodyShape {
   virtual BodyPart build(const Material& material, const std::string& prefix) const = 0;
   // Upper bound on the particles build() makes, known before building (memory checks).
   virtual long estimated_particles() const = 0;
+  // Estimate of the springs build() makes (memory checks): the lattice's 13 per particle unless
+  // the kind knows better.
+  virtual long estimated_springs() const { return 13 * estimated_particles(); }
   // Writes the kind's own keys into `object`.
   virtual void write(Json& object) const = 0;
 };

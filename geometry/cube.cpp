@@ -6,6 +6,14 @@
 
 namespace jelly {
 
+std::int64_t cube_particle_count(std::int64_t n) { return n * n * n; }
+
+std::int64_t cube_spring_count(std::int64_t n) {
+  if (n < 2) return 0;
+  const std::int64_t m = n - 1;
+  return 3 * n * n * m + 6 * n * m * m + 4 * m * m * m + 3 * n * n * (n - 2);
+}
+
 void CubeShape::validate(const std::string& prefix) const {
   require(n >= 2 && n <= 400, prefix + "n", n, "an integer in [2, 400]");
   require(std::isfinite(edge_length) && edge_length > 0, prefix + "edge_length", edge_length,

@@ -2,12 +2,19 @@
 // The seed's jelly cube: an n x n x n particle lattice joined by structural, shear and bending
 // springs, each spring stored once.
 #include <array>
+#include <cstdint>
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/geometry/body_shape.hpp>
 
 namespace jelly {
+
+// Particles and springs of an n x n x n cube: n^3 and
+// 3 n^2 (n - 1) + 6 n (n - 1)^2 + 4 (n - 1)^3 + 3 n^2 (n - 2) (structural, face and body
+// diagonals, bending; 12,876 for n = 10).
+std::int64_t cube_particle_count(std::int64_t n);
+std::int64_t cube_spring_count(std::int64_t n);
 
 // Body kind "cube": n particles per edge, edge_length, origin = position of particle (0, 0, 0).
 struct CubeShape final : BodyShapeOf<CubeShape> {
@@ -18,7 +25,8 @@ struct CubeShape final : BodyShapeOf<CubeShape> {
   std::string_view kind() const override { return "cube"; }
   void validate(const std::string& prefix) const override;
   BodyPart build(const Material& material, const std::string& prefix) const override;
-  long estimated_particles() const override { return static_cast<long>(n) * n * n; }
+  long estimated_particles() const override { return cube_particle_count(n); }
+  long estimated_springs() const override { return cube_spring_count(n); }
   void write(Json& object) const override;
   static std::unique_ptr<BodyShape> read(JsonFields& fields);
 };

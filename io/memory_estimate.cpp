@@ -6,14 +6,6 @@
 
 namespace jelly {
 
-std::int64_t cube_particle_count(std::int64_t n) { return n * n * n; }
-
-std::int64_t cube_spring_count(std::int64_t n) {
-  if (n < 2) return 0;
-  const std::int64_t m = n - 1;
-  return 3 * n * n * m + 6 * n * m * m + 4 * m * m * m + 3 * n * n * (n - 2);
-}
-
 double estimate_memory_bytes(std::int64_t particles, std::int64_t springs,
                              const std::string& integrator, bool recording) {
   // Peak resident sizes measured with `jelly run` (Release, /usr/bin/time -f %M) on the seed

@@ -6,12 +6,6 @@
 
 namespace jelly {
 
-// Particles and springs of an n x n x n cube (core/cube.hpp): n^3 and
-// 3 n^2 (n - 1) + 6 n (n - 1)^2 + 4 (n - 1)^3 + 3 n^2 (n - 2) (structural, face and body
-// diagonals, bending; 12,876 for n = 10).
-std::int64_t cube_particle_count(std::int64_t n);
-std::int64_t cube_spring_count(std::int64_t n);
-
 // Bytes of memory a simulation of `particles` particles and `springs` springs needs with the
 // named integrator, with a recorder when `recording`. Calibrated on measured peak resident
 // sizes (see the .cpp), linear in the counts: an estimate good to a factor of about 1.5 up to

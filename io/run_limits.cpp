@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/io/memory_estimate.hpp>
 
 namespace jelly {
@@ -50,11 +51,18 @@ RunEstimate estimate_run(const Scene& scene, Real t_start, bool recording) {
   e.frames = 1 + (scene.output_interval > 0
                       ? std::min(e.steps, std::floor(std::max(span, 0.0) / scene.output_interval))
                       : e.steps);
-  const std::int64_t n = scene.cube.n;
-  const double particles = static_cast<double>(cube_particle_count(n));
-  const double springs = static_cast<double>(cube_spring_count(n));
-  e.memory_bytes = estimate_memory_bytes(cube_particle_count(n), cube_spring_count(n),
-                                         scene.integrator.name, recording);
+  std::int64_t body_particles = 0, body_springs = 0;
+  for (const BodySpec& b : scene.bodies) {
+    if (!b.shape) continue;
+    body_particles += b.shape->estimated_particles();
+    body_springs += b.shape->estimated_springs();
+  }
+  e.particles = body_particles;
+  e.springs = body_springs;
+  const double particles = static_cast<double>(body_particles);
+  const double springs = static_cast<double>(body_springs);
+  e.memory_bytes =
+      estimate_memory_bytes(body_particles, body_springs, scene.integrator.name, recording);
   e.recording_bytes = recording ? e.frames * frame_bytes(particles, scene.terrains.size()) +
                                       36 * springs + 32 * particles
                                 : 0;
@@ -105,11 +113,17 @@ void check_run_limits(const Scene& scene, Real t_start, const RunLimits& limits,
   }
   const double memory = limits.memory_bytes >= 0 ? limits.memory_bytes : available_memory_bytes();
   if (memory >= 0 && e.memory_bytes > memory) {
+    // A one-cube scene names its size; others their bodies' particle count.
+    const bool one_cube = scene.bodies.size() == 1 && scene.bodies[0].shape &&
+                          scene.bodies[0].shape.is<CubeShape>();
     throw InputError(
-        "cube.n", std::to_string(scene.cube.n),
-        "a cube that fits in memory: the run needs about " + bytes_text(e.memory_bytes) + " (" +
-            count(static_cast<double>(cube_particle_count(scene.cube.n))) + " particles, " +
-            count(static_cast<double>(cube_spring_count(scene.cube.n))) + " springs, " +
+        one_cube ? "cube.n" : "bodies",
+        one_cube ? std::to_string(scene.bodies[0].shape.as<CubeShape>().n)
+                 : count(static_cast<double>(e.particles)) + " particles",
+        std::string(one_cube ? "a cube that fits" : "bodies that fit") +
+            " in memory: the run needs about " +
+            bytes_text(e.memory_bytes) + " (" + count(static_cast<double>(e.particles)) +
+            " particles, " + count(static_cast<double>(e.springs)) + " springs, " +
             scene.integrator.name + "), more than the " + bytes_text(memory) + " available");
   }
   // Compression saves at most about a third of a recording (docs/output.md): refuse only what

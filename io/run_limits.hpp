@@ -3,6 +3,7 @@
 // whose step or frame count is absurd, whose time step is lost to rounding, or which cannot fit
 // in memory or on disk is refused with a message naming the field, instead of hanging, running
 // zero steps or failing hours later.
+#include <cstdint>
 #include <string>
 
 #include <jelly/io/scene.hpp>
@@ -21,7 +22,9 @@ struct RunLimits {
 struct RunEstimate {
   double steps = 0;            // steps from t_start to the scene's duration
   double frames = 0;           // observer frames (with the first one)
-  double memory_bytes = 0;     // estimate_memory_bytes() of the scene's cube and integrator
+  std::int64_t particles = 0;  // of the scene's bodies, estimated before building them
+  std::int64_t springs = 0;
+  double memory_bytes = 0;     // estimate_memory_bytes() of the bodies and integrator
   double recording_bytes = 0;  // uncompressed size of a recording of the run
 };
 

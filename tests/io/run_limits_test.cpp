@@ -7,7 +7,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/io/memory_estimate.hpp>
 
@@ -123,7 +123,9 @@ TEST(RunLimits, OutputIntervalsAreBounded) {
 
 TEST(RunLimits, ACubeBeyondMemoryIsRefusedWithTheEstimate) {
   Scene s = seed_scene();
-  s.cube.n = 400;
+  CubeSpec cube = s.cube();
+  cube.n = 400;
+  s.set_cube(cube);
   RunLimits limits;
   limits.memory_bytes = 16e9;
   EXPECT_EQ(limit_error(s, 0, limits),
