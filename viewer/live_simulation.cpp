@@ -33,9 +33,9 @@ LiveSettings LiveSettings::of(const Scene& scene) {
   LiveSettings s;
   s.integrator = scene.integrator.name;
   s.dt = scene.integrator.dt;
-  s.springs = scene.cube.springs;
-  s.gravity = scene.cube.gravity;
-  for (const TerrainSpec& t : scene.terrains) s.contacts.push_back(t.contact);
+  s.springs = scene.bodies.front().material.springs;
+  s.gravity = scene.gravity;
+  for (const auto& t : scene.terrains) s.contacts.push_back(t->contact);
   return s;
 }
 
@@ -43,10 +43,10 @@ Scene LiveSettings::applied_to(Scene scene) const {
   if (scene.integrator.name != integrator) scene.integrator.options = {};
   scene.integrator.name = integrator;
   scene.integrator.dt = dt;
-  scene.cube.springs = springs;
-  scene.cube.gravity = gravity;
+  for (BodySpec& body : scene.bodies) body.material.springs = springs;
+  scene.gravity = gravity;
   for (size_t i = 0; i < scene.terrains.size() && i < contacts.size(); ++i)
-    scene.terrains[i].contact = contacts[i];
+    scene.terrains[i]->contact = contacts[i];
   return scene;
 }
 

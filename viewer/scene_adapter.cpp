@@ -150,7 +150,7 @@ Terrains recording_terrains(const Recording& recording) {
   Terrains terrains;
   if (recording.scene_json.empty()) return terrains;
   const Scene scene = parse_scene(recording.scene_json, {}, "the recording's scene_json");
-  for (const TerrainSpec& spec : scene.terrains) terrains.push_back(make_terrain(spec));
+  for (const auto& spec : scene.terrains) terrains.push_back(spec->make());
   return terrains;
 }
 

@@ -300,9 +300,9 @@ struct ViewerWindow::Impl {
 
   void make_builder() {
     const Scene& s = live->scene();
-    const Model model = build_cube(s.cube);
+    const Model model = make_model(s);
     Terrains terrains;
-    for (const TerrainSpec& spec : s.terrains) terrains.push_back(make_terrain(spec));
+    for (const auto& spec : s.terrains) terrains.push_back(spec->make());
     Vec3 lo, hi;
     bounds_of(model.rest_position, lo, hi);
     const bool first = builder == nullptr;

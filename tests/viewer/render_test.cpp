@@ -36,12 +36,12 @@ class Offscreen : public ::testing::Test {
 
 struct SeedView {
   Scene scene = load_scene(JELLY_SCENES_DIR "/seed_slope.json");
-  Model model = build_cube(scene.cube);
+  Model model = make_model(scene);
   std::unique_ptr<viewer::SceneBuilder> builder;
   viewer::Camera camera;
   SeedView() {
     Terrains terrains;
-    for (const TerrainSpec& t : scene.terrains) terrains.push_back(make_terrain(t));
+    for (const auto& t : scene.terrains) terrains.push_back(t->make());
     Vec3 lo, hi;
     viewer::bounds_of(model.rest_position, lo, hi);
     builder = std::make_unique<viewer::SceneBuilder>(model, std::move(terrains), lo, hi);

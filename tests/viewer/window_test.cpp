@@ -50,7 +50,7 @@ TEST(Window, ScreenshotOfTheSeedSlopeAtStart) {
                        "'" + view_args(),
                    dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  const Model model = build_cube(load_scene(kSlope).cube);
+  const Model model = make_model(load_scene(kSlope));
   expect_jelly_at(dir.file("s.png"), model.rest_position);
 }
 
@@ -108,7 +108,7 @@ TEST(Window, PickingAndDraggingMovesTheParticle) {
     auto window = viewer::ViewerWindow::live(scene, kSlope, options);
     ASSERT_TRUE(window->frame());
     // The middle of the face towards the camera (+z).
-    const int n = scene.cube.n, p = cube_index(n, n / 2, n / 2, n - 1);
+    const int n = scene.cube().n, p = cube_index(n, n / 2, n / 2, n - 1);
     const Vec3 start = particle(window->positions(), p);
     const auto at =
         window->camera().project(start.cast<float>(), window->width(), window->height());
@@ -129,7 +129,7 @@ TEST(Window, PickingAndDraggingMovesTheParticle) {
         << target.transpose();
     // The rest of the jelly follows, less far.
     const int far = cube_index(n, 0, 0, 0);
-    EXPECT_GT((particle(window->positions(), far) - particle(scene.cube.origin, 0)).norm(), 0.01);
+    EXPECT_GT((particle(window->positions(), far) - particle(scene.cube().origin, 0)).norm(), 0.01);
     window->mouse_button(0, false, at->x() + 60, at->y() - 40);
     EXPECT_EQ(window->dragged_particle(), -1);
     EXPECT_EQ(window->simulation()->front().status, RunStatus::kCompleted);
