@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/io/memory_estimate.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
@@ -68,7 +69,7 @@ void Scene::set_cube(const CubeSpec& cube, int index) {
 
 void Scene::validate() const {
   require(!bodies.empty(), "bodies", "[]", "at least one body");
-  long particles = 0;
+  long particles = 0, springs = 0;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     bodies[i].validate(body_prefix(i));
     for (std::size_t j = 0; j < i; ++j) {
@@ -77,11 +78,13 @@ void Scene::validate() const {
               "a name no other body has (bodies[" + std::to_string(j) + "] has it)");
     }
     particles += bodies[i].shape->estimated_particles();
+    springs += bodies[i].shape->estimated_springs();
   }
   require(max_particles > 0, "max_particles", max_particles, "a number of particles > 0");
   require(particles <= max_particles, "bodies", std::to_string(particles) + " particles",
-          "at most max_particles = " + std::to_string(max_particles) +
-              " (raise max_particles if the memory allows)");
+          "at most max_particles = " + std::to_string(max_particles) + " (they would need about " +
+              bytes_text(estimate_memory_bytes(particles, springs, integrator.name, false)) +
+              " of memory with " + integrator.name + "; raise max_particles if it allows)");
   require(gravity.allFinite(), "gravity", gravity.transpose(), "finite components");
   for (std::size_t i = 0; i < terrains.size(); ++i) {
     const std::string prefix = "terrains[" + std::to_string(i) + "].";

@@ -209,7 +209,7 @@ void create_view(hid_t group, const std::string& name, hid_t source, const std::
 // ---------------------------------------------------------------------------------------------
 // What the recording holds
 
-struct Body {
+struct RecordedBody {
   std::string name;              // group /particles/<name>
   hsize_t first = 0, count = 0;  // its particles' global indices
   std::vector<hsize_t> springs;  // global indices of its springs (both ends are its particles)
@@ -235,7 +235,7 @@ struct Recording {
   std::string h5_name;  // the file name as the sidecar names it (it sits beside the file)
   hsize_t frames = 0;
   std::vector<double> time;
-  std::vector<Body> bodies;
+  std::vector<RecordedBody> bodies;
   hsize_t num_springs = 0;
   std::vector<TerrainInfo> terrains;
   std::vector<Observable> observables;
@@ -263,7 +263,7 @@ Recording inspect(hid_t file, const std::string& h5_path) {
     hsize_t next = 0;
     for (const std::string& name : member_names(particles.get())) {
       if (!is_group(particles.get(), name)) continue;
-      Body body;
+      RecordedBody body;
       body.name = name;
       if (!h5::exists(file, body.group() + "/position/value") ||
           !h5::exists(file, body.group() + "/velocity/value") ||
@@ -283,13 +283,13 @@ Recording inspect(hid_t file, const std::string& h5_path) {
   }
   if (r.bodies.empty()) not_a_recording(h5_path, "no body under /particles");
   std::sort(r.bodies.begin(), r.bodies.end(),
-            [](const Body& a, const Body& b) { return a.first < b.first; });
+            [](const RecordedBody& a, const RecordedBody& b) { return a.first < b.first; });
 
   // The clock and the frames every series holds (a killed run may have flushed one series
   // further than another).
   r.time = h5::read_doubles(file, r.bodies.front().group() + "/position/time");
   r.frames = r.time.size();
-  for (const Body& body : r.bodies) {
+  for (const RecordedBody& body : r.bodies) {
     r.frames = std::min({r.frames, frames_of(file, body.group() + "/position/value"),
                          frames_of(file, body.group() + "/velocity/value")});
   }
@@ -300,7 +300,7 @@ Recording inspect(hid_t file, const std::string& h5_path) {
   r.num_springs = spring_dims.empty() ? 0 : spring_dims[0];
   for (hsize_t s = 0; s < r.num_springs; ++s) {
     const hsize_t a = static_cast<hsize_t>(ends[2 * s]), b = static_cast<hsize_t>(ends[2 * s + 1]);
-    auto owner = std::find_if(r.bodies.begin(), r.bodies.end(), [&](const Body& body) {
+    auto owner = std::find_if(r.bodies.begin(), r.bodies.end(), [&](const RecordedBody& body) {
       return a >= body.first && a < body.first + body.count;
     });
     if (owner == r.bodies.end() || b < owner->first || b >= owner->first + owner->count) {
@@ -310,7 +310,7 @@ Recording inspect(hid_t file, const std::string& h5_path) {
     }
     owner->springs.push_back(s);
   }
-  for (Body& body : r.bodies) {
+  for (RecordedBody& body : r.bodies) {
     body.all_springs = body.first == 0 && body.springs.size() == r.num_springs;
   }
 
@@ -369,7 +369,7 @@ Recording inspect(hid_t file, const std::string& h5_path) {
 // ---------------------------------------------------------------------------------------------
 // /xdmf: views and derived arrays
 
-std::string body_path(const Body& body) { return "/xdmf/particles/" + body.name; }
+std::string body_path(const RecordedBody& body) { return "/xdmf/particles/" + body.name; }
 std::string terrain_path(const TerrainInfo& t) { return "/xdmf/terrain/" + t.name; }
 
 struct Bounds {
@@ -384,7 +384,7 @@ struct Bounds {
 
 // The body's springs as the sidecar reads them: /connectivity itself, or (for one body of
 // several) its own copies with particle indices counted from its first particle.
-void write_body_springs(hid_t file, const Body& body, hid_t group) {
+void write_body_springs(hid_t file, const RecordedBody& body, hid_t group) {
   if (body.all_springs) return;
   const std::vector<int> ends = h5::read_ints(file, "/connectivity/springs");
   const hsize_t m = body.springs.size();
@@ -412,7 +412,7 @@ void write_body_springs(hid_t file, const Body& body, hid_t group) {
 
 // Speed and strain of the frames not derived yet, the views of every new frame, and the
 // bounding box of the positions read.
-void update_body(hid_t file, const Recording& r, const Body& body, hsize_t first_new_view,
+void update_body(hid_t file, const Recording& r, const RecordedBody& body, hsize_t first_new_view,
                  const XdmfOptions& options, Bounds& bounds) {
   Handle group = open_or_create_group(file, body_path(body));
   write_body_springs(file, body, group.get());
@@ -698,7 +698,7 @@ class Writer {
   std::ostringstream out_;
 };
 
-void body_grids(Writer& w, hid_t file, const Recording& r, const Body& body, bool observables,
+void body_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody& body, bool observables,
                 const XdmfOptions& options) {
   const std::string own = body_path(body);
   const std::string springs = body.all_springs ? "/connectivity" : own;
@@ -810,7 +810,7 @@ std::string update_xdmf(hid_t file, const std::string& h5_path, const XdmfOption
     }
   }
   open_or_create_group(root.get(), "particles");
-  for (const Body& body : r.bodies) update_body(file, r, body, viewed, options, bounds);
+  for (const RecordedBody& body : r.bodies) update_body(file, r, body, viewed, options, bounds);
   if (!bounds.empty()) {
     h5::write_attribute(root.get(), "bounds",
                         std::vector<double>{bounds.lo.x(), bounds.lo.y(), bounds.lo.z(),

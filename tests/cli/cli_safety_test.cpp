@@ -242,8 +242,9 @@ TEST(SilentRuns, ARestartOfAnotherSceneExitsTwo) {
   const std::string restart = " --duration 0.2 -q --restart " + quoted(file);
   Result r = jelly("run " + kSmallSlope + restart + " --set springs.structural.ks=2400");
   EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err, HasSubstr("its run had springs.structural.ks = 1400.0, this scene has 2400.0: "
-                               "a restart continues the same run"));
+  EXPECT_THAT(r.err,
+              HasSubstr("its run had bodies[0].springs.structural.ks = 1400.0, this scene has "
+                        "2400.0: a restart continues the same run"));
   r = jelly("run " + kSmallSlope + restart + " --set gravity=[0,-1,0]");
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, HasSubstr("its run had gravity[1] = -9.8, this scene has -1.0"));
@@ -277,8 +278,9 @@ TEST(ExitCodes, ACubeBeyondMemoryExitsTwoWithTheEstimate) {
   const std::string s = "'" + scene("seed_slope.json") + "'";
   const Result r = jelly("run " + s + " --set cube.n=400");
   EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err, StartsWith("error: cube.n = 400 is invalid: a cube that fits in memory: the "
-                                "run needs about 100.7 GB (64000000 particles"));
+  EXPECT_THAT(r.err, StartsWith("error: bodies = 64000000 particles is invalid: at most "
+                                "max_particles = 2000000 (they would need about 100.7 GB of "
+                                "memory with rk4"));
 }
 
 TEST(ExitCodes, AnUnwritableSidecarExitsTwoBeforeTheRun) {
