@@ -76,7 +76,7 @@ Real energy_in_frame(const Model& model, const VecX& x, const VecX& v, const Vec
 }  // namespace
 
 Mat3 ImplicitContact::free_projector(const Contact& c) {
-  if (c.mode == Mode::kStick) return Mat3::Zero();
+  if (c.pinned || c.mode == Mode::kStick) return Mat3::Zero();
   return Mat3::Identity() - c.normal * c.normal.transpose();
 }
 
@@ -97,6 +97,7 @@ int ImplicitContact::penetrated_terrain(const Terrains& terrains, const Vec3& p,
 }
 
 Real ImplicitContact::bounce_speed(const Contact& c, const Terrains& terrains) {
+  if (c.pinned) return 0;
   const ContactParams& params = terrains[c.terrain]->contact();
   return c.approach > params.resting_speed ? params.restitution * c.approach : 0.0;
 }
@@ -137,7 +138,8 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
   const bool any = std::any_of(terrains.begin(), terrains.end(),
                                [](const auto& terrain) { return uses_coulomb(*terrain); });
   projected_ = 0;
-  if (!any) {
+  pinned_ = 0;
+  if (!any && model.pins.empty()) {
     contacts_.clear();
     return false;
   }
@@ -153,12 +155,27 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
   std::fill(slot_.begin(), slot_.end(), -1);
   for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
     const Contact& old = contacts_[ci];
-    if (old.release || old.particle >= np || old.terrain >= static_cast<int>(terrains.size()))
+    if (old.pinned || old.release || old.particle >= np ||
+        old.terrain >= static_cast<int>(terrains.size()))
       continue;
     slot_[old.particle] = ci;
   }
   next_.clear();
+  // Pins first: their velocity at t1 is their path's.
+  std::vector<char>& is_pinned = pinned_mask_;
+  is_pinned.assign(np, 0);
+  for (int k = 0; k < model.pins.size(); ++k) {
+    Contact c;
+    c.particle = model.pins.particles[k];
+    c.terrain = -1;
+    c.pinned = true;
+    c.target_velocity = model.pins.sample(k, t1_).velocity;
+    next_.push_back(c);
+    is_pinned[c.particle] = 1;
+  }
+  pinned_ = static_cast<int>(next_.size());
   for (int i = 0; i < np; ++i) {
+    if (is_pinned[i]) continue;
     const Vec3 v1 = particle(v0_, i) + (h / model.mass[i]) * particle(f, i);
     const Vec3 predicted = particle(x0_, i) + h * v1;
     if (slot_[i] >= 0) {
@@ -199,7 +216,9 @@ void ImplicitContact::constrain(SparseMatrix& a, const VecX& b, bool prescribe, 
     if (!prescribe) continue;
     const Vec3 v0 = particle(v0_, c.particle);
     Vec3 dz;
-    if (c.mode == Mode::kStick) {
+    if (c.pinned) {
+      dz = c.target_velocity - v0;
+    } else if (c.mode == Mode::kStick) {
       const Vec3 u = c.surface_velocity;
       dz = tangential(u, c.normal) + c.target_normal * c.normal - v0;
     } else {
@@ -272,6 +291,7 @@ constexpr size_t kSavedPerContact = 5;
 
 void ImplicitContact::save(std::vector<Real>& out) const {
   for (const Contact& c : contacts_) {
+    if (c.pinned) continue;  // rebuilt from the model at every step
     out.push_back(c.particle);
     out.push_back(c.terrain);
     out.push_back(c.mode == Mode::kSlide ? 1 : 0);
@@ -299,7 +319,7 @@ void ImplicitContact::restore(const Real* data, size_t size) {
 
 void ImplicitContact::subtract_friction(const VecX& v1, VecX& w) const {
   for (const Contact& c : contacts_) {
-    if (c.mode != Mode::kSlide) continue;
+    if (c.pinned || c.mode != Mode::kSlide) continue;
     particle(w, c.particle) +=
         c.viscosity * tangential(particle(v1, c.particle) - c.surface_velocity, c.normal);
   }
@@ -311,6 +331,10 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
   next_.clear();
   for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
     Contact c = contacts_[ci];
+    if (c.pinned) {  // a pin holds whatever force it takes
+      next_.push_back(c);
+      continue;
+    }
     // p = (A dv - b)_c from the original column (A is symmetric).
     const BlockColumn col = block_column(a, c.particle);
     const Real* orig = saved_.data() + saved_at_[ci];
@@ -411,6 +435,7 @@ void ImplicitContact::finish(const Model& model, const Terrains& terrains, State
   }
   // Contacts end at rest on their surface in the normal direction.
   for (const Contact& c : contacts_) {
+    if (c.pinned) continue;
     auto v = particle(s1.v, c.particle);
     v -= (v - c.surface_velocity).dot(c.normal) * c.normal;
   }
@@ -419,7 +444,7 @@ void ImplicitContact::finish(const Model& model, const Terrains& terrains, State
   bool any_impact = false, one_frame = true;
   Vec3 frame = Vec3::Zero();
   for (const Contact& c : contacts_) {
-    const Real bounce = bounce_speed(c, terrains);
+    const Real bounce = bounce_speed(c, terrains);  // 0 for pins
     if (bounce <= 0) continue;
     quadratic += 0.5 * model.mass[c.particle] * bounce * bounce;
     if (!any_impact) frame = c.surface_velocity;

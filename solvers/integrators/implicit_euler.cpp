@@ -66,14 +66,26 @@ struct ImplicitEuler::Impl {
                                  Real t);
   // Newton corrections on the nonlinear backward-Euler equations from v1_.
   StepResult newton(const Dynamics& dynamics, const State& s, Real h);
+  // Wind drag at time t: d(f)/d(v) = -drag on its particles, so A gains h drag on the diagonal.
+  void add_external_damping_system(const Model& model, Real t, Real h) {
+    if (model.external_forces.empty()) return;
+    ensure_size(damping_, model.num_particles());
+    damping_.setZero();
+    add_external_damping(model.external_forces, t, damping_);
+    for (int i = 0; i < model.num_particles(); ++i) {
+      if (damping_[i] == 0) continue;
+      for (int d = 0; d < 3; ++d) jacobian_->add_to_diagonal(a_, 3 * i + d, h * damping_[i]);
+    }
+  }
 
   ImplicitEulerOptions options_;
   JacobianOptions jacobian_options_;
   std::optional<SpringJacobian> jacobian_;
   std::unique_ptr<LinearSolver> solver_;
   SparseMatrix a_;
-  VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_;
+  VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
+  const Terrains* contact_terrains_ = nullptr;  // the terrains contact_ resolves this step
   bool contact_active_ = false;  // the current step constrains contacts
   bool terrains_seen_ = true;    // the last step's Dynamics had terrains
   bool anchored_ = false;        // the current step's Dynamics has anchor springs
@@ -249,11 +261,17 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   jacobian_->assemble_system(model, s.x, s.v, jacobian_options_, h, h * h, a_, s.v, kw_);
   anchored_ = dynamics.anchors() != nullptr;
   if (anchored_) add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, s.v, kw_);
+  add_external_damping_system(model, s.t + h, h);
   b_ = h * (f_ + h * kw_);
   assembly_seconds_ += seconds_since(start);
-  const Terrains* terrains = dynamics.terrains();
-  terrains_seen_ = terrains != nullptr;
-  contact_active_ = resolves_contact() && contact_.begin_step(model, *terrains, s, f_, h);
+  terrains_seen_ = dynamics.terrains() != nullptr;
+  // The terrains whose contact this solve resolves (none with contact = "after_step"); pinned
+  // particles are constraints of the solve either way.
+  static const Terrains kNoTerrains;
+  const Terrains* terrains = resolves_contact() ? dynamics.terrains() : &kNoTerrains;
+  contact_terrains_ = terrains;
+  contact_active_ = (resolves_contact() || !model.pins.empty()) &&
+                    contact_.begin_step(model, *terrains, s, f_, h);
   // Solve; with contacts, again while their active set changes.
   for (int round = 1;; ++round) {
     const bool constrained = contact_active_ && contact_.has_constraints();
@@ -308,6 +326,7 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
     const auto start = Clock::now();
     jacobian_->assemble_system(model, x1_, v1_, jacobian_options_, h, h * h, a_, v1_, kw_);
     if (anchored_) add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, v1_, kw_);
+    add_external_damping_system(model, s.t + h, h);
     assembly_seconds_ += seconds_since(start);
     if (constrained) contact_.constrain(a_, g_, false, rhs_, z_, delta_);
     if (StepResult r =
@@ -334,7 +353,7 @@ StepResult ImplicitEuler::Impl::step(const Dynamics& dynamics, State& s, Real h)
   s.v = v1_;
   s.x += h * s.v;
   s.t += h;
-  if (contact_active_) contact_.finish(dynamics.model(), *dynamics.terrains(), s);
+  if (contact_active_) contact_.finish(dynamics.model(), *contact_terrains_, s);
   return StepResult::success();
 }
 

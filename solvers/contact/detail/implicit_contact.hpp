@@ -25,6 +25,9 @@
 // A new contact sticks or slides as a lone particle would (|v_t| <= mu_s dv_n sticks).
 // The constraint impulses do no positive work (p_n >= 0 against a velocity that lands the
 // particle; friction against the sliding), so contact adds no energy to the backward-Euler step.
+// Pinned particles (Model::pins) are constraints of the same kind with all three directions
+// prescribed: their velocity at the end of the step is their path's (S_i = 0); they are never
+// released and take no part in friction or restitution.
 // At the end of the step a contact's normal velocity relative to the surface is zeroed, and a
 // particle that hit the surface faster than the resting speed bounces with restitution e, as far
 // as the energy the step lost allows (in the terrain's frame); a lone particle bounces fully.
@@ -56,6 +59,8 @@ class ImplicitContact {
     Real normal_impulse = 0;  // p_n of the last solve
     bool release = false;     // held for this step (pulled without work), free at the next
     Real approach = 0;        // -(v0 - u).n at the start of the step
+    bool pinned = false;      // a pinned particle: v1 = target_velocity, terrain -1
+    Vec3 target_velocity = Vec3::Zero();
   };
 
   struct Counters {
@@ -64,10 +69,10 @@ class ImplicitContact {
     long restitution_limited = 0;  // steps whose bounce the energy budget reduced
   };
 
-  // Starts a step of size h from s0 (time s0.t) with forces f(x0, v0): the active set starts
-  // from the last step's contacts still touching their terrain and the particles that the
-  // explicit prediction x0 + h (v0 + h f / m) puts below a coulomb terrain. Returns whether any
-  // terrain uses the coulomb model (else the step has nothing to do here).
+  // Starts a step of size h from s0 (time s0.t) with forces f(x0, v0): the model's pinned
+  // particles, then the last step's contacts still touching their terrain and the particles that
+  // the explicit prediction x0 + h (v0 + h f / m) puts below a coulomb terrain. Returns whether
+  // there is anything to constrain: pins, or a terrain that uses the coulomb model.
   bool begin_step(const Model& model, const Terrains& terrains, const State& s0, const VecX& f,
                   Real h);
   bool has_constraints() const { return !contacts_.empty(); }
@@ -99,8 +104,8 @@ class ImplicitContact {
   void save(std::vector<Real>& out) const;
   void restore(const Real* data, size_t size);
 
-  // Particles in contact at the end of the last step.
-  int count() const { return static_cast<int>(contacts_.size()) + projected_; }
+  // Particles in contact with a terrain at the end of the last step (pins not counted).
+  int count() const { return static_cast<int>(contacts_.size()) - pinned_ + projected_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
   const Counters& counters() const { return counters_; }
 
@@ -122,9 +127,11 @@ class ImplicitContact {
   VecX x0_, v0_;
   std::vector<Contact> contacts_, next_;
   std::vector<int> slot_;      // [N]: index into contacts_ or -1
+  std::vector<char> pinned_mask_;  // [N]: pinned this step
   std::vector<Real> saved_;    // original values of the constrained columns
   std::vector<int> saved_at_;  // [contacts]: offset into saved_
   int projected_ = 0;
+  int pinned_ = 0;  // the first pinned_ entries of contacts_ are pins
   Counters counters_;
 };
 

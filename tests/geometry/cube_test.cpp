@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 
 namespace jelly {
 namespace {
