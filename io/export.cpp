@@ -19,15 +19,17 @@ void put_f32(std::FILE* f, float v) { std::fwrite(&v, 4, 1, f); }
 
 }  // namespace
 
-void write_obj(const std::string& path, const std::vector<ObjObject>& objects) {
+void write_obj(const std::string& path, const std::vector<ObjObject>& objects,
+               const std::string& one_object) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (f == nullptr)
     throw InputError("output", path,
                      "a file that can be written (" + std::string(std::strerror(errno)) + ")");
   std::fprintf(f, "# jelly render surface\n");
+  if (!one_object.empty()) std::fprintf(f, "o %s\n", one_object.c_str());
   int base = 1;
   for (const ObjObject& o : objects) {
-    std::fprintf(f, "o %s\n", o.name.c_str());
+    std::fprintf(f, "%s %s\n", one_object.empty() ? "o" : "g", o.name.c_str());
     for (const Vec3& v : o.vertices) std::fprintf(f, "v %.9g %.9g %.9g\n", v.x(), v.y(), v.z());
     for (const auto& t : o.triangles)
       std::fprintf(f, "f %d %d %d\n", t[0] + base, t[1] + base, t[2] + base);
@@ -49,8 +51,9 @@ std::vector<ObjObject> read_obj(const std::string& path) {
     std::istringstream items(line);
     std::string key;
     items >> key;
-    if (key == "o") {
-      objects.emplace_back();
+    if (key == "o" || key == "g") {
+      // A new part, unless the current one has nothing yet (an object named before its group).
+      if (objects.empty() || !objects.back().vertices.empty()) objects.emplace_back();
       items >> objects.back().name;
       base = seen + 1;
     } else if (key == "v" || key == "f") {

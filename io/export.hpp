@@ -20,12 +20,15 @@ struct ObjObject {
 };
 
 // Writes the objects into one OBJ file ("o name", "v x y z" with 9 significant digits, "f a b c"
-// with indices counted over the whole file). Throws InputError naming the path when it cannot
-// be written.
-void write_obj(const std::string& path, const std::vector<ObjObject>& objects);
+// with indices counted over the whole file). With `one_object` given, they are groups ("g
+// name") of one object of that name instead: a tool then imports one mesh with every vertex
+// in order (what a point cache over all of them needs). Throws InputError naming the path when
+// it cannot be written.
+void write_obj(const std::string& path, const std::vector<ObjObject>& objects,
+               const std::string& one_object = "");
 
-// Reads back what write_obj wrote (vertices and triangles of every object in order; other OBJ
-// statements are skipped). Throws InputError for a file it cannot read.
+// Reads back what write_obj wrote: one ObjObject per object or group, vertices and triangles in
+// order (other OBJ statements are skipped). Throws InputError for a file it cannot read.
 std::vector<ObjObject> read_obj(const std::string& path);
 
 // A PC2 file written sample by sample; the sample count in the header is fixed by close().

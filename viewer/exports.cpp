@@ -10,7 +10,7 @@ namespace jelly::viewer {
 namespace {
 
 std::vector<BodySurface> surfaces_of(const Recording& recording) {
-  std::vector<BodySurface> surfaces = body_surfaces(recording.model);
+  std::vector<BodySurface> surfaces = recording_surfaces(recording);
   int triangles = 0;
   for (const BodySurface& s : surfaces) triangles += static_cast<int>(s.triangles.size());
   if (triangles == 0)
@@ -56,7 +56,10 @@ std::string export_pc2(const Recording& recording, const std::string& pc2_path) 
   const std::string obj_path = std::filesystem::path(pc2_path).replace_extension(".obj").string();
   if (obj_path == pc2_path)
     throw InputError("--pc2", pc2_path, "a path whose extension is not .obj (e.g. out.pc2)");
-  write_obj(obj_path, surface_objects(surfaces, recording.model.rest_position));
+  // One object (the bodies as its groups): Blender's importer then makes one mesh of every
+  // vertex in the cache's order.
+  write_obj(obj_path, surface_objects(surfaces, recording.model.rest_position),
+            std::filesystem::path(pc2_path).stem().string());
   Pc2Writer pc2(pc2_path, points, 0, 1);
   std::vector<double> xyz(static_cast<size_t>(3 * points));
   for (int k = 0; k < recording.frames(); ++k) {

@@ -20,7 +20,8 @@ int export_obj_sequence(const Recording& recording, const std::string& dir);
 
 // Writes the PC2 file (one sample per recorded frame, start frame 0, sample rate 1) and the
 // rest surface (the surfaces at the model's rest positions, the vertex order of the cache) as
-// an OBJ file of the same name with .obj; returns that OBJ's path.
+// an OBJ file of the same name with .obj, one object named after the file whose groups are the
+// bodies; returns that OBJ's path.
 std::string export_pc2(const Recording& recording, const std::string& pc2_path);
 
 }  // namespace jelly::viewer

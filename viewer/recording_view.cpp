@@ -10,8 +10,8 @@ namespace jelly::viewer {
 RecordingView::RecordingView(const std::string& path) : recording_(read_recording(path)) {
   if (recording_.frames() == 0) throw InputError("recording", path, "a recording with frames");
   bounds_of(recording_.position, lo_, hi_);
-  builder_ =
-      std::make_unique<SceneBuilder>(recording_.model, recording_terrains(recording_), lo_, hi_);
+  builder_ = std::make_unique<SceneBuilder>(recording_.model, recording_surfaces(recording_),
+                                            recording_terrains(recording_), lo_, hi_);
 }
 
 int RecordingView::frame_at(Real t) const {

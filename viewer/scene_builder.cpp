@@ -40,10 +40,10 @@ void bounds_of(const std::vector<VecX>& frames, Vec3& lo, Vec3& hi) {
   }
 }
 
-SceneBuilder::SceneBuilder(const Model& model, Terrains terrains, const Vec3& focus_lo,
-                           const Vec3& focus_hi)
+SceneBuilder::SceneBuilder(const Model& model, std::vector<BodySurface> surfaces, Terrains terrains,
+                           const Vec3& focus_lo, const Vec3& focus_hi)
     : num_particles_(model.num_particles()),
-      surfaces_(body_surfaces(model)),
+      surfaces_(std::move(surfaces)),
       terrains_(std::move(terrains)) {
   const Vec3 centre = 0.5 * (focus_lo + focus_hi);
   const Real size = focus_lo.x() <= focus_hi.x() ? (focus_hi - focus_lo).norm() : 1.0;
@@ -55,8 +55,9 @@ SceneBuilder::SceneBuilder(const Model& model, Terrains terrains, const Vec3& fo
   for (const auto& terrain : terrains_) {
     meshes_.push_back(terrain_mesh(*terrain, centre, extent));
     has_floor = has_floor || is_ground(*terrain);
-    if (!meshes_.back().vertices.empty())
-      lowest = std::min(lowest, terrain_pose(*terrain, 0).translation().y());
+    if (is_ground(*terrain)) continue;
+    const Eigen::Isometry3d pose = terrain_pose(*terrain, 0);
+    for (const Vec3& v : meshes_.back().vertices) lowest = std::min(lowest, (pose * v).y());
   }
   floor_ = !has_floor;
   floor_height_ = static_cast<float>(std::floor(lowest - 1.0));

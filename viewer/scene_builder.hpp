@@ -17,7 +17,11 @@ class SceneBuilder {
   // `focus` is where the action is (the bodies' initial bounds, or their bounds over a whole
   // recording): infinite planes are drawn as squares around it. The builder keeps its own
   // terrains (the caller's may live on another thread).
-  SceneBuilder(const Model& model, Terrains terrains, const Vec3& focus_lo, const Vec3& focus_hi);
+  SceneBuilder(const Model& model, std::vector<BodySurface> surfaces, Terrains terrains,
+               const Vec3& focus_lo, const Vec3& focus_hi);
+  // The model's own bodies (body_surfaces).
+  SceneBuilder(const Model& model, Terrains terrains, const Vec3& focus_lo, const Vec3& focus_hi)
+      : SceneBuilder(model, body_surfaces(model), std::move(terrains), focus_lo, focus_hi) {}
 
   // A scene of this model's topology at state (x, t); its `topology` is new.
   RenderScene make_scene(const VecX& x, Real t) const;
@@ -32,7 +36,7 @@ class SceneBuilder {
   int num_particles_ = 0;
   std::vector<BodySurface> surfaces_;
   Terrains terrains_;
-  std::vector<TerrainMesh> meshes_;
+  std::vector<TriangleMesh> meshes_;
   std::vector<std::array<int, 2>> springs_;
   std::vector<float> rest_length_;
   std::vector<int> type_;

@@ -12,6 +12,7 @@ import bpy
 rest, pc2, frame, expected = sys.argv[sys.argv.index("--") + 1:]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 bpy.ops.wm.obj_import(filepath=rest)  # Blender's defaults: forward -Z, up Y
+assert len(bpy.context.selected_objects) == 1, "the rest OBJ is one object (its groups: the bodies)"
 obj = bpy.context.selected_objects[0]
 cache = obj.modifiers.new("jelly", "MESH_CACHE")
 cache.cache_format = "PC2"

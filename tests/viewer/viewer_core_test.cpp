@@ -8,9 +8,9 @@
 #include <map>
 #include <thread>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/io/export.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
@@ -90,12 +90,30 @@ TEST(BodySurface, CubeLatticeBoundaryIsClosedAndOutward) {
   }
 }
 
-TEST(BodySurface, NoSurfaceWithoutALattice) {
-  Model model;
-  model.mass = VecX::Ones(5);
-  model.rest_position = VecX::Zero(15);
-  const auto surfaces = viewer::body_surfaces(model);
+// A recording's bodies: from its scene when the file holds none; without a scene, all its
+// particles as one body, a cube's lattice boundary when there are n^3 of them.
+TEST(BodySurface, RecordingBodiesFromTheSceneOrTheParticles) {
+  Recording r;
+  const Scene scene = small_slope(3);
+  r.model = make_model(scene);
+  r.model.bodies.clear();
+  r.scene_json = scene_to_json(scene);
+  auto surfaces = viewer::recording_surfaces(r);
   ASSERT_EQ(surfaces.size(), 1u);
+  EXPECT_EQ(surfaces[0].name, "jelly");
+  EXPECT_EQ(surfaces[0].triangles, make_model(scene).bodies[0].surface.triangles);
+
+  r.scene_json.clear();
+  surfaces = viewer::recording_surfaces(r);
+  ASSERT_EQ(surfaces.size(), 1u);
+  EXPECT_EQ(surfaces[0].num_particles, 27);
+  EXPECT_EQ(surfaces[0].triangles.size(), 48u);
+
+  r.model.mass = VecX::Ones(5);
+  r.model.rest_position = VecX::Zero(15);
+  surfaces = viewer::recording_surfaces(r);
+  ASSERT_EQ(surfaces.size(), 1u);
+  EXPECT_EQ(surfaces[0].num_particles, 5);
   EXPECT_TRUE(surfaces[0].triangles.empty());
 }
 
@@ -158,7 +176,8 @@ TEST(Export, ObjSequenceAndPc2ReadBackTheRecordedSurface) {
   record(h5, 0.2);
   const Recording rec = read_recording(h5);
   ASSERT_EQ(rec.frames(), 13);
-  const auto surfaces = viewer::body_surfaces(rec.model);
+  const auto surfaces = viewer::recording_surfaces(rec);
+  ASSERT_EQ(surfaces.size(), 1u);
   const viewer::BodySurface& s = surfaces[0];
 
   ASSERT_EQ(viewer::export_obj_sequence(rec, dir.file("objs")), rec.frames());
@@ -192,6 +211,44 @@ TEST(Export, ObjSequenceAndPc2ReadBackTheRecordedSurface) {
   ASSERT_EQ(rest_objects.size(), 1u);
   for (int v = 0; v < s.num_vertices(); ++v)
     EXPECT_LT((rest_objects[0].vertices[v] - s.vertex(rec.model.rest_position, v)).norm(), 1e-7);
+}
+
+// Every body's surface, in the model's order: one object each in the sequence, one group each
+// of the rest OBJ, all their vertices in the cache.
+TEST(Export, EveryBody) {
+  TempDir dir;
+  const Scene scene = load_scene(JELLY_VIEWER_TEST_DIR "/three_bodies.json");
+  Simulator sim = make_simulator(scene);
+  RecorderOptions options;
+  options.scene_json = scene_to_json(scene);
+  options.write_xdmf = false;
+  {
+    H5Recorder recorder(dir.file("r.h5"), sim, options);
+    sim.add_observer(recorder);
+    ASSERT_TRUE(sim.run_until(0.1).ok());
+  }
+  const Recording rec = read_recording(dir.file("r.h5"));
+  const auto surfaces = viewer::recording_surfaces(rec);
+  ASSERT_EQ(surfaces.size(), 3u);
+  viewer::export_obj_sequence(rec, dir.file("objs"));
+  const std::string rest = viewer::export_pc2(rec, dir.file("r.pc2"));
+  const std::vector<ObjObject> frame = read_obj(dir.file("objs/frame_0006.obj"));
+  const std::vector<ObjObject> rest_parts = read_obj(rest);
+  ASSERT_EQ(frame.size(), 3u);
+  ASSERT_EQ(rest_parts.size(), 3u);
+  int points = 0;
+  for (size_t b = 0; b < 3; ++b) {
+    EXPECT_EQ(frame[b].name, scene.bodies[b].name);
+    EXPECT_EQ(rest_parts[b].name, scene.bodies[b].name);
+    ASSERT_EQ(frame[b].vertices.size(), static_cast<size_t>(surfaces[b].num_vertices()));
+    EXPECT_FALSE(frame[b].triangles.empty());
+    for (int v = 0; v < surfaces[b].num_vertices(); ++v)
+      EXPECT_LT((frame[b].vertices[v] - surfaces[b].vertex(rec.position[6], v)).norm(), 1e-6);
+    points += surfaces[b].num_vertices();
+  }
+  const Pc2Data pc2 = read_pc2(dir.file("r.pc2"));
+  EXPECT_EQ(pc2.num_points, points);
+  EXPECT_EQ(pc2.samples.size(), static_cast<size_t>(rec.frames()));
 }
 
 TEST(Export, CliWritesBothAndRejectsNothingToDo) {
