@@ -20,8 +20,6 @@
 #include <jelly/io/detail/checkpoint_h5.hpp>
 #include <jelly/io/detail/h5.hpp>
 #include <jelly/io/detail/xdmf_h5.hpp>
-#include <jelly/terrain/elevator.hpp>
-#include <jelly/terrain/plane.hpp>
 #include <jelly/version.hpp>
 
 namespace jelly {
@@ -173,7 +171,16 @@ struct H5Recorder::Impl {
   Model model;
   int n = 0;
   h5::Handle file, parameters;
-  h5::Series step, time, position, velocity;
+  h5::Series step, time;
+  // One /particles/<name> group per body (a model without bodies is one body "jelly").
+  struct BodySeries {
+    std::string name;
+    int first = 0, count = 0;
+    const Surface* surface = nullptr;  // in `model`, or null
+    h5::Series position, velocity, surface_position;
+    std::vector<double> position_work, velocity_work, surface_work;
+  };
+  std::vector<BodySeries> bodies;
   std::vector<h5::Series> observables, terrains;
   std::unique_ptr<h5::CheckpointWriter> checkpoint;
   long frames_received = 0;
@@ -228,7 +235,8 @@ H5Recorder::Impl::Impl(const std::string& p, const Simulator& sim, RecorderOptio
     } catch (...) {
       // A file this recorder created and could not complete (a full disk): not left behind.
       parameters.reset();
-      for (h5::Series* series : {&step, &time, &position, &velocity}) *series = h5::Series();
+      for (h5::Series* series : {&step, &time}) *series = h5::Series();
+      bodies.clear();
       observables.clear();
       terrains.clear();
       checkpoint.reset();
@@ -263,31 +271,89 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
   h5::write_attribute(par, "num_springs", static_cast<long>(model.springs.size()));
   h5::write_attribute(par, "run_status", std::string("running"));
 
-  const hsize_t N = static_cast<hsize_t>(n);
-  h5::create_group(f, "particles");
-  h5::Handle jelly = h5::create_group(f, "particles/jelly");
-  h5::write_dataset(jelly.get(), "mass", {N}, model.mass.data());
-  h5::write_dataset(jelly.get(), "rest_position", {N, 3}, model.rest_position.data());
   const int level = options.compression_level;
   const int every = options.flush_every_frames;
-  const hsize_t frame_chunk = chunk_frames(3 * N, every);
-  {
-    h5::Handle g = h5::create_group(jelly.get(), "position");
-    step = h5::Series(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LONG, {}, kSmallSeriesChunk, 0);
-    time = h5::Series(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, kSmallSeriesChunk, 0);
-    position =
-        h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3}, frame_chunk, level);
+  h5::create_group(f, "particles");
+  if (model.bodies.empty()) {
+    bodies.push_back({"jelly", 0, n, nullptr, {}, {}, {}, {}, {}, {}});
+  } else {
+    for (const Body& b : model.bodies) {
+      bodies.push_back({b.name,
+                        b.first_particle,
+                        b.num_particles,
+                        b.surface.empty() ? nullptr : &b.surface,
+                        {},
+                        {},
+                        {},
+                        {},
+                        {},
+                        {}});
+    }
   }
-  // H5MD lets time-dependent groups sampled at the same frames share step and time by hard links.
+  // H5MD lets time-dependent groups sampled at the same frames share step and time by hard
+  // links: the first body's position group holds them.
+  const std::string clock = "/particles/" + bodies.front().name + "/position/";
   const auto link_clock = [&](hid_t group) {
-    h5::hard_link(f, "/particles/jelly/position/step", group, "step");
-    h5::hard_link(f, "/particles/jelly/position/time", group, "time");
+    h5::hard_link(f, clock + "step", group, "step");
+    h5::hard_link(f, clock + "time", group, "time");
   };
-  {
-    h5::Handle g = h5::create_group(jelly.get(), "velocity");
-    link_clock(g.get());
-    velocity =
-        h5::Series(g.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3}, frame_chunk, level);
+  for (std::size_t bi = 0; bi < bodies.size(); ++bi) {
+    BodySeries& body = bodies[bi];
+    const hsize_t N = static_cast<hsize_t>(body.count);
+    h5::Handle g = h5::create_group(f, "particles/" + body.name);
+    h5::write_attribute(g.get(), "first_particle", static_cast<long>(body.first));
+    if (!model.bodies.empty()) {
+      const Body& b = model.bodies[bi];
+      h5::write_attribute(g.get(), "kind", b.kind);
+      h5::write_attribute(g.get(), "first_spring", static_cast<long>(b.first_spring));
+      h5::write_attribute(g.get(), "num_springs", static_cast<long>(b.num_springs));
+      h5::write_attribute(g.get(), "radius", b.radius);
+      h5::write_attribute(g.get(), "spacing", b.spacing);
+    }
+    h5::write_dataset(g.get(), "mass", {N}, model.mass.data() + body.first);
+    h5::write_dataset(g.get(), "rest_position", {N, 3},
+                      model.rest_position.data() + 3 * body.first);
+    const hsize_t frame_chunk = chunk_frames(3 * N, every);
+    {
+      h5::Handle p = h5::create_group(g.get(), "position");
+      if (bi == 0) {
+        step =
+            h5::Series(p.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LONG, {}, kSmallSeriesChunk, 0);
+        time = h5::Series(p.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, kSmallSeriesChunk,
+                          0);
+      } else {
+        link_clock(p.get());
+      }
+      body.position = h5::Series(p.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3},
+                                 frame_chunk, level);
+    }
+    {
+      h5::Handle v = h5::create_group(g.get(), "velocity");
+      link_clock(v.get());
+      body.velocity = h5::Series(v.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {N, 3},
+                                 frame_chunk, level);
+    }
+    if (body.surface != nullptr) {
+      // The render surface: triangles over vertices that are weighted sums of the body's
+      // particles (body-local indices), and the vertices' positions at every frame.
+      const Surface& s = *body.surface;
+      h5::Handle sg = h5::create_group(g.get(), "surface");
+      const hsize_t F = static_cast<hsize_t>(s.num_triangles());
+      const hsize_t V = static_cast<hsize_t>(s.num_vertices());
+      const hsize_t K = static_cast<hsize_t>(s.particles.size());
+      std::vector<int> triangles(3 * F), particles(K);
+      for (hsize_t t = 0; t < F; ++t)
+        for (int c = 0; c < 3; ++c) triangles[3 * t + c] = s.triangles[t][c];
+      for (hsize_t k = 0; k < K; ++k) particles[k] = s.particles[k] - body.first;
+      h5::write_dataset(sg.get(), "triangles", {F, 3}, triangles.data());
+      h5::write_dataset(sg.get(), "vertex_offsets", {V + 1}, s.offsets.data());
+      h5::write_dataset(sg.get(), "vertex_particles", {K}, particles.data());
+      h5::write_dataset(sg.get(), "vertex_weights", {K}, s.weights.data());
+      h5::Handle p = h5::create_group(sg.get(), "position");
+      link_clock(p.get());
+      body.surface_position = h5::Series(p.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                                         {V, 3}, chunk_frames(3 * V, every), level);
+    }
   }
 
   const Springs& s = model.springs;
@@ -334,11 +400,24 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
                           std::string(contact_model_name(terrain.contact().model)));
       h5::write_attribute(t.get(), "restitution", terrain.contact().restitution);
       h5::write_attribute(t.get(), "friction", terrain.contact().friction);
-      if (const auto* elevator = dynamic_cast<const Elevator*>(&terrain)) {
-        h5::write_attribute(t.get(), "size_x", elevator->spec().size_x);
-        h5::write_attribute(t.get(), "size_z", elevator->spec().size_z);
-        h5::write_attribute(t.get(), "thickness", elevator->spec().thickness);
-        h5::write_attribute(t.get(), "mass", elevator->spec().mass);
+      for (const auto& [name, value] : terrain.attributes()) {
+        h5::write_attribute(t.get(), name, value);
+      }
+      {
+        // Its shape for drawing, in its own frame; each frame's pose moves it (position: the
+        // translation; orientation: a unit quaternion w, x, y, z).
+        const TriangleMesh mesh = terrain.render_mesh();
+        h5::Handle mg = h5::create_group(t.get(), "mesh");
+        const hsize_t V = static_cast<hsize_t>(mesh.num_vertices());
+        const hsize_t F = static_cast<hsize_t>(mesh.num_triangles());
+        std::vector<double> vertices(3 * V);
+        std::vector<int> triangles(3 * F);
+        for (hsize_t v = 0; v < V; ++v)
+          for (int c = 0; c < 3; ++c) vertices[3 * v + c] = mesh.vertices[v][c];
+        for (hsize_t k = 0; k < F; ++k)
+          for (int c = 0; c < 3; ++c) triangles[3 * k + c] = mesh.triangles[k][c];
+        h5::write_dataset(mg.get(), "vertices", {V, 3}, vertices.data());
+        h5::write_dataset(mg.get(), "triangles", {F, 3}, triangles.data());
       }
       h5::Handle pos = h5::create_group(t.get(), "position");
       link_clock(pos.get());
@@ -360,17 +439,44 @@ void H5Recorder::Impl::write_batch(Batch& batch) {
     for (size_t k = 0; k < specs.size(); ++k) observable_work[k].resize(frames * specs[k].width);
     ensure_size(x_work, dofs);
     ensure_size(v_work, dofs);
+    const bool whole = bodies.size() == 1 && bodies[0].count == n;
+    for (BodySeries& body : bodies) {
+      if (!whole) {
+        body.position_work.resize(frames * 3 * body.count);
+        body.velocity_work.resize(frames * 3 * body.count);
+      }
+      if (body.surface) body.surface_work.resize(frames * 3 * body.surface->num_vertices());
+    }
     for (hsize_t f = 0; f < frames; ++f) {
       std::memcpy(x_work.data(), batch.position.data() + f * dofs, sizeof(double) * dofs);
       std::memcpy(v_work.data(), batch.velocity.data() + f * dofs, sizeof(double) * dofs);
       for (size_t k = 0; k < specs.size(); ++k) {
         specs[k].compute(model, x_work, v_work, observable_work[k].data() + f * specs[k].width);
       }
+      for (BodySeries& body : bodies) {
+        const std::size_t values = 3 * static_cast<std::size_t>(body.count);
+        if (!whole) {
+          std::memcpy(body.position_work.data() + f * values, x_work.data() + 3 * body.first,
+                      sizeof(double) * values);
+          std::memcpy(body.velocity_work.data() + f * values, v_work.data() + 3 * body.first,
+                      sizeof(double) * values);
+        }
+        if (body.surface) {
+          const int nv = body.surface->num_vertices();
+          for (int v = 0; v < nv; ++v) {
+            Eigen::Map<Vec3>(body.surface_work.data() + (f * nv + v) * 3) =
+                body.surface->vertex(x_work, v);
+          }
+        }
+      }
     }
     step.append(batch.step.data(), frames);
     time.append(batch.time.data(), frames);
-    position.append(batch.position.data(), frames);
-    velocity.append(batch.velocity.data(), frames);
+    for (BodySeries& body : bodies) {
+      body.position.append(whole ? batch.position.data() : body.position_work.data(), frames);
+      body.velocity.append(whole ? batch.velocity.data() : body.velocity_work.data(), frames);
+      if (body.surface) body.surface_position.append(body.surface_work.data(), frames);
+    }
     for (size_t k = 0; k < specs.size(); ++k)
       observables[k].append(observable_work[k].data(), frames);
     for (size_t i = 0; i < terrains.size(); ++i)

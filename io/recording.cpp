@@ -1,5 +1,6 @@
 #include <jelly/io/recording.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <limits>
@@ -49,19 +50,79 @@ std::vector<VecX> split_frames(const std::vector<double>& data, const std::vecto
   return frames;
 }
 
+// A body of a recording: its group under /particles and its place among the particles.
+struct BodyGroup {
+  std::string name;
+  long first = -1;
+  std::string group() const { return "/particles/" + name; }
+};
+
+// The bodies in the order of their particles (the attribute first_particle; a recording without
+// it has one body).
+std::vector<BodyGroup> body_groups(hid_t file) {
+  h5::Handle particles = h5::open_group(file, "/particles");
+  std::vector<BodyGroup> bodies;
+  for (const std::string& name : member_names(particles.get())) {
+    BodyGroup b{name, -1};
+    h5::Handle g = h5::open_group(particles.get(), name);
+    if (h5::has_attribute(g.get(), "first_particle")) {
+      b.first = h5::read_long_attribute(g.get(), "first_particle");
+    }
+    bodies.push_back(b);
+  }
+  expect(!bodies.empty(), "/particles", "no body");
+  std::stable_sort(bodies.begin(), bodies.end(),
+                   [](const BodyGroup& a, const BodyGroup& b) { return a.first < b.first; });
+  return bodies;
+}
+
+// The body's render surface from /particles/<body>/surface (global particle indices), if any.
+Surface read_surface(hid_t file, const std::string& group, int first, int count) {
+  Surface s;
+  if (!h5::exists(file, group + "/surface/triangles")) return s;
+  const std::string at = group + "/surface/";
+  const std::vector<int> triangles = h5::read_ints(file, at + "triangles");
+  s.offsets = h5::read_ints(file, at + "vertex_offsets");
+  s.particles = h5::read_ints(file, at + "vertex_particles");
+  s.weights = h5::read_doubles(file, at + "vertex_weights");
+  expect(triangles.size() % 3 == 0, at + "triangles", "not [F][3]");
+  for (std::size_t t = 0; t < triangles.size(); t += 3) {
+    s.triangles.push_back({triangles[t], triangles[t + 1], triangles[t + 2]});
+  }
+  for (int& p : s.particles) {
+    expect(p >= 0 && p < count, at + "vertex_particles",
+           "index " + std::to_string(p) + " outside the body's " + std::to_string(count) +
+               " particles");
+    p += first;
+  }
+  return s;
+}
+
 Recording read(hid_t file) {
   Recording r;
   std::vector<hsize_t> dims;
-  std::vector<double> mass = h5::read_doubles(file, "/particles/jelly/mass");
-  r.model.mass = Eigen::Map<const VecX>(mass.data(), static_cast<Eigen::Index>(mass.size()));
-  const std::size_t n = mass.size();
-  expect(n <= static_cast<std::size_t>(std::numeric_limits<int>::max() / 3),
-         "/particles/jelly/mass", "too many particles");
-  std::vector<double> rest = h5::read_doubles(file, "/particles/jelly/rest_position");
-  expect(rest.size() == 3 * n, "/particles/jelly/rest_position",
-         count_text(rest.size()) + " numbers for " + count_text(n) + " particles");
-  r.model.rest_position =
-      Eigen::Map<const VecX>(rest.data(), static_cast<Eigen::Index>(rest.size()));
+  const std::vector<BodyGroup> groups = body_groups(file);
+  std::vector<int> counts;
+  std::size_t n = 0;
+  for (const BodyGroup& b : groups) {
+    std::vector<double> mass = h5::read_doubles(file, b.group() + "/mass");
+    expect(b.first < 0 || static_cast<std::size_t>(b.first) == n, b.group(),
+           "first_particle " + std::to_string(b.first) + " does not follow the bodies before it (" +
+               count_text(n) + " particles)");
+    expect(n + mass.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max() / 3),
+           b.group() + "/mass", "too many particles");
+    std::vector<double> rest = h5::read_doubles(file, b.group() + "/rest_position");
+    expect(rest.size() == 3 * mass.size(), b.group() + "/rest_position",
+           count_text(rest.size()) + " numbers for " + count_text(mass.size()) + " particles");
+    r.model.mass.conservativeResize(static_cast<Eigen::Index>(n + mass.size()));
+    r.model.mass.tail(static_cast<Eigen::Index>(mass.size())) =
+        Eigen::Map<const VecX>(mass.data(), static_cast<Eigen::Index>(mass.size()));
+    r.model.rest_position.conservativeResize(static_cast<Eigen::Index>(3 * (n + mass.size())));
+    r.model.rest_position.tail(static_cast<Eigen::Index>(rest.size())) =
+        Eigen::Map<const VecX>(rest.data(), static_cast<Eigen::Index>(rest.size()));
+    counts.push_back(static_cast<int>(mass.size()));
+    n += mass.size();
+  }
   const std::vector<int> pairs = h5::read_ints(file, "/connectivity/springs");
   const std::vector<int> type = h5::read_ints(file, "/connectivity/type");
   const std::vector<double> rest_length = h5::read_doubles(file, "/connectivity/rest_length");
@@ -86,27 +147,65 @@ Recording read(hid_t file) {
     r.model.springs.add(pairs[2 * i], pairs[2 * i + 1], rest_length[i], {ks[i], kd[i]},
                         static_cast<SpringType>(type[i]));
   }
+  // The bodies: ranges of particles and of the springs (which follow each other body by body).
+  {
+    int first = 0, spring = 0;
+    for (std::size_t bi = 0; bi < groups.size(); ++bi) {
+      Body body;
+      body.name = groups[bi].name;
+      body.first_particle = first;
+      body.num_particles = counts[bi];
+      body.first_spring = spring;
+      while (spring < static_cast<int>(m) && pairs[2 * spring] < first + counts[bi]) ++spring;
+      body.num_springs = spring - body.first_spring;
+      h5::Handle g = h5::open_group(file, groups[bi].group());
+      if (h5::has_attribute(g.get(), "kind"))
+        body.kind = h5::read_string_attribute(g.get(), "kind");
+      if (h5::has_attribute(g.get(), "radius"))
+        body.radius = h5::read_double_attribute(g.get(), "radius");
+      if (h5::has_attribute(g.get(), "spacing"))
+        body.spacing = h5::read_double_attribute(g.get(), "spacing");
+      body.surface = read_surface(file, groups[bi].group(), first, counts[bi]);
+      r.model.bodies.push_back(std::move(body));
+      first += counts[bi];
+    }
+  }
   h5::Handle parameters = h5::open_group(file, "/parameters");
   r.attributes = attributes_of(parameters.get());
   r.scene_json = h5::read_string_attribute(parameters.get(), "scene_json");
-  std::vector<hsize_t> gdims;
   if (h5::has_attribute(parameters.get(), "gravity")) {
     const std::string g = r.attributes["gravity"];
     std::istringstream in(g);
     in >> r.model.gravity.x() >> r.model.gravity.y() >> r.model.gravity.z();
   }
 
-  r.time = h5::read_doubles(file, "/particles/jelly/position/time");
-  r.step = h5::read_longs(file, "/particles/jelly/position/step");
+  const std::string clock = groups.front().group() + "/position/";
+  r.time = h5::read_doubles(file, clock + "time");
+  r.step = h5::read_longs(file, clock + "step");
   try {
     r.model.validate();
   } catch (const InputError& e) {
     throw std::runtime_error(std::string("its model is invalid: ") + e.what());
   }
-  r.position = split_frames(h5::read_doubles(file, "/particles/jelly/position/value", &dims), dims,
-                            n, "/particles/jelly/position/value");
-  r.velocity = split_frames(h5::read_doubles(file, "/particles/jelly/velocity/value", &dims), dims,
-                            n, "/particles/jelly/velocity/value");
+  // Every frame's positions and velocities, the bodies' rows one after the other.
+  for (std::size_t bi = 0; bi < groups.size(); ++bi) {
+    const std::size_t count = static_cast<std::size_t>(counts[bi]);
+    const Eigen::Index first = 3 * static_cast<Eigen::Index>(r.model.bodies[bi].first_particle);
+    for (auto [series, frames] :
+         {std::pair{"/position/value", &r.position}, std::pair{"/velocity/value", &r.velocity}}) {
+      const std::string path = groups[bi].group() + series;
+      const std::vector<VecX> body_frames =
+          split_frames(h5::read_doubles(file, path, &dims), dims, count, path);
+      if (bi == 0) {
+        frames->assign(body_frames.size(), VecX::Zero(static_cast<Eigen::Index>(3 * n)));
+      }
+      const std::size_t common = std::min(frames->size(), body_frames.size());
+      frames->resize(common);
+      for (std::size_t f = 0; f < common; ++f) {
+        (*frames)[f].segment(first, static_cast<Eigen::Index>(3 * count)) = body_frames[f];
+      }
+    }
+  }
   // A killed run may have flushed one series further than another: keep the common frames.
   const size_t frames =
       std::min({r.time.size(), r.step.size(), r.position.size(), r.velocity.size()});
@@ -178,8 +277,27 @@ std::string describe_recording(const std::string& path) {
     out << "file:          " << path << " (" << std::filesystem::file_size(path) << " bytes)\n";
     out << "creator:       " << h5::read_string_attribute(h5md.get(), "creator") << ' '
         << h5::read_string_attribute(h5md.get(), "creator_version") << '\n';
-    h5::Handle mass = h5::open_dataset(f, "/particles/jelly/mass");
-    out << "particles:     " << h5::dataset_dims(mass.get()).at(0) << '\n';
+    const std::vector<BodyGroup> bodies = body_groups(f);
+    hsize_t particles = 0;
+    std::ostringstream listing;
+    for (const BodyGroup& b : bodies) {
+      h5::Handle mass = h5::open_dataset(f, b.group() + "/mass");
+      const hsize_t count = h5::dataset_dims(mass.get()).at(0);
+      particles += count;
+      h5::Handle g = h5::open_group(f, b.group());
+      listing << (listing.tellp() > 0 ? ", " : "") << b.name << " (";
+      if (h5::has_attribute(g.get(), "kind")) {
+        listing << h5::read_string_attribute(g.get(), "kind") << ", ";
+      }
+      listing << count << " particles";
+      if (h5::exists(f, b.group() + "/surface/triangles")) {
+        h5::Handle t = h5::open_dataset(f, b.group() + "/surface/triangles");
+        listing << ", surface of " << h5::dataset_dims(t.get()).at(0) << " triangles";
+      }
+      listing << ")";
+    }
+    out << "particles:     " << particles << '\n';
+    out << "bodies:        " << listing.str() << '\n';
     const std::vector<int> type = h5::read_ints(f, "/connectivity/type");
     int counts[kSpringTypeCount] = {0, 0, 0};
     for (int t : type) {
@@ -190,8 +308,8 @@ std::string describe_recording(const std::string& path) {
       out << (t ? ", " : "") << counts[t] << ' ' << spring_type_name(static_cast<SpringType>(t));
     }
     out << ")\n";
-    const std::vector<double> time = h5::read_doubles(f, "/particles/jelly/position/time");
-    h5::Handle value = h5::open_dataset(f, "/particles/jelly/position/value");
+    const std::vector<double> time = h5::read_doubles(f, bodies.front().group() + "/position/time");
+    h5::Handle value = h5::open_dataset(f, bodies.front().group() + "/position/value");
     const hsize_t frames = std::min<hsize_t>(time.size(), h5::dataset_dims(value.get()).at(0));
     out << "frames:        " << frames;
     if (frames > 0) out << ", t = " << time.front() << " .. " << time[frames - 1] << " s";

@@ -44,6 +44,12 @@ class Elevator final : public Terrain {
   Real mass() const override { return spec_.mass; }
   // The platform: size_x by thickness by size_z, its top face at the surface.
   TriangleMesh render_mesh() const override;
+  std::vector<std::pair<std::string, Real>> attributes() const override {
+    return {{"size_x", spec_.size_x},
+            {"size_z", spec_.size_z},
+            {"thickness", spec_.thickness},
+            {"mass", spec_.mass}};
+  }
 
   Real height(Real t) const { return spec_.center.y() + spec_.motion.offset(t); }
   const ElevatorSpec& spec() const { return spec_; }

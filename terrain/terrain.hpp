@@ -3,7 +3,10 @@
 // answers particles touching it. Queries are per particle, never per spring.
 #include <limits>
 #include <memory>
+#include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include <jelly/core/types.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
@@ -33,6 +36,8 @@ class Terrain {
   virtual TriangleMesh render_mesh() const = 0;
   // Where render_mesh() is at time t: its rigid placement in the world.
   virtual Eigen::Isometry3d pose(Real t) const;
+  // The kind's dimensions as named numbers (a recording stores them as attributes).
+  virtual std::vector<std::pair<std::string, Real>> attributes() const { return {}; }
 
   const ContactParams& contact() const { return contact_; }
   void set_contact(const ContactParams& contact);
