@@ -1,5 +1,5 @@
-"""Shared helpers of plot.py and animate.py: read a jelly recording (HDF5) and draw the jelly,
-its springs and its terrains on a matplotlib 3-D axis. The simulation's y axis is up; the plots
+"""Shared helpers of plot.py and animate.py: read a jelly recording (HDF5) and draw its bodies
+(their surfaces, or particles and springs), and its terrains on a matplotlib 3-D axis. The simulation's y axis is up; the plots
 show (x, z, y) so that up is up on screen."""
 import h5py
 import numpy as np
@@ -11,16 +11,39 @@ def attr_text(value):
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
+class Body:
+    """One body of a recording: its name, kind, particle range and render surface (triangles
+    and vertex positions per frame), as /particles/<name>/ holds them."""
+
+    def __init__(self, name, group, frames):
+        self.name = name
+        self.kind = attr_text(group.attrs.get("kind", ""))
+        self.first_particle = int(group.attrs.get("first_particle", 0))
+        self.num_particles = group["position/value"].shape[1]
+        self.triangles = None
+        self.surface = None  # [T][V][3]
+        if "surface" in group:
+            self.triangles = group["surface/triangles"][:]
+            self.surface = group["surface/position/value"][:frames]
+
+
 class Recording:
     def __init__(self, path):
         with h5py.File(path, "r") as f:
-            jelly = f["particles/jelly"]
-            self.position = jelly["position/value"][:]
-            self.velocity = jelly["velocity/value"][:]
-            self.time = jelly["position/time"][:]
-            frames = min(len(self.time), len(self.position), len(self.velocity))
-            self.position, self.velocity, self.time = (
-                self.position[:frames], self.velocity[:frames], self.time[:frames])
+            groups = sorted(f["particles"].items(),
+                            key=lambda item: int(item[1].attrs.get("first_particle", 0)))
+            if not groups:
+                raise ValueError(f"{path} holds no bodies under /particles")
+            first = groups[0][1]
+            self.time = first["position/time"][:]
+            frames = min([len(self.time)] + [min(len(g["position/value"]), len(g["velocity/value"]))
+                                             for _, g in groups])
+            self.time = self.time[:frames]
+            self.position = np.concatenate([g["position/value"][:frames] for _, g in groups],
+                                           axis=1)
+            self.velocity = np.concatenate([g["velocity/value"][:frames] for _, g in groups],
+                                           axis=1)
+            self.bodies = [Body(name, g, frames) for name, g in groups]
             self.springs = f["connectivity/springs"][:]
             self.spring_type = f["connectivity/type"][:]
             self.observables = {name: g["value"][:frames] for name, g in f["observables"].items()}
@@ -31,6 +54,9 @@ class Recording:
                 t["name"] = name
                 t["kind"] = attr_text(t.get("kind", ""))
                 t["position"] = g["position/value"][:frames]
+                if "mesh" in g:
+                    t["mesh_vertices"] = g["mesh/vertices"][:]
+                    t["mesh_triangles"] = g["mesh/triangles"][:]
                 self.terrains.append(t)
 
     @property
@@ -40,7 +66,8 @@ class Recording:
     def title(self):
         p = self.parameters
         status = attr_text(p.get("run_status", "?"))
-        return (f"{len(self.position[0]) if self.frames else 0} particles, "
+        bodies = f"{len(self.bodies)} bodies, " if len(self.bodies) > 1 else ""
+        return (f"{bodies}{len(self.position[0]) if self.frames else 0} particles, "
                 f"{len(self.springs)} springs, {attr_text(p.get('integrator', '?'))} "
                 f"dt={float(p.get('dt', float('nan'))):g} s, run {status}")
 
@@ -57,6 +84,26 @@ def spring_segments(x, springs):
     """[M][2][3] segments in plot order (x, z, y)."""
     seg = x[springs][:, :, [0, 2, 1]]
     return seg
+
+
+def surface_polygons(body, frame):
+    """[F][3][3] triangles of a body's surface at a frame in plot order (x, z, y), or None."""
+    if body.surface is None or len(body.triangles) == 0:
+        return None
+    return body.surface[frame][body.triangles][:, :, [0, 2, 1]]
+
+
+def terrain_polygons(rec, frame):
+    """Triangles [F][3][3] in plot order of every terrain that is not a plane (obstacles, the
+    elevator): its recorded mesh moved to its recorded position."""
+    polygons = []
+    for t in rec.terrains:
+        if t["kind"] in ("plane", "slope", "elevator") or "mesh_vertices" not in t:
+            continue
+        p = t["position"][frame] if len(t["position"]) > frame else t["position"][-1]
+        v = t["mesh_vertices"] + p
+        polygons.append(v[t["mesh_triangles"]][:, :, [0, 2, 1]])
+    return polygons
 
 
 def terrain_surfaces(rec, frame, limits):

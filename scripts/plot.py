@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Plots a jelly recording: centre-of-mass trajectory, energies over time and 3-D snapshots of
-the jelly with its springs and terrain, in one PNG.
+its bodies (shaded surfaces, or particles and springs) and terrains, in one PNG.
 
     scripts/plot.py out/slope.h5 [-o out/slope.png] [--snapshots 4] [--all-springs]
 """
@@ -13,10 +13,21 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Line3DCollection  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import jelly_h5  # noqa: E402
+
+
+def shaded(polygons, colour, light=(0.4, -0.3, 0.87)):
+    """Face colours lit by a directional light (plot order x, z, y; light from above-front)."""
+    n = np.cross(polygons[:, 1] - polygons[:, 0], polygons[:, 2] - polygons[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+    light = np.asarray(light) / np.linalg.norm(light)
+    # The plot order (x, z, y) mirrors the frame: outward normals point the other way.
+    brightness = 0.35 + 0.65 * np.clip(-(n @ light), 0, 1)
+    rgb = np.asarray(colour[:3])[None, :] * brightness[:, None]
+    return np.hstack([rgb, np.ones((len(rgb), 1))])
 
 
 def draw_snapshot(ax, rec, frame, limits, all_springs):
@@ -24,10 +35,23 @@ def draw_snapshot(ax, rec, frame, limits, all_springs):
     keep = np.ones(len(rec.springs), bool) if all_springs else rec.spring_type == 0
     for X, Z, Y in jelly_h5.terrain_surfaces(rec, frame, limits):
         ax.plot_surface(X, Z, Y, color="tan", alpha=0.35, linewidth=0)
-    lines = Line3DCollection(jelly_h5.spring_segments(x, rec.springs[keep]), colors="tab:blue",
+    for polygons in jelly_h5.terrain_polygons(rec, frame):
+        ax.add_collection3d(Poly3DCollection(polygons, facecolor="tan", alpha=0.5, linewidth=0))
+    colours = plt.get_cmap("tab10")
+    drawn = np.zeros(len(x), bool)
+    for k, body in enumerate(rec.bodies):
+        polygons = jelly_h5.surface_polygons(body, frame)
+        if polygons is None or all_springs:
+            continue
+        ax.add_collection3d(Poly3DCollection(polygons, facecolors=shaded(polygons, colours(k % 10)),
+                                             edgecolor="k", linewidth=0.05))
+        drawn[body.first_particle:body.first_particle + body.num_particles] = True
+    springs = rec.springs[keep]
+    springs = springs[~drawn[springs[:, 0]]]
+    lines = Line3DCollection(jelly_h5.spring_segments(x, springs), colors="tab:blue",
                              linewidths=0.4, alpha=0.6)
     ax.add_collection3d(lines)
-    ax.scatter(x[:, 0], x[:, 2], x[:, 1], s=0.5, c="navy", depthshade=False)
+    ax.scatter(x[~drawn, 0], x[~drawn, 2], x[~drawn, 1], s=0.5, c="navy", depthshade=False)
     jelly_h5.style_axis(ax, limits)
     ax.view_init(elev=15, azim=-70)
     ax.set_title(f"t = {rec.time[frame]:.2f} s")
@@ -39,7 +63,8 @@ def main():
     parser.add_argument("-o", "--output", help="PNG path (default: FILE with .png)")
     parser.add_argument("--snapshots", type=int, default=4, help="3-D snapshots (default 4)")
     parser.add_argument("--all-springs", action="store_true",
-                        help="draw shear and bending springs too (default: structural only)")
+                        help="draw every spring and particle instead of the surfaces "
+                        "(default: surfaces; structural springs of bodies without one)")
     args = parser.parse_args()
     rec = jelly_h5.Recording(args.file)
     if rec.frames == 0:
