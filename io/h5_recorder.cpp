@@ -404,8 +404,8 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
         h5::write_attribute(t.get(), name, value);
       }
       {
-        // Its shape for drawing, in its own frame; each frame's pose moves it (position: the
-        // translation; orientation: a unit quaternion w, x, y, z).
+        // Its shape for drawing, in its own frame, moved at each frame by the recorded position
+        // (a translation: no recorded terrain rotates yet).
         const TriangleMesh mesh = terrain.render_mesh();
         h5::Handle mg = h5::create_group(t.get(), "mesh");
         const hsize_t V = static_cast<hsize_t>(mesh.num_vertices());
