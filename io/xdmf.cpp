@@ -222,6 +222,10 @@ struct TerrainInfo {
   std::vector<Vec3> position;  // Terrain::position(t) of every frame
   Vec3 normal = Vec3::UnitY();
   double size_x = 0, size_z = 0, thickness = 0;
+  // Its drawing in its own frame (/terrain/<name>/mesh: Terrain::render_mesh()), placed at the
+  // recorded position; absent from recordings made before it was recorded.
+  std::vector<Vec3> mesh_vertices;
+  std::vector<std::array<int, 3>> mesh_triangles;
   bool moving = false;
 };
 
@@ -348,6 +352,30 @@ Recording inspect(hid_t file, const std::string& h5_path) {
         if (key == "size_x") in >> info.size_x;
         if (key == "size_z") in >> info.size_z;
         if (key == "thickness") in >> info.thickness;
+      }
+      if (h5::exists(group.get(), name + "/mesh/vertices") &&
+          h5::exists(group.get(), name + "/mesh/triangles")) {
+        std::vector<hsize_t> vertex_dims, triangle_dims;
+        const std::vector<double> v =
+            h5::read_doubles(group.get(), name + "/mesh/vertices", &vertex_dims);
+        const std::vector<int> f =
+            h5::read_ints(group.get(), name + "/mesh/triangles", &triangle_dims);
+        if (vertex_dims.size() != 2 || vertex_dims[1] != 3 || triangle_dims.size() != 2 ||
+            triangle_dims[1] != 3) {
+          not_a_recording(h5_path, "/terrain/" + name + "/mesh is not [V][3] and [F][3]");
+        }
+        for (size_t k = 0; k + 2 < v.size(); k += 3)
+          info.mesh_vertices.emplace_back(v[k], v[k + 1], v[k + 2]);
+        for (size_t k = 0; k + 2 < f.size(); k += 3) {
+          for (int c = 0; c < 3; ++c) {
+            if (f[k + c] < 0 || static_cast<size_t>(f[k + c]) >= info.mesh_vertices.size()) {
+              not_a_recording(h5_path, "/terrain/" + name + "/mesh/triangles names vertex " +
+                                           std::to_string(f[k + c]) + " of " +
+                                           std::to_string(info.mesh_vertices.size()));
+            }
+          }
+          info.mesh_triangles.push_back({f[k], f[k + 1], f[k + 2]});
+        }
       }
       r.terrains.push_back(std::move(info));
     }
@@ -537,10 +565,18 @@ Mesh box_mesh(const Vec3& top, double size_x, double size_z, double thickness) {
   return mesh;
 }
 
-// The surface a terrain shows, where it is at frame 0; empty for a kind without one.
+// The surface a terrain shows, where it is at frame 0; empty when the file has none for it.
 Mesh terrain_mesh(const TerrainInfo& t, const Bounds& bounds) {
   if (t.position.empty()) return {};
+  // A plane is infinite: drawn under wherever the bodies went, not as its recorded square.
   if (t.kind == "plane") return plane_mesh(t.position.front(), t.normal, bounds);
+  if (!t.mesh_vertices.empty()) {
+    Mesh mesh;
+    for (const Vec3& v : t.mesh_vertices) mesh.vertices.push_back(v + t.position.front());
+    mesh.triangles = t.mesh_triangles;
+    return mesh;
+  }
+  // Recordings made before the meshes were recorded.
   if (t.kind == "elevator" && t.size_x > 0 && t.size_z > 0) {
     const double thickness = t.thickness > 0 ? t.thickness : 0.1 * std::min(t.size_x, t.size_z);
     return box_mesh(t.position.front(), t.size_x, t.size_z, thickness);
@@ -698,8 +734,8 @@ class Writer {
   std::ostringstream out_;
 };
 
-void body_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody& body, bool observables,
-                const XdmfOptions& options) {
+void body_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody& body,
+                bool observables, const XdmfOptions& options) {
   const std::string own = body_path(body);
   const std::string springs = body.all_springs ? "/connectivity" : own;
   const Item ends = item_of(file, springs + "/springs");

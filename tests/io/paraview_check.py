@@ -67,7 +67,8 @@ class Recording:
             for name, g in f.get("terrain", {}).items():
                 self.terrains.append({"name": name, "kind": g.attrs["kind"],
                                       "normal": np.asarray(g.attrs["normal"], float),
-                                      "position": g["position/value"][:]})
+                                      "position": g["position/value"][:],
+                                      "mesh": g["mesh/vertices"][:] if "mesh" in g else None})
         self.terrains.sort(key=lambda t: int(t["name"].split("_")[0]))
         frames = [len(self.time)] + [len(b["x"]) for b in self.bodies] + [
             len(b["v"]) for b in self.bodies]
@@ -153,7 +154,11 @@ def check_terrain(tag, terrain, data, k):
               f"{tag}: {len(points)} points, {data.GetNumberOfCells()} cells; expected a quad")
         check(np.allclose((points - p) @ terrain["normal"], 0, atol=1e-9),
               f"{tag}: the quad is not in the plane")
-    elif terrain["kind"] == "elevator":
+    elif terrain["mesh"] is not None:  # its recorded render mesh, at the recorded position
+        check(len(points) == len(terrain["mesh"]) and
+              np.allclose(points, terrain["mesh"] + p, rtol=0, atol=1e-9),
+              f"{tag}: the points are not the recorded mesh at the recorded position")
+    if terrain["kind"] == "elevator":
         check(len(points) == 8 and data.GetNumberOfCells() == 12,
               f"{tag}: {len(points)} points, {data.GetNumberOfCells()} cells; expected a box")
         if len(points):

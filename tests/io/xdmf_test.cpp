@@ -6,6 +6,8 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <regex>
@@ -191,11 +193,45 @@ TEST(Xdmf, TheElevatorIsABoxAtItsRecordedHeight) {
     EXPECT_NEAR(top - bottom, ElevatorSpec{}.thickness, 1e-12);
   }
   EXPECT_EQ(read(file, "/xdmf/terrain/0_elevator/triangles").size(), 36u);
+  // The recorder records the elevator's render mesh (Terrain::render_mesh()), which this is.
+  std::vector<hsize_t> mesh_dims;
+  read(file, "/terrain/0_elevator/mesh/vertices", &mesh_dims);
+  EXPECT_EQ(mesh_dims, (std::vector<hsize_t>{8, 3}));
+  read(file, "/terrain/0_elevator/mesh/triangles", &mesh_dims);
+  EXPECT_EQ(mesh_dims, (std::vector<hsize_t>{12, 3}));
   // Its speed: 3 m/s^2 from rest, about 3 t.
   const std::vector<double> speed =
       read(file, "/xdmf/terrain/0_elevator/frame/speed/" + std::to_string(frames - 1));
   EXPECT_NEAR(speed[0], 3 * 0.5, 0.05);
+  const std::vector<double> last =
+      read(file, "/xdmf/terrain/0_elevator/frame/position/" + std::to_string(frames - 1));
   H5Fclose(file);
+
+  // A recording made before the meshes were recorded: the box comes from the elevator's size.
+  const std::string old = dir.file("old.h5");
+  std::filesystem::copy_file(path, old);
+  const hid_t f = H5Fopen(old.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(H5Ldelete(f, "/terrain/0_elevator/mesh", H5P_DEFAULT), 0);
+  ASSERT_GE(H5Ldelete(f, "/xdmf", H5P_DEFAULT), 0);
+  H5Fclose(f);
+  write_xdmf_for_recording(old);
+  const hid_t g = H5Fopen(old.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  std::vector<double> again =
+      read(g, "/xdmf/terrain/0_elevator/frame/position/" + std::to_string(frames - 1));
+  H5Fclose(g);
+  // The same corners, maybe in another order.
+  auto sorted = [](std::vector<double> xyz) {
+    std::vector<std::array<double, 3>> corners;
+    for (size_t k = 0; k + 2 < xyz.size(); k += 3)
+      corners.push_back({xyz[k], xyz[k + 1], xyz[k + 2]});
+    std::sort(corners.begin(), corners.end());
+    return corners;
+  };
+  const auto a = sorted(last), b = sorted(again);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t c = 0; c < a.size(); ++c) {
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(a[c][k], b[c][k], 1e-12);
+  }
 }
 
 // The sidecar after a run in three parts, or written from the file alone after a run without
