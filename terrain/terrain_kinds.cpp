@@ -2,17 +2,32 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/obstacle.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly {
 
 const std::vector<TerrainKindInfo>& terrain_kinds() {
   static const std::vector<TerrainKindInfo> kinds{
+      {"box",
+       "an oriented box obstacle: center, size, rotation_degrees, motion, "
+       "angular_velocity_degrees",
+       &ObstacleSpec::read_box},
+      {"capsule",
+       "a capsule obstacle (axis along its own y): center, radius, height (between the caps), "
+       "rotation_degrees, motion, angular_velocity_degrees",
+       &ObstacleSpec::read_capsule},
+      {"cylinder",
+       "a capped cylinder obstacle (axis along its own y): center, radius, height, "
+       "rotation_degrees, motion, angular_velocity_degrees",
+       &ObstacleSpec::read_cylinder},
       {"elevator",
        "a moving platform: center, size_x, size_z, thickness, mass, motion (phases or \"seed\")",
        &ElevatorSpec::read},
       {"plane", "a fixed plane: point, normal", &PlaneSpec::read},
       {"slope", "a fixed plane tilted about z: angle_degrees, point", &SlopeSpec::read},
+      {"sphere", "a sphere obstacle: center, radius, motion, angular_velocity_degrees",
+       &ObstacleSpec::read_sphere},
   };
   return kinds;
 }

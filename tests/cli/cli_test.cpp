@@ -14,8 +14,8 @@
 
 #include <jelly/geometry/body_kinds.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/terrain/terrain_kinds.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
+#include <jelly/terrain/terrain_kinds.hpp>
 
 #include "cli/cli_support.hpp"
 
@@ -142,6 +142,28 @@ TEST(Cli, BadOptionsExitTwoNamingTheJsonPath) {
   r = jelly("run " + kSmallSlope + " --set cube.n");
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, StartsWith("error: --set 'cube.n': expected path=value"));
+}
+
+// Obstacles: a bad radius exits 2 naming the field; a good one runs.
+TEST(Cli, ObstacleKindsRunAndNameTheirBadFields) {
+  const std::string path = write_scene(R"({
+    "cube": {"n": 3, "edge_length": 1, "origin": [-0.5, 1.2, -0.5]},
+    "terrains": [{"kind": "plane"}, {"kind": "sphere", "center": [0, 0.5, 0], "radius": 0.5},
+                 {"kind": "box", "center": [2, 0, 0], "size": [1, 1, 1],
+                  "motion": {"kind": "oscillation", "amplitude": [0, 0.2, 0], "frequency": 1}},
+                 {"kind": "capsule", "center": [-2, 0, 0], "radius": 0.2, "height": 1},
+                 {"kind": "cylinder", "center": [0, 0, 2], "radius": 0.2, "height": 1,
+                  "angular_velocity_degrees": [0, 90, 0]}],
+    "integrator": {"name": "rk4", "dt": 0.001},
+    "duration": 0.3})");
+  Result r = jelly("run '" + path + "' --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+  r = jelly("run '" + path + "' --set terrains[1].radius=-1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: terrains[1].radius = -1 is invalid: a finite radius > 0 (m)\n");
+  r = jelly("run '" + path + "' --set terrains[2].size=[1,0,1]");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: terrains[2].size = "));
 }
 
 TEST(Cli, CommandLineParseErrorsExitTwo) {

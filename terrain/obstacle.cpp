@@ -1,0 +1,259 @@
+#include <jelly/terrain/obstacle.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/geometry/pose.hpp>
+
+namespace jelly {
+
+namespace {
+
+constexpr Real kDegree = M_PI / 180;
+
+Real sign_of(Real x) { return x < 0 ? -1.0 : 1.0; }
+
+// The 2-D rounded-box distance of (a, b) from the rectangle |a| <= ea, |b| <= eb (a, b >= 0 are
+// the absolute coordinates), with the weights of its gradient along a and b.
+Real rectangle_distance(Real a, Real b, Real ea, Real eb, Real& ga, Real& gb) {
+  const Real da = a - ea, db = b - eb;
+  if (da > 0 || db > 0) {
+    const Real pa = std::max(da, 0.0), pb = std::max(db, 0.0);
+    const Real d = std::hypot(pa, pb);
+    ga = pa / d;
+    gb = pb / d;
+    return d;
+  }
+  ga = da >= db ? 1.0 : 0.0;
+  gb = 1.0 - ga;
+  return std::max(da, db);
+}
+
+}  // namespace
+
+std::string_view obstacle_shape_name(ObstacleShape shape) {
+  switch (shape) {
+    case ObstacleShape::kSphere:
+      return "sphere";
+    case ObstacleShape::kBox:
+      return "box";
+    case ObstacleShape::kCapsule:
+      return "capsule";
+    case ObstacleShape::kCylinder:
+      return "cylinder";
+  }
+  return "?";
+}
+
+Real ObstacleGeometry::distance(const Vec3& q) const {
+  switch (shape) {
+    case ObstacleShape::kSphere:
+      return q.norm() - radius;
+    case ObstacleShape::kBox: {
+      const Vec3 d = q.cwiseAbs() - 0.5 * size;
+      return d.cwiseMax(0.0).norm() + std::min(d.maxCoeff(), 0.0);
+    }
+    case ObstacleShape::kCapsule: {
+      const Real y = std::clamp(q.y(), -0.5 * height, 0.5 * height);
+      return (q - Vec3(0, y, 0)).norm() - radius;
+    }
+    case ObstacleShape::kCylinder: {
+      Real ga, gb;
+      return rectangle_distance(std::hypot(q.x(), q.z()), std::abs(q.y()), radius, 0.5 * height, ga,
+                                gb);
+    }
+  }
+  return 0;
+}
+
+Vec3 ObstacleGeometry::normal(const Vec3& q) const {
+  // The direction from the centre (or the axis) out through q; +y where it is undefined.
+  const auto outward = [](const Vec3& w) -> Vec3 {
+    const Real r = w.norm();
+    return r > 0 ? Vec3(w / r) : Vec3(Vec3::UnitY());
+  };
+  switch (shape) {
+    case ObstacleShape::kSphere:
+      return outward(q);
+    case ObstacleShape::kBox: {
+      const Vec3 d = q.cwiseAbs() - 0.5 * size;
+      if (d.maxCoeff() > 0) {
+        Vec3 n = d.cwiseMax(0.0);
+        for (int k = 0; k < 3; ++k) n[k] *= sign_of(q[k]);
+        return n.normalized();
+      }
+      int k;
+      d.maxCoeff(&k);
+      Vec3 n = Vec3::Zero();
+      n[k] = sign_of(q[k]);
+      return n;
+    }
+    case ObstacleShape::kCapsule: {
+      const Real y = std::clamp(q.y(), -0.5 * height, 0.5 * height);
+      const Vec3 w = q - Vec3(0, y, 0);
+      // On the axis of the cylindrical part: out along x.
+      return w.norm() > 0 ? outward(w) : Vec3(Vec3::UnitX());
+    }
+    case ObstacleShape::kCylinder: {
+      const Real rho = std::hypot(q.x(), q.z());
+      Real ga, gb;
+      rectangle_distance(rho, std::abs(q.y()), radius, 0.5 * height, ga, gb);
+      const Vec3 radial = rho > 0 ? Vec3(q.x() / rho, 0, q.z() / rho) : Vec3(Vec3::UnitX());
+      return (ga * radial + gb * sign_of(q.y()) * Vec3::UnitY()).normalized();
+    }
+  }
+  return Vec3::UnitY();
+}
+
+TriangleMesh ObstacleGeometry::mesh() const {
+  switch (shape) {
+    case ObstacleShape::kSphere:
+      return sphere_mesh(radius);
+    case ObstacleShape::kBox:
+      return box_mesh(size);
+    case ObstacleShape::kCapsule:
+      return capsule_mesh(radius, height);
+    case ObstacleShape::kCylinder:
+      return cylinder_mesh(radius, height);
+  }
+  return {};
+}
+
+void ObstacleSpec::validate(const std::string& prefix) const {
+  require(center.allFinite(), prefix + "center", center.transpose(), "finite coordinates");
+  require(rotation_degrees.allFinite(), prefix + "rotation_degrees", rotation_degrees.transpose(),
+          "finite angles (degrees)");
+  require(angular_velocity_degrees.allFinite(), prefix + "angular_velocity_degrees",
+          angular_velocity_degrees.transpose(), "finite rates (degrees per second)");
+  const ObstacleGeometry& g = geometry;
+  if (g.shape != ObstacleShape::kBox) {
+    require(std::isfinite(g.radius) && g.radius > 0, prefix + "radius", g.radius,
+            "a finite radius > 0 (m)");
+  } else {
+    require(g.size.allFinite() && g.size.minCoeff() > 0, prefix + "size", g.size.transpose(),
+            "three finite edge lengths > 0 (m)");
+  }
+  if (g.shape == ObstacleShape::kCylinder) {
+    require(std::isfinite(g.height) && g.height > 0, prefix + "height", g.height,
+            "a finite length > 0 (m)");
+  } else if (g.shape == ObstacleShape::kCapsule) {
+    require(std::isfinite(g.height) && g.height >= 0, prefix + "height", g.height,
+            "a finite length >= 0 between the caps (m)");
+  }
+}
+
+std::unique_ptr<Terrain> ObstacleSpec::make() const {
+  return std::make_unique<Obstacle>(*this, contact);
+}
+
+void ObstacleSpec::write(Json& j) const {
+  j["center"] = json_of(center);
+  switch (geometry.shape) {
+    case ObstacleShape::kSphere:
+      j["radius"] = geometry.radius;
+      break;
+    case ObstacleShape::kBox:
+      j["size"] = json_of(geometry.size);
+      break;
+    case ObstacleShape::kCapsule:
+    case ObstacleShape::kCylinder:
+      j["radius"] = geometry.radius;
+      j["height"] = geometry.height;
+      break;
+  }
+  j["rotation_degrees"] = json_of(rotation_degrees);
+  j["motion"] = motion.to_json();
+  j["angular_velocity_degrees"] = json_of(angular_velocity_degrees);
+}
+
+namespace {
+
+std::unique_ptr<TerrainSpec> read_obstacle(JsonFields& f, ObstacleShape shape) {
+  auto spec = std::make_unique<ObstacleSpec>();
+  ObstacleGeometry& g = spec->geometry;
+  g.shape = shape;
+  spec->center = f.vec3_or("center", spec->center);
+  switch (shape) {
+    case ObstacleShape::kSphere:
+      g.radius = f.number("radius");
+      break;
+    case ObstacleShape::kBox:
+      g.size = f.vec3_or("size", g.size);
+      break;
+    case ObstacleShape::kCapsule:
+    case ObstacleShape::kCylinder:
+      g.radius = f.number("radius");
+      g.height = f.number("height");
+      break;
+  }
+  spec->rotation_degrees = f.vec3_or("rotation_degrees", spec->rotation_degrees);
+  if (const Json* m = f.value("motion")) spec->motion = Path::read(*m, f.path("motion"));
+  spec->angular_velocity_degrees =
+      f.vec3_or("angular_velocity_degrees", spec->angular_velocity_degrees);
+  spec->validate(f.prefix());
+  return spec;
+}
+
+}  // namespace
+
+std::unique_ptr<TerrainSpec> ObstacleSpec::read_sphere(JsonFields& f) {
+  return read_obstacle(f, ObstacleShape::kSphere);
+}
+std::unique_ptr<TerrainSpec> ObstacleSpec::read_box(JsonFields& f) {
+  return read_obstacle(f, ObstacleShape::kBox);
+}
+std::unique_ptr<TerrainSpec> ObstacleSpec::read_capsule(JsonFields& f) {
+  return read_obstacle(f, ObstacleShape::kCapsule);
+}
+std::unique_ptr<TerrainSpec> ObstacleSpec::read_cylinder(JsonFields& f) {
+  return read_obstacle(f, ObstacleShape::kCylinder);
+}
+
+Obstacle::Obstacle(ObstacleSpec spec, ContactParams contact)
+    : Terrain(contact), spec_(std::move(spec)) {
+  spec_.validate("obstacle.");
+  contact.validate("contact.");
+  Pose pose;
+  pose.rotation_degrees = spec_.rotation_degrees;
+  rotation0_ = pose.rotation();
+  omega_ = spec_.angular_velocity_degrees * kDegree;
+}
+
+Eigen::Matrix3d Obstacle::rotation(Real t) const {
+  const Real angle = omega_.norm() * t;
+  if (angle == 0) return rotation0_;
+  return Eigen::AngleAxisd(angle, omega_.normalized()).toRotationMatrix() * rotation0_;
+}
+
+Vec3 Obstacle::position(Real t) const {
+  return spec_.motion.is_fixed() ? spec_.center
+                                 : Vec3(spec_.center + spec_.motion.sample(t).offset);
+}
+
+Real Obstacle::signed_distance(const Vec3& p, Real t) const {
+  return spec_.geometry.distance(rotation(t).transpose() * (p - position(t)));
+}
+
+Vec3 Obstacle::normal(const Vec3& p, Real t) const {
+  const Eigen::Matrix3d r = rotation(t);
+  return r * spec_.geometry.normal(r.transpose() * (p - position(t)));
+}
+
+Vec3 Obstacle::surface_velocity(const Vec3& p, Real t) const {
+  Vec3 u = spec_.motion.is_fixed() ? Vec3(Vec3::Zero()) : spec_.motion.sample(t).velocity;
+  if (omega_.squaredNorm() > 0) {
+    const Vec3 closest = p - signed_distance(p, t) * normal(p, t);
+    u += omega_.cross(closest - position(t));
+  }
+  return u;
+}
+
+Eigen::Isometry3d Obstacle::pose(Real t) const {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation(t);
+  pose.translation() = position(t);
+  return pose;
+}
+
+}  // namespace jelly
