@@ -31,7 +31,7 @@ namespace {
 using h5::check;
 using h5::Handle;
 
-constexpr long kLayoutVersion = 1;    // of /xdmf; a group of another version is rebuilt
+constexpr long kLayoutVersion = 2;    // of /xdmf; a group of another version is rebuilt
 constexpr hsize_t kBlockFrames = 32;  // frames read and derived at a time
 // Strain is stored to 5 decimals (HDF5 scale-offset, lossy: |error| < 1e-5, invisible in a
 // colour map), which halves its size; speed is stored as computed (float32).
@@ -214,6 +214,12 @@ struct RecordedBody {
   hsize_t first = 0, count = 0;  // its particles' global indices
   std::vector<hsize_t> springs;  // global indices of its springs (both ends are its particles)
   bool all_springs = false;      // first == 0 and it has every spring: /connectivity serves as is
+  // Its render surface (/particles/<name>/surface), when the recording holds one: vertex v is
+  // sum over k in [offsets[v], offsets[v+1]) of weights[k] * x[particles[k]] (body-local).
+  bool surface = false;
+  hsize_t surface_vertices = 0;
+  std::vector<int> offsets, particles;
+  std::vector<double> weights;
   std::string group() const { return "/particles/" + name; }
 };
 
@@ -254,6 +260,49 @@ hsize_t frames_of(hid_t file, const std::string& path) {
   return h5::dataset_dims(dataset.get()).at(0);
 }
 
+// The body's render surface, checked (a triangle naming a vertex that is not there would crash
+// ParaView's readers); none when the recording holds none (recordings made before surfaces).
+void read_surface(hid_t file, const std::string& h5_path, RecordedBody& body) {
+  const std::string g = body.group() + "/surface";
+  if (!h5::exists(file, g + "/triangles") || !h5::exists(file, g + "/position/value")) return;
+  const auto bad = [&](const std::string& why) { not_a_recording(h5_path, g + ": " + why); };
+  std::vector<hsize_t> triangle_dims, position_dims;
+  const std::vector<int> triangles = h5::read_ints(file, g + "/triangles", &triangle_dims);
+  {
+    Handle position = h5::open_dataset(file, g + "/position/value");
+    position_dims = h5::dataset_dims(position.get());
+  }
+  if (triangle_dims.size() != 2 || triangle_dims[1] != 3) bad("triangles is not [F][3]");
+  if (position_dims.size() != 3 || position_dims[2] != 3) bad("position/value is not [T][V][3]");
+  const hsize_t v = position_dims[1];
+  if (triangle_dims[0] == 0 || v == 0) return;  // nothing to draw
+  for (const int t : triangles) {
+    if (t < 0 || static_cast<hsize_t>(t) >= v) {
+      bad("triangles names vertex " + std::to_string(t) + " of " + std::to_string(v));
+    }
+  }
+  body.offsets = h5::read_ints(file, g + "/vertex_offsets");
+  body.particles = h5::read_ints(file, g + "/vertex_particles");
+  body.weights = h5::read_doubles(file, g + "/vertex_weights");
+  if (body.offsets.size() != v + 1 || body.offsets.front() != 0 ||
+      body.offsets.back() != static_cast<int>(body.particles.size()) ||
+      body.weights.size() != body.particles.size()) {
+    bad("vertex_offsets, vertex_particles and vertex_weights do not describe " + std::to_string(v) +
+        " vertices");
+  }
+  for (size_t k = 0; k + 1 < body.offsets.size(); ++k) {
+    if (body.offsets[k] > body.offsets[k + 1]) bad("vertex_offsets decrease");
+  }
+  for (const int p : body.particles) {
+    if (p < 0 || static_cast<hsize_t>(p) >= body.count) {
+      bad("vertex_particles names particle " + std::to_string(p) + " of " +
+          std::to_string(body.count));
+    }
+  }
+  body.surface = true;
+  body.surface_vertices = v;
+}
+
 Recording inspect(hid_t file, const std::string& h5_path) {
   Recording r;
   const size_t slash = h5_path.find_last_of('/');
@@ -282,6 +331,7 @@ Recording inspect(hid_t file, const std::string& h5_path) {
               ? static_cast<hsize_t>(h5::read_long_attribute(group.get(), "first_particle"))
               : next;
       next = body.first + body.count;
+      read_surface(file, h5_path, body);
       r.bodies.push_back(std::move(body));
     }
   }
@@ -296,6 +346,9 @@ Recording inspect(hid_t file, const std::string& h5_path) {
   for (const RecordedBody& body : r.bodies) {
     r.frames = std::min({r.frames, frames_of(file, body.group() + "/position/value"),
                          frames_of(file, body.group() + "/velocity/value")});
+    if (body.surface) {
+      r.frames = std::min(r.frames, frames_of(file, body.group() + "/surface/position/value"));
+    }
   }
 
   // Springs: each belongs to the body that holds its first particle.
@@ -398,7 +451,10 @@ Recording inspect(hid_t file, const std::string& h5_path) {
 // /xdmf: views and derived arrays
 
 std::string body_path(const RecordedBody& body) { return "/xdmf/particles/" + body.name; }
+// The block of a body's surface beside the block of its particles and springs.
+std::string surface_grid_name(const RecordedBody& body) { return body.name + " surface"; }
 std::string terrain_path(const TerrainInfo& t) { return "/xdmf/terrain/" + t.name; }
+std::string surface_path(const RecordedBody& body) { return body_path(body) + "/surface"; }
 
 struct Bounds {
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
@@ -518,6 +574,47 @@ void update_body(hid_t file, const Recording& r, const RecordedBody& body, hsize
     create_view(velocity_views.get(), name, velocity.get(), velocity_path, f);
     create_view(speed_views.get(), name, speed.get(), own + "/speed", f);
     if (options.strain) create_view(strain_views.get(), name, strain.get(), own + "/strain", f);
+  }
+}
+
+// The speed of every surface vertex for the frames not derived yet (|sum of weights times the
+// velocities of its particles|), and the views of every new frame.
+void update_surface(hid_t file, const Recording& r, const RecordedBody& body,
+                    hsize_t first_new_view, const XdmfOptions& options) {
+  if (!body.surface) return;
+  Handle group = open_or_create_group(file, surface_path(body));
+  const hsize_t n = body.count, vertices = body.surface_vertices;
+  const std::string position_path = body.group() + "/surface/position/value";
+  Handle position = h5::open_dataset(file, position_path);
+  Handle velocity = h5::open_dataset(file, body.group() + "/velocity/value");
+  Handle speed =
+      series(group.get(), "speed", H5T_IEEE_F32LE, {vertices}, options.compression_level);
+  const hsize_t done = std::min(r.frames, h5::dataset_dims(speed.get())[0]);
+  std::vector<float> rows;
+  for (hsize_t f0 = done; f0 < r.frames; f0 += kBlockFrames) {
+    const hsize_t count = std::min(kBlockFrames, r.frames - f0);
+    const std::vector<double> v = read_rows<double>(velocity.get(), f0, count, H5T_NATIVE_DOUBLE);
+    rows.assign(count * vertices, 0.0f);
+    for (hsize_t f = 0; f < count; ++f) {
+      const double* vf = v.data() + 3 * n * f;
+      for (hsize_t i = 0; i < vertices; ++i) {
+        Vec3 u = Vec3::Zero();
+        for (int k = body.offsets[i]; k < body.offsets[i + 1]; ++k) {
+          const double* p = vf + 3 * body.particles[k];
+          u += body.weights[k] * Vec3(p[0], p[1], p[2]);
+        }
+        rows[f * vertices + i] = static_cast<float>(u.norm());
+      }
+    }
+    write_rows(speed.get(), f0, count, H5T_NATIVE_FLOAT, rows.data());
+  }
+  Handle frame = open_or_create_group(group.get(), "frame");
+  Handle position_views = open_or_create_group(frame.get(), "position");
+  Handle speed_views = open_or_create_group(frame.get(), "speed");
+  for (hsize_t f = first_new_view; f < r.frames; ++f) {
+    const std::string name = std::to_string(f);
+    create_view(position_views.get(), name, position.get(), position_path, f);
+    create_view(speed_views.get(), name, speed.get(), surface_path(body) + "/speed", f);
   }
 }
 
@@ -781,6 +878,31 @@ void body_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody& b
   out << "    </Grid>\n";
 }
 
+// The body's render surface: its triangles over the recorded vertex positions, frame by frame.
+void surface_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody& body) {
+  const std::string own = surface_path(body);
+  const Item triangles = item_of(file, body.group() + "/surface/triangles");
+  const std::string faces = triangles.dims.substr(0, triangles.dims.find(' '));
+  Item xyz = item_of(file, body.group() + "/surface/position/value");
+  xyz.dims = std::to_string(body.surface_vertices) + " 3";
+  const Item speed = float32_item(body.surface_vertices);
+  const std::string name = xml_escape(surface_grid_name(body));
+  auto& out = w.out();
+  out << "    <Grid Name=\"" << name << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (hsize_t f = 0; f < r.frames; ++f) {
+    out << "      <Grid Name=\"" << name << "\" GridType=\"Uniform\">\n"
+        << "        <Time Value=\"" << r.time[f] << "\"/>\n"
+        << "        <Topology TopologyType=\"Triangle\" NumberOfElements=\"" << faces << "\">\n";
+    w.data_item(triangles, 10);
+    out << "        </Topology>\n        <Geometry GeometryType=\"XYZ\">\n";
+    w.data_item(frame_item(xyz, own + "/frame/position", f), 10);
+    out << "        </Geometry>\n";
+    w.attribute("speed", "Scalar", "Node", frame_item(speed, own + "/frame/speed", f));
+    out << "      </Grid>\n";
+  }
+  out << "    </Grid>\n";
+}
+
 void terrain_grids(Writer& w, hid_t file, const Recording& r, const TerrainInfo& t) {
   const std::string own = terrain_path(t);
   const Item triangles = item_of(file, own + "/triangles");
@@ -846,7 +968,10 @@ std::string update_xdmf(hid_t file, const std::string& h5_path, const XdmfOption
     }
   }
   open_or_create_group(root.get(), "particles");
-  for (const RecordedBody& body : r.bodies) update_body(file, r, body, viewed, options, bounds);
+  for (const RecordedBody& body : r.bodies) {
+    update_body(file, r, body, viewed, options, bounds);
+    update_surface(file, r, body, viewed, options);
+  }
   if (!bounds.empty()) {
     h5::write_attribute(root.get(), "bounds",
                         std::vector<double>{bounds.lo.x(), bounds.lo.y(), bounds.lo.z(),
@@ -862,6 +987,7 @@ std::string update_xdmf(hid_t file, const std::string& h5_path, const XdmfOption
   w.out() << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n";
   for (size_t b = 0; b < r.bodies.size(); ++b) {
     body_grids(w, file, r, r.bodies[b], b == 0, options);
+    if (r.bodies[b].surface) surface_grids(w, file, r, r.bodies[b]);
   }
   for (const TerrainInfo* t : drawn) terrain_grids(w, file, r, *t);
   w.out() << "  </Domain>\n</Xdmf>\n";

@@ -7,8 +7,11 @@
 // gets "None" and drops it), and the XDMF Reader reports an error for any Geometry whose first
 // DataItem has no text of its own, so every DataItem of the sidecar names one whole HDF5
 // dataset. What the recording does not hold in that form is written into it, under /xdmf: one
-// HDF5 virtual dataset per frame viewing that frame of /particles/<body>/position/value (no
-// copy), the derived arrays (speed per particle, strain per spring) and the terrain meshes.
+// HDF5 virtual dataset per frame viewing that frame of /particles/<body>/position/value and of
+// /particles/<body>/surface/position/value (no copy), the derived arrays (speed per particle and
+// per surface vertex, strain per spring) and the terrain meshes. Each body is a block of its
+// particles and springs, followed by a block of its render surface when it has one; then come
+// the terrains.
 // docs/output.md describes the sidecar and the /xdmf group.
 #include <string>
 

@@ -4,10 +4,13 @@ from tests/io/paraview_test.py).
 For each RECORDING.xdmf (its .h5 beside it):
   * the default reader (what the GUI preselects and OpenDataFile picks; Xdmf3ReaderS in ParaView
     5.11): one time step per frame at the recorded times; in every frame one block per body
-    (points = the recorded positions bit for bit, one cell per spring, velocity bit for bit)
-    and one per terrain (the plane's quad in its plane, the elevator's box at its recorded
-    height); in three frames every array (speed, strain, mass, rest_length, ks, kd, spring type,
-    the observables as field data) against values computed from the HDF5 file;
+    (points = the recorded positions bit for bit, one cell per spring, velocity bit for bit),
+    one per body's render surface (points = the recorded surface vertices bit for bit, one
+    triangle per recorded triangle) and one per terrain (the plane's quad in its plane, the
+    elevator's box at its recorded height); in three frames every array (speed, strain, mass,
+    rest_length, ks, kd, spring type, the observables as field data; the surface's vertices as
+    the weighted sums of the particles, its triangles and speed) against values computed from
+    the HDF5 file;
   * Xdmf3ReaderT and the XDMF Reader: time steps, blocks, points and cells of three frames.
 With --screenshot PNG: shows the first recording as ParaView shows it by default (colour by speed
 is checked) at its frame of largest elastic energy and saves a screenshot (needs a display:
@@ -18,6 +21,7 @@ Prints "paraview_check: ..." lines; exit status 1 if a check failed.
 import argparse
 import os
 import sys
+import time
 
 import h5py
 import numpy as np
@@ -51,6 +55,7 @@ class Recording:
                     "x": group["position/value"][:],
                     "v": group["velocity/value"][:],
                     "mass": group["mass"][:],
+                    "surface": self.read_surface(group),
                 })
             next_first = 0
             for body in bodies:  # without first_particle the bodies follow one another by name
@@ -71,7 +76,8 @@ class Recording:
                                       "mesh": g["mesh/vertices"][:] if "mesh" in g else None})
         self.terrains.sort(key=lambda t: int(t["name"].split("_")[0]))
         frames = [len(self.time)] + [len(b["x"]) for b in self.bodies] + [
-            len(b["v"]) for b in self.bodies]
+            len(b["v"]) for b in self.bodies] + [
+            len(b["surface"]["x"]) for b in self.bodies if b["surface"] is not None]
         self.frames = min(frames)
         for body in self.bodies:
             n = len(body["mass"])
@@ -79,6 +85,23 @@ class Recording:
             body["springs"] = springs[mine] - body["first"]
             body["rest_length"], body["ks"], body["kd"], body["type"] = (
                 rest[mine], ks[mine], kd[mine], kind[mine])
+
+    @staticmethod
+    def read_surface(group):
+        """The body's render surface (None when the recording holds none)."""
+        if "surface" not in group:
+            return None
+        s = group["surface"]
+        return {"triangles": s["triangles"][:], "x": s["position/value"][:],
+                "offsets": s["vertex_offsets"][:], "particles": s["vertex_particles"][:],
+                "weights": s["vertex_weights"][:]}
+
+    @staticmethod
+    def blend(surface, values):
+        """Per vertex: sum of weights times `values` of its particles ([N][3] -> [V][3])."""
+        o = surface["offsets"]
+        terms = surface["weights"][:, None] * values[surface["particles"]]
+        return np.add.reduceat(terms, o[:-1], axis=0) if len(terms) else terms
 
     def strain(self, body, k):
         x = body["x"][k]
@@ -139,11 +162,43 @@ def check_body(tag, rec, body, data, k, every_array):
         check(values is not None and np.array_equal(values, body[key]), f"{tag}: {name} differs")
     ids = vtk_to_numpy(data.GetCells().GetConnectivityArray()).reshape(-1, 2)
     check(np.array_equal(ids, body["springs"]), f"{tag}: cells are not the springs")
+    if body is not rec.bodies[0]:  # the observables (of the whole model) are the first body's
+        return
     fd = data.GetFieldData()
     for name, values in rec.observables.items():
         a = array(fd, name)
         check(a is not None and np.array_equal(a.reshape(-1), np.atleast_1d(values[k])),
               f"{tag}: field data {name} differs from /observables/{name}")
+
+
+def check_surface(tag, rec, body, data, k, every_array):
+    """A body's render surface: the recorded vertex positions as points, its triangles."""
+    s = body["surface"]
+    v, f = len(s["offsets"]) - 1, len(s["triangles"])
+    check(data.GetNumberOfPoints() == v and data.GetNumberOfCells() == f,
+          f"{tag}: {data.GetNumberOfPoints()} points, {data.GetNumberOfCells()} cells; "
+          f"expected {v} vertices, {f} triangles")
+    if data.GetNumberOfPoints() != v:
+        return
+    points = vtk_to_numpy(data.GetPoints().GetData())
+    check(np.array_equal(points, s["x"][k]),
+          f"{tag}: points differ from the recorded surface/position/value")
+    if not every_array:
+        return
+    # The recorded vertices are what the surface's weights make of the recorded particles.
+    check(np.allclose(points, rec.blend(s, body["x"][k]), rtol=0, atol=1e-12),
+          f"{tag}: points are not the weighted sums of the particle positions")
+    check(all(data.GetCellType(c) == 5 for c in range(data.GetNumberOfCells())),
+          f"{tag}: cells are not all triangles")
+    ids = vtk_to_numpy(data.GetCells().GetConnectivityArray()).reshape(-1, 3)
+    check(np.array_equal(ids, s["triangles"]), f"{tag}: cells are not the surface's triangles")
+    speed = array(data.GetPointData(), "speed")
+    expected = np.linalg.norm(rec.blend(s, body["v"][k]), axis=1)
+    check(speed is not None and np.allclose(speed, expected, rtol=1e-6, atol=1e-6),
+          f"{tag}: speed is not |the weighted sum of the particle velocities|")
+    check(data.GetPointData().GetScalars() is not None and
+          data.GetPointData().GetScalars().GetName() == "speed",
+          f"{tag}: the active point scalars are not speed")
 
 
 def check_terrain(tag, terrain, data, k):
@@ -169,15 +224,24 @@ def check_terrain(tag, terrain, data, k):
 
 
 def check_blocks(tag, rec, blocks, k, every_array=False, names=False):
-    expected = len(rec.bodies) + len(rec.terrains)
-    if not check(len(blocks) == expected, f"{tag} frame {k}: {len(blocks)} blocks, "
-                 f"expected {expected} (bodies, then terrains)"):
+    # Each body (particles and springs), then its surface when it has one; then the terrains.
+    expected = []
+    for body in rec.bodies:
+        expected.append((body["name"], body, False))
+        if body["surface"] is not None:
+            expected.append((body["name"] + " surface", body, True))
+    if not check(len(blocks) == len(expected) + len(rec.terrains),
+                 f"{tag} frame {k}: {len(blocks)} blocks, expected {len(expected)} for the "
+                 f"bodies and their surfaces, then {len(rec.terrains)} terrains"):
         return
-    for body, (name, data) in zip(rec.bodies, blocks):
+    for (block, body, surface), (name, data) in zip(expected, blocks):
         if names:
-            check(name == body["name"], f"{tag}: block named {name}, expected {body['name']}")
-        check_body(f"{tag} frame {k} {body['name']}", rec, body, data, k, every_array)
-    for terrain, (name, data) in zip(rec.terrains, blocks[len(rec.bodies):]):
+            check(name == block, f"{tag}: block named {name}, expected {block}")
+        if surface:
+            check_surface(f"{tag} frame {k} {block}", rec, body, data, k, every_array)
+        else:
+            check_body(f"{tag} frame {k} {block}", rec, body, data, k, every_array)
+    for terrain, (name, data) in zip(rec.terrains, blocks[len(expected):]):
         if names:
             check(name == terrain["name"], f"{tag}: block named {name}, expected {terrain['name']}")
         check_terrain(f"{tag} frame {k} {terrain['name']}", terrain, data, k)
@@ -188,6 +252,7 @@ def check_recording(xdmf):
     rec = Recording(h5)
     label = os.path.basename(xdmf)
     some = sorted({0, rec.frames // 2, rec.frames - 1})
+    start = time.monotonic()
 
     reader = simple.OpenDataFile(xdmf)
     check(reader is not None and reader.GetXMLName() == "Xdmf3ReaderS",
@@ -216,6 +281,9 @@ def check_recording(xdmf):
                          names=name == "XDMF Reader")
         say(f"{label}: {name}: {len(reader.TimestepValues)} time steps, frames {some} checked")
         simple.Delete(reader)
+    say(f"{label}: {len(rec.bodies)} bodies, "
+        f"{sum(b['surface'] is not None for b in rec.bodies)} surfaces, {len(rec.terrains)} "
+        f"terrains, {rec.frames} frames checked in {time.monotonic() - start:.1f} s")
     return rec
 
 
@@ -260,8 +328,12 @@ def screenshot(xdmf, rec, png):
     simple.Render(view)  # the first render resets the camera: place it after
     com = rec.observables["center_of_mass"][k] if "center_of_mass" in rec.observables else \
         rec.bodies[0]["x"][k].mean(axis=0)
+    # From the front right, above, at three times the diagonal of the bodies' box.
+    x = np.concatenate([b["x"][k] for b in rec.bodies])
+    away = np.array([8.0, 6.0, 18.0])
+    away *= 3 * np.linalg.norm(np.ptp(x, axis=0)) / np.linalg.norm(away)
     view.CameraFocalPoint = list(com)
-    view.CameraPosition = list(com + np.array([8.0, 6.0, 18.0]))
+    view.CameraPosition = list(com + away)
     view.CameraViewUp = [0, 1, 0]
     text = simple.Text(Text=f"{os.path.basename(xdmf)}   t = {rec.time[k]:.2f} s   "
                             "(default reader, colour by speed)")

@@ -1,4 +1,5 @@
-"""The ParaView test (ctest jelly_paraview): records each seed scene with the jelly program and
+"""The ParaView test (ctest jelly_paraview): records each seed scene and two scenes of several
+bodies (two cubes; a cloth, whose surface is its own) with the jelly program and
 checks the recordings in Debian's ParaView (tests/io/paraview_check.py under pvpython, in a
 virtual X server for the screenshot). Exit status 77 (ctest: skipped) when pvpython is absent.
 
@@ -15,8 +16,10 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = os.path.join(HERE, "..", "..", "scenes")
-# Each seed scene, long enough to see its impact (and kept short: every frame is compared).
-RUNS = [("seed_slope", 1.5), ("seed_elevator", 1.5), ("drop_coulomb", 1.2)]
+# Each seed scene, long enough to see its impact, and scenes of several bodies and surfaces (kept
+# short: every frame is compared).
+RUNS = [("two_jellies", 1.0), ("seed_slope", 1.5), ("seed_elevator", 1.5), ("drop_coulomb", 1.2),
+        ("hanging_cloth", 0.5)]
 # What a reader says when it cannot read something: the sidecar must not cause any of these.
 COMPLAINT = re.compile(r"ERR\||WARN\||error|warning|skipping|HDF5-DIAG|cannot|failed", re.I)
 # What says that the X server, not ParaView, failed (then the check runs again on another display).

@@ -15,6 +15,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/io/h5_recorder.hpp>
+#include <jelly/io/scene.hpp>
 #include <jelly/io/xdmf.hpp>
 #include <jelly/terrain/elevator.hpp>
 
@@ -85,15 +86,18 @@ TEST(Xdmf, EveryDataItemNamesAWholeDatasetOfTheRecording) {
   // No HyperSlab or Function items: VTK's Xdmf3 readers read none of them.
   EXPECT_EQ(text.find("HyperSlab"), std::string::npos);
   EXPECT_EQ(text.find("Function"), std::string::npos);
-  // One temporal collection per body and per terrain, 26 frames each.
+  // One temporal collection per body, per body's surface and per terrain, 26 frames each.
   EXPECT_NE(text.find(R"(<Grid Name="jelly" GridType="Collection" CollectionType="Temporal">)"),
             std::string::npos);
+  EXPECT_NE(
+      text.find(R"(<Grid Name="jelly surface" GridType="Collection" CollectionType="Temporal">)"),
+      std::string::npos);
   EXPECT_NE(text.find(R"(<Grid Name="0_plane" GridType="Collection" CollectionType="Temporal">)"),
             std::string::npos);
   size_t times = 0;
   for (size_t at = text.find("<Time "); at != std::string::npos; at = text.find("<Time ", at + 1))
     ++times;
-  EXPECT_EQ(times, 2u * 26);
+  EXPECT_EQ(times, 3u * 26);
 
   const std::vector<Item> items = hdf_items(text);
   ASSERT_GT(items.size(), 26u * 10);
@@ -256,7 +260,8 @@ TEST(Xdmf, SameSidecarInPartsOrFromTheFileAlone) {
   const hid_t a = H5Fopen(whole.file("run.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   const hid_t b = H5Fopen(parts.file("run.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   for (const char* dataset :
-       {"/xdmf/particles/jelly/speed", "/xdmf/particles/jelly/frame/position/25"}) {
+       {"/xdmf/particles/jelly/speed", "/xdmf/particles/jelly/frame/position/25",
+        "/xdmf/particles/jelly/surface/speed", "/xdmf/particles/jelly/surface/frame/position/25"}) {
     EXPECT_EQ(read(a, dataset), read(b, dataset)) << dataset;
   }
   const std::vector<double> strain_a = read(a, "/xdmf/particles/jelly/strain");
@@ -265,6 +270,72 @@ TEST(Xdmf, SameSidecarInPartsOrFromTheFileAlone) {
   for (size_t i = 0; i < strain_a.size(); ++i) ASSERT_NEAR(strain_a[i], strain_b[i], 2e-5) << i;
   H5Fclose(a);
   H5Fclose(b);
+}
+
+// Several bodies: each is a block of particles and springs followed by a block of its render
+// surface, whose per-frame vertices are the recorded ones and whose speed is that of the
+// vertices (the weighted sums of the particle velocities).
+TEST(Xdmf, EachBodyAndItsSurfaceAreBlocks) {
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  const Scene scene = parse_scene(R"({
+    "bodies": [
+      {"kind": "cube", "name": "jelly", "n": 3, "edge_length": 0.6, "origin": [-1.5, 0.5, -0.3]},
+      {"kind": "cloth", "name": "flag", "nu": 5, "nv": 4, "size_u": 1, "size_v": 0.8,
+       "position": [0, 1.5, 0], "particle_mass": 0.5, "pins": [{"group": "corner_00"}]}
+    ],
+    "terrains": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0],
+                  "contact": {"model": "coulomb", "restitution": 0.4, "friction": 0.3}}],
+    "integrator": {"name": "rk4", "dt": 0.001}, "duration": 1, "output_interval": 0.02})");
+  Model model;
+  {
+    Simulator sim = make_simulator(scene);
+    model = sim.model();
+    H5Recorder recorder(path, sim, {});
+    sim.add_observer(recorder);
+    ASSERT_TRUE(sim.run_until(0.3).ok());
+  }
+  ASSERT_EQ(model.bodies.size(), 2u);
+  const std::string text = read_text(dir.file("run.xdmf"));
+  std::vector<std::string> blocks;
+  static const std::regex collection(R"re(<Grid Name="([^"]+)" GridType="Collection")re");
+  for (std::sregex_iterator it(text.begin(), text.end(), collection), end; it != end; ++it)
+    blocks.push_back((*it)[1]);
+  EXPECT_EQ(blocks, (std::vector<std::string>{"jelly", "jelly surface", "flag", "flag surface",
+                                              "0_plane"}));
+  EXPECT_NE(text.find(R"(<Topology TopologyType="Triangle" NumberOfElements=")" +
+                      std::to_string(model.bodies[1].surface.num_triangles()) + "\">"),
+            std::string::npos);
+
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  for (const Body& body : model.bodies) {
+    const std::string g = "/particles/" + body.name, x = "/xdmf" + g + "/surface";
+    std::vector<hsize_t> dims;
+    const std::vector<double> recorded = read(file, g + "/surface/position/value", &dims);
+    const std::vector<double> v = read(file, g + "/velocity/value");
+    const hsize_t frames = dims.at(0), V = dims.at(1), N = body.num_particles;
+    ASSERT_EQ(frames, 16u);
+    ASSERT_EQ(V, static_cast<hsize_t>(body.surface.num_vertices()));
+    for (hsize_t f : {hsize_t{0}, hsize_t{7}, frames - 1}) {
+      const std::string k = std::to_string(f);
+      EXPECT_EQ(
+          read(file, x + "/frame/position/" + k),
+          std::vector<double>(recorded.begin() + 3 * V * f, recorded.begin() + 3 * V * (f + 1)))
+          << body.name << " frame " << f;
+      // The vertex velocities from the body's particle velocities (global indices).
+      VecX vf = VecX::Zero(3 * model.num_particles());
+      for (hsize_t i = 0; i < 3 * N; ++i) vf[3 * body.first_particle + i] = v[3 * N * f + i];
+      const std::vector<double> speed = read(file, x + "/frame/speed/" + k);
+      ASSERT_EQ(speed.size(), V);
+      for (hsize_t i = 0; i < V; ++i) {
+        const double s = body.surface.vertex(vf, static_cast<int>(i)).norm();
+        EXPECT_NEAR(speed[i], s, 1e-6 * (1 + s)) << body.name << " frame " << f << " vertex " << i;
+      }
+      if (f == frames - 1) EXPECT_GT(*std::max_element(speed.begin(), speed.end()), 0.5);
+    }
+  }
+  H5Fclose(file);
 }
 
 TEST(Xdmf, WithoutStrain) {
