@@ -84,7 +84,8 @@ struct Batch {
   hsize_t frames = 0;
   std::vector<long> step;
   std::vector<double> time, position, velocity;
-  std::vector<std::vector<double>> terrain;  // per terrain, 3 per frame
+  std::vector<std::vector<double>> terrain;   // per terrain, 3 per frame
+  std::vector<std::vector<double>> rotation;  // per terrain, 9 per frame (row-major)
   bool has_checkpoint = false;
   SimulatorSnapshot checkpoint;
 
@@ -95,6 +96,7 @@ struct Batch {
     position.clear();
     velocity.clear();
     for (auto& t : terrain) t.clear();
+    for (auto& r : rotation) r.clear();
     has_checkpoint = false;
   }
 };
@@ -111,7 +113,7 @@ hsize_t chunk_frames(size_t values, int flush_every) {
   return 1;
 }
 
-// The small series (clock, observables, terrain: 1 or 3 numbers a frame) are stored
+// The small series (clock, observables, terrain: 1, 3 or 9 numbers a frame) are stored
 // uncompressed in chunks of this many frames: a chunk is allocated once and then filled in place,
 // flush after flush, instead of a new tiny compressed chunk per flush.
 constexpr hsize_t kSmallSeriesChunk = 256;
@@ -181,7 +183,7 @@ struct H5Recorder::Impl {
     std::vector<double> position_work, velocity_work, surface_work;
   };
   std::vector<BodySeries> bodies;
-  std::vector<h5::Series> observables, terrains;
+  std::vector<h5::Series> observables, terrains, terrain_rotations;
   std::unique_ptr<h5::CheckpointWriter> checkpoint;
   long frames_received = 0;
 
@@ -239,6 +241,7 @@ H5Recorder::Impl::Impl(const std::string& p, const Simulator& sim, RecorderOptio
       bodies.clear();
       observables.clear();
       terrains.clear();
+      terrain_rotations.clear();
       checkpoint.reset();
       file.reset();
       std::remove(write_path.c_str());
@@ -247,6 +250,7 @@ H5Recorder::Impl::Impl(const std::string& p, const Simulator& sim, RecorderOptio
   }
   current = take_spare();
   current->terrain.resize(terrains.size());
+  current->rotation.resize(terrains.size());
   if (options.background_writer) writer = std::thread([this] { writer_loop(); });
 }
 
@@ -404,8 +408,8 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
         h5::write_attribute(t.get(), name, value);
       }
       {
-        // Its shape for drawing, in its own frame, moved at each frame by the recorded position
-        // (a translation: no recorded terrain rotates yet).
+        // Its shape for drawing, in its own frame, placed at each frame by the recorded rotation
+        // and position (Terrain::pose(t)): a vertex v is at rotation * v + position.
         const TriangleMesh mesh = terrain.render_mesh();
         h5::Handle mg = h5::create_group(t.get(), "mesh");
         const hsize_t V = static_cast<hsize_t>(mesh.num_vertices());
@@ -423,6 +427,10 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       link_clock(pos.get());
       terrains.emplace_back(pos.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
                             std::vector<hsize_t>{3}, kSmallSeriesChunk, 0);
+      h5::Handle rot = h5::create_group(t.get(), "rotation");
+      link_clock(rot.get());
+      terrain_rotations.emplace_back(rot.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                                     std::vector<hsize_t>{3, 3}, kSmallSeriesChunk, 0);
     }
   }
 
@@ -479,8 +487,10 @@ void H5Recorder::Impl::write_batch(Batch& batch) {
     }
     for (size_t k = 0; k < specs.size(); ++k)
       observables[k].append(observable_work[k].data(), frames);
-    for (size_t i = 0; i < terrains.size(); ++i)
+    for (size_t i = 0; i < terrains.size(); ++i) {
       terrains[i].append(batch.terrain[i].data(), frames);
+      terrain_rotations[i].append(batch.rotation[i].data(), frames);
+    }
   }
   if (batch.has_checkpoint) checkpoint->write(batch.checkpoint);
   h5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + path);
@@ -519,6 +529,7 @@ std::unique_ptr<Batch> H5Recorder::Impl::take_spare() {
   if (spare.empty()) {
     auto batch = std::make_unique<Batch>();
     batch->terrain.resize(terrains.size());
+    batch->rotation.resize(terrains.size());
     return batch;
   }
   std::unique_ptr<Batch> batch = std::move(spare.front());
@@ -592,8 +603,11 @@ void H5Recorder::on_frame(const Simulator& sim) {
   b.position.insert(b.position.end(), s.x.data(), s.x.data() + s.x.size());
   b.velocity.insert(b.velocity.end(), s.v.data(), s.v.data() + s.v.size());
   for (size_t i = 0; i < m.terrains.size(); ++i) {
-    const Vec3 p = sim.terrains()[i]->position(s.t);
+    const Terrain& terrain = *sim.terrains()[i];
+    const Vec3 p = terrain.position(s.t);
     b.terrain[i].insert(b.terrain[i].end(), p.data(), p.data() + 3);
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r = terrain.pose(s.t).linear();
+    b.rotation[i].insert(b.rotation[i].end(), r.data(), r.data() + 9);
   }
   ++b.frames;
   ++m.frames_received;

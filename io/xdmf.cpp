@@ -226,6 +226,9 @@ struct RecordedBody {
 struct TerrainInfo {
   std::string name, kind;      // group /terrain/<name>, attribute kind
   std::vector<Vec3> position;  // Terrain::position(t) of every frame
+  // Terrain::pose(t).linear() of every frame (identity in recordings made before it was
+  // recorded): a vertex v of the mesh is at rotation * v + position.
+  std::vector<Eigen::Matrix3d> rotation;
   Vec3 normal = Vec3::UnitY();
   double size_x = 0, size_z = 0, thickness = 0;
   // Its drawing in its own frame (/terrain/<name>/mesh: Terrain::render_mesh()), placed at the
@@ -399,6 +402,19 @@ Recording inspect(hid_t file, const std::string& h5_path) {
       r.frames = std::min(r.frames, dims.at(0));
       for (hsize_t f = 0; f < dims[0]; ++f)
         info.position.emplace_back(p[3 * f], p[3 * f + 1], p[3 * f + 2]);
+      if (h5::exists(group.get(), name + "/rotation/value")) {
+        std::vector<hsize_t> rotation_dims;
+        const std::vector<double> m =
+            h5::read_doubles(group.get(), name + "/rotation/value", &rotation_dims);
+        if (rotation_dims.size() != 3 || rotation_dims[1] != 3 || rotation_dims[2] != 3) {
+          not_a_recording(h5_path, "/terrain/" + name + "/rotation/value is not [T][3][3]");
+        }
+        r.frames = std::min(r.frames, rotation_dims[0]);
+        for (hsize_t f = 0; f < rotation_dims[0]; ++f) {
+          info.rotation.emplace_back(
+              Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m.data() + 9 * f));
+        }
+      }
       for (const auto& [key, value] : h5::read_attributes_as_text(t.get())) {
         std::istringstream in(value);
         if (key == "normal") in >> info.normal.x() >> info.normal.y() >> info.normal.z();
@@ -442,7 +458,11 @@ Recording inspect(hid_t file, const std::string& h5_path) {
   r.time.resize(r.frames);
   for (TerrainInfo& t : r.terrains) {
     t.position.resize(r.frames);
-    for (const Vec3& p : t.position) t.moving = t.moving || p != t.position.front();
+    t.rotation.resize(r.frames, Eigen::Matrix3d::Identity());
+    for (hsize_t f = 0; f < r.frames; ++f) {
+      t.moving =
+          t.moving || t.position[f] != t.position.front() || t.rotation[f] != t.rotation.front();
+    }
   }
   return r;
 }
@@ -669,7 +689,9 @@ Mesh terrain_mesh(const TerrainInfo& t, const Bounds& bounds) {
   if (t.kind == "plane") return plane_mesh(t.position.front(), t.normal, bounds);
   if (!t.mesh_vertices.empty()) {
     Mesh mesh;
-    for (const Vec3& v : t.mesh_vertices) mesh.vertices.push_back(v + t.position.front());
+    for (const Vec3& v : t.mesh_vertices) {
+      mesh.vertices.push_back(t.rotation.front() * v + t.position.front());
+    }
     mesh.triangles = t.mesh_triangles;
     return mesh;
   }
@@ -679,6 +701,12 @@ Mesh terrain_mesh(const TerrainInfo& t, const Bounds& bounds) {
     return box_mesh(t.position.front(), t.size_x, t.size_z, thickness);
   }
   return {};
+}
+
+// Where the point `at` of the terrain at frame 0 is at frame f (its rigid motion).
+Vec3 placed(const TerrainInfo& t, hsize_t f, const Vec3& at) {
+  return t.rotation[f] * (t.rotation.front().transpose() * (at - t.position.front())) +
+         t.position[f];
 }
 
 // The terrain's mesh (and, when it moves, its vertices and speed at every frame with views).
@@ -705,8 +733,9 @@ bool update_terrain(hid_t file, const Recording& r, const TerrainInfo& t, const 
     put_dataset(group.get(), "speed", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, {v}, zero.data());
     return true;
   }
-  // Moving: the frame-0 mesh carried along by the recorded position; the speed of every vertex
-  // is the platform's, from the recorded positions (backward difference, forward at frame 0).
+  // Moving: the frame-0 mesh carried along by the recorded rotation and position; the speed of
+  // every vertex from its positions at the frames before and after (backward difference,
+  // forward at frame 0).
   Handle position = series(group.get(), "position", H5T_IEEE_F64LE, {v, 3}, 0);
   Handle speed = series(group.get(), "speed", H5T_IEEE_F32LE, {v}, 0);
   const hsize_t done =
@@ -714,17 +743,14 @@ bool update_terrain(hid_t file, const Recording& r, const TerrainInfo& t, const 
   std::vector<double> xs;
   std::vector<float> speeds;
   for (hsize_t f = done; f < r.frames; ++f) {
-    const Vec3 shift = t.position[f] - t.position.front();
-    for (const Vec3& p : mesh.vertices) {
-      const Vec3 q = p + shift;
-      xs.insert(xs.end(), q.data(), q.data() + 3);
-    }
-    double s = 0;
     const hsize_t a = f > 0 ? f - 1 : 0, b = f > 0 ? f : std::min<hsize_t>(1, r.frames - 1);
-    if (b > a && r.time[b] > r.time[a]) {
-      s = (t.position[b] - t.position[a]).norm() / (r.time[b] - r.time[a]);
+    const double dt = b > a ? r.time[b] - r.time[a] : 0;
+    for (const Vec3& p : mesh.vertices) {
+      const Vec3 q = placed(t, f, p);
+      xs.insert(xs.end(), q.data(), q.data() + 3);
+      const double s = dt > 0 ? (placed(t, b, p) - placed(t, a, p)).norm() / dt : 0;
+      speeds.push_back(static_cast<float>(s));
     }
-    speeds.insert(speeds.end(), v, static_cast<float>(s));
   }
   write_rows(position.get(), done, r.frames - done, H5T_NATIVE_DOUBLE, xs.data());
   write_rows(speed.get(), done, r.frames - done, H5T_NATIVE_FLOAT, speeds.data());

@@ -54,6 +54,8 @@ class Recording:
                 t["name"] = name
                 t["kind"] = attr_text(t.get("kind", ""))
                 t["position"] = g["position/value"][:frames]
+                if "rotation" in g:  # [T][3][3]; absent from recordings made before it was
+                    t["rotation"] = g["rotation/value"][:frames]
                 if "mesh" in g:
                     t["mesh_vertices"] = g["mesh/vertices"][:]
                     t["mesh_triangles"] = g["mesh/triangles"][:]
@@ -95,13 +97,16 @@ def surface_polygons(body, frame):
 
 def terrain_polygons(rec, frame):
     """Triangles [F][3][3] in plot order of every terrain that is not a plane (obstacles, the
-    elevator): its recorded mesh moved to its recorded position."""
+    elevator): its recorded mesh turned by its recorded rotation and moved to its position."""
     polygons = []
     for t in rec.terrains:
         if t["kind"] in ("plane", "slope", "elevator") or "mesh_vertices" not in t:
             continue
         p = t["position"][frame] if len(t["position"]) > frame else t["position"][-1]
-        v = t["mesh_vertices"] + p
+        r = np.eye(3)
+        if "rotation" in t and len(t["rotation"]):
+            r = t["rotation"][min(frame, len(t["rotation"]) - 1)]
+        v = t["mesh_vertices"] @ r.T + p
         polygons.append(v[t["mesh_triangles"]][:, :, [0, 2, 1]])
     return polygons
 

@@ -7,7 +7,8 @@ For each RECORDING.xdmf (its .h5 beside it):
     (points = the recorded positions bit for bit, one cell per spring, velocity bit for bit),
     one per body's render surface (points = the recorded surface vertices bit for bit, one
     triangle per recorded triangle) and one per terrain (the plane's quad in its plane, the
-    elevator's box at its recorded height); in three frames every array (speed, strain, mass,
+    elevator's box at its recorded height, an obstacle's mesh at its recorded rotation and
+    position); in three frames every array (speed, strain, mass,
     rest_length, ks, kd, spring type, the observables as field data; the surface's vertices as
     the weighted sums of the particles, its triangles and speed) against values computed from
     the HDF5 file;
@@ -73,6 +74,8 @@ class Recording:
                 self.terrains.append({"name": name, "kind": g.attrs["kind"],
                                       "normal": np.asarray(g.attrs["normal"], float),
                                       "position": g["position/value"][:],
+                                      "rotation": g["rotation/value"][:] if "rotation" in g
+                                      else None,
                                       "mesh": g["mesh/vertices"][:] if "mesh" in g else None})
         self.terrains.sort(key=lambda t: int(t["name"].split("_")[0]))
         frames = [len(self.time)] + [len(b["x"]) for b in self.bodies] + [
@@ -209,10 +212,11 @@ def check_terrain(tag, terrain, data, k):
               f"{tag}: {len(points)} points, {data.GetNumberOfCells()} cells; expected a quad")
         check(np.allclose((points - p) @ terrain["normal"], 0, atol=1e-9),
               f"{tag}: the quad is not in the plane")
-    elif terrain["mesh"] is not None:  # its recorded render mesh, at the recorded position
+    elif terrain["mesh"] is not None:  # its recorded render mesh, turned and placed
+        r = terrain["rotation"][k] if terrain["rotation"] is not None else np.eye(3)
         check(len(points) == len(terrain["mesh"]) and
-              np.allclose(points, terrain["mesh"] + p, rtol=0, atol=1e-9),
-              f"{tag}: the points are not the recorded mesh at the recorded position")
+              np.allclose(points, terrain["mesh"] @ r.T + p, rtol=0, atol=1e-9),
+              f"{tag}: the points are not the recorded mesh at the recorded rotation and position")
     if terrain["kind"] == "elevator":
         check(len(points) == 8 and data.GetNumberOfCells() == 12,
               f"{tag}: {len(points)} points, {data.GetNumberOfCells()} cells; expected a box")

@@ -19,7 +19,20 @@ SCENES = os.path.join(HERE, "..", "..", "scenes")
 # Each seed scene, long enough to see its impact, and scenes of several bodies and surfaces (kept
 # short: every frame is compared).
 RUNS = [("two_jellies", 1.0), ("seed_slope", 1.5), ("seed_elevator", 1.5), ("drop_coulomb", 1.2),
-        ("hanging_cloth", 0.5)]
+        ("hanging_cloth", 0.5), ("obstacles", 0.5)]
+# Written by the test (no scene of scenes/ has obstacles): a cube dropped onto a turned box that
+# spins and oscillates, and a sphere.
+OBSTACLES = """{
+  "bodies": [{"kind": "cube", "name": "jelly", "n": 4, "edge_length": 0.6,
+              "origin": [-0.3, 1.4, -0.3]}],
+  "terrains": [
+    {"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]},
+    {"kind": "box", "center": [0, 0.6, 0], "size": [2, 0.2, 1], "rotation_degrees": [0, 30, 10],
+     "angular_velocity_degrees": [0, 90, 0],
+     "motion": {"kind": "oscillation", "amplitude": [0.3, 0, 0], "frequency": 1}},
+    {"kind": "sphere", "center": [1.5, 0.5, 0], "radius": 0.5}],
+  "integrator": {"name": "rk4", "dt": 0.001}, "duration": 1, "output_interval": 0.02
+}"""
 # What a reader says when it cannot read something: the sidecar must not cause any of these.
 COMPLAINT = re.compile(r"ERR\||WARN\||error|warning|skipping|HDF5-DIAG|cannot|failed", re.I)
 # What says that the X server, not ParaView, failed (then the check runs again on another display).
@@ -41,7 +54,12 @@ def main():
         xdmfs = []
         for scene, seconds in RUNS:
             h5 = os.path.join(tmp, scene + ".h5")
-            subprocess.run([args.jelly, "run", os.path.join(SCENES, scene + ".json"), "--duration",
+            path = os.path.join(SCENES, scene + ".json")
+            if scene == "obstacles":
+                path = os.path.join(tmp, scene + ".json")
+                with open(path, "w") as out:
+                    out.write(OBSTACLES)
+            subprocess.run([args.jelly, "run", path, "--duration",
                             str(seconds), "-o", h5, "--quiet"], check=True,
                            stdout=subprocess.DEVNULL)
             # Relative to the working directory below: the sidecar must find its .h5 by itself.

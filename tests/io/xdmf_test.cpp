@@ -14,10 +14,12 @@
 #include <vector>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/triangle_mesh.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/io/xdmf.hpp>
 #include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 #include "io/io_support.hpp"
 
@@ -333,6 +335,61 @@ TEST(Xdmf, EachBodyAndItsSurfaceAreBlocks) {
         EXPECT_NEAR(speed[i], s, 1e-6 * (1 + s)) << body.name << " frame " << f << " vertex " << i;
       }
       if (f == frames - 1) EXPECT_GT(*std::max_element(speed.begin(), speed.end()), 0.5);
+    }
+  }
+  H5Fclose(file);
+}
+
+// An obstacle turned, spinning and moving: its mesh at every frame is where Terrain::pose(t)
+// puts it (the recorder records the rotation beside the position), its speed the rigid
+// motion's at each vertex.
+TEST(Xdmf, ASpinningObstacleIsWhereItsPosePutsIt) {
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  const Scene scene = parse_scene(R"({
+    "bodies": [{"kind": "cube", "name": "jelly", "n": 3, "edge_length": 0.4,
+                "origin": [-0.2, 1.5, -0.2]}],
+    "terrains": [
+      {"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]},
+      {"kind": "box", "center": [0, 0.5, 0], "size": [2, 0.2, 1], "rotation_degrees": [0, 30, 10],
+       "angular_velocity_degrees": [0, 90, 0],
+       "motion": {"kind": "oscillation", "amplitude": [0.3, 0, 0], "frequency": 1}}],
+    "integrator": {"name": "rk4", "dt": 0.001}, "duration": 1, "output_interval": 0.02})");
+  Simulator sim = make_simulator(scene);
+  {
+    H5Recorder recorder(path, sim, {});
+    sim.add_observer(recorder);
+    ASSERT_TRUE(sim.run_until(0.4).ok());
+  }
+  ASSERT_EQ(sim.terrains().size(), 2u);
+  const Terrain& box = *sim.terrains()[1];
+  const TriangleMesh mesh = box.render_mesh();
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  std::vector<hsize_t> dims;
+  const std::vector<double> time = read(file, "/terrain/1_box/position/time", &dims);
+  const hsize_t frames = dims.at(0);
+  ASSERT_EQ(frames, 21u);
+  read(file, "/terrain/1_box/rotation/value", &dims);
+  EXPECT_EQ(dims, (std::vector<hsize_t>{frames, 3, 3}));
+  const Vec3 omega(0, M_PI / 2, 0);
+  for (hsize_t f : {hsize_t{0}, hsize_t{7}, frames - 1}) {
+    const std::string k = std::to_string(f);
+    const std::vector<double> xyz = read(file, "/xdmf/terrain/1_box/frame/position/" + k, &dims);
+    ASSERT_EQ(dims, (std::vector<hsize_t>{static_cast<hsize_t>(mesh.num_vertices()), 3}));
+    const std::vector<double> speed = read(file, "/xdmf/terrain/1_box/frame/speed/" + k);
+    const Eigen::Isometry3d pose = box.pose(time[f]);
+    // The speed is a difference over one frame (backward, forward at frame 0): the rigid
+    // motion's speed at the middle of that frame, to second order.
+    const double tm = f > 0 ? 0.5 * (time[f - 1] + time[f]) : 0.5 * (time[0] + time[1]);
+    const Eigen::Isometry3d middle = box.pose(tm);
+    const Vec3 centre_velocity = (box.position(tm + 1e-6) - box.position(tm - 1e-6)) / 2e-6;
+    for (int v = 0; v < mesh.num_vertices(); ++v) {
+      const Vec3 want = pose * mesh.vertices[v];
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(xyz[3 * v + c], want[c], 1e-12) << f << " " << v;
+      const double rigid =
+          (centre_velocity + omega.cross(middle * mesh.vertices[v] - middle.translation())).norm();
+      EXPECT_NEAR(speed[v], rigid, 0.01 * rigid + 1e-3) << "frame " << f << " vertex " << v;
     }
   }
   H5Fclose(file);
