@@ -24,6 +24,14 @@ struct RunArgs {
 int run_command(const RunArgs& args);
 // jelly info FILE.h5: what a recording holds.
 int info_command(const std::string& path);
+
+struct XdmfArgs {
+  std::string recording;   // HDF5 file written by `jelly run -o` (or a killed run's)
+  bool overwrite = false;  // --overwrite: replace an existing sidecar
+  bool no_strain = false;  // --no-strain: no strain cell array (XdmfOptions::strain = false)
+};
+// jelly xdmf FILE.h5: (re)writes the recording's XDMF sidecar for ParaView.
+int xdmf_command(const XdmfArgs& args);
 struct FitArgs {
   std::string recording;             // HDF5 file written by `jelly run -o`
   std::string free = "ks,kd";        // --free: the coefficients to fit

@@ -74,6 +74,16 @@ int main(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "Describe an HDF5 file written by `jelly run -o`");
   info->add_option("file", info_path, "HDF5 file")->required()->check(kNonEmpty);
 
+  XdmfArgs xdmf_args;
+  CLI::App* xdmf = app.add_subcommand(
+      "xdmf",
+      "Write the XDMF sidecar (FILE.xdmf) that opens a recording in ParaView: for a killed run, "
+      "or again for a recording made by an older jelly");
+  xdmf->add_option("file", xdmf_args.recording, "HDF5 file")->required()->check(kNonEmpty);
+  xdmf->add_flag("--overwrite", xdmf_args.overwrite, "Replace an existing sidecar");
+  xdmf->add_flag("--no-strain", xdmf_args.no_strain,
+                 "No strain cell array (the largest part of what the sidecar adds to the file)");
+
   FitArgs fit_args;
   CLI::App* fit = app.add_subcommand(
       "fit", "Fit spring and damper coefficients to a recording (HDF5 from `jelly run -o`)");
@@ -187,6 +197,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(run_args);
     if (info->parsed()) return info_command(info_path);
+    if (xdmf->parsed()) return xdmf_command(xdmf_args);
     if (fit->parsed()) return fit_command(fit_args);
     if (list->parsed()) return list_command();
     if (view->parsed()) return view_command(view_args);

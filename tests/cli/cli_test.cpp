@@ -232,6 +232,34 @@ TEST(Cli, RunWritesAFileThatInfoDescribes) {
   EXPECT_NE(r.out, "");
 }
 
+// jelly xdmf writes the sidecar a run writes (for a killed run, or an older recording), and
+// replaces an existing one only with --overwrite.
+TEST(Cli, XdmfWritesTheSidecarOfARecording) {
+  const std::string file = temp_path(".h5");
+  const std::string sidecar = file.substr(0, file.size() - 3) + ".xdmf";
+  Result r = jelly("run " + kSmallSlope + " --duration 0.1 -q -o '" + file + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string written = read_file(sidecar);
+  ASSERT_THAT(written, HasSubstr("<Xdmf"));
+  ASSERT_EQ(std::remove(sidecar.c_str()), 0);
+  r = jelly("xdmf '" + file + "'");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("wrote " + sidecar));
+  EXPECT_EQ(read_file(sidecar), written);
+  r = jelly("xdmf '" + file + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("'" + sidecar + "' exists: pass --overwrite"));
+  r = jelly("xdmf '" + file + "' --overwrite --no-strain");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(read_file(sidecar), Not(HasSubstr("strain")));
+  r = jelly("xdmf '" + sidecar + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("give the recording (.h5)"));
+  r = jelly("xdmf '" + temp_path(".h5") + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("no such file"));
+}
+
 TEST(Cli, ADivergentRunKeepsItsFile) {
   const std::string file = temp_path(".h5");
   Result r =

@@ -1,0 +1,37 @@
+#include <cstdio>
+#include <filesystem>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/io/h5_recorder.hpp>
+#include <jelly/io/xdmf.hpp>
+
+#include "commands.hpp"
+#include "exit_codes.hpp"
+
+namespace jelly::cli {
+
+int xdmf_command(const XdmfArgs& args) {
+  const std::string sidecar = xdmf_path_for(args.recording);
+  if (sidecar == args.recording) {
+    throw InputError("'" + args.recording +
+                     "' is named like a sidecar: give the recording (.h5), not its .xdmf");
+  }
+  if (!std::filesystem::exists(args.recording)) {
+    throw InputError("'" + args.recording + "': no such file");
+  }
+  std::error_code error;
+  if (std::filesystem::exists(sidecar, error) && !args.overwrite) {
+    throw InputError("'" + sidecar +
+                     "' exists: pass --overwrite to replace it (it is rewritten from the "
+                     "recording)");
+  }
+  XdmfOptions options;
+  options.strain = !args.no_strain;
+  const std::string written = write_xdmf_for_recording(args.recording, options);
+  // With a folder: ParaView's Xdmf3 readers misread a bare file name (docs/output.md).
+  const std::string open = written.find('/') == std::string::npos ? "./" + written : written;
+  std::printf("wrote %s (open it in ParaView: paraview %s)\n", written.c_str(), open.c_str());
+  return kExitOk;
+}
+
+}  // namespace jelly::cli
