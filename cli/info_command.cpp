@@ -1,4 +1,7 @@
 #include <cstdio>
+#include <filesystem>
+
+#include <jelly/io/h5_recorder.hpp>
 
 #include "commands.hpp"
 #include "exit_codes.hpp"
@@ -7,9 +10,17 @@
 namespace jelly::cli {
 
 int info_command(const std::string& path) {
-  const std::string text = describe_file(path);
+  std::string text = describe_file(path);
+  if (!text.empty() && text.back() != '\n') text += '\n';
+  // The XDMF sidecar beside it (ParaView opens that, not the .h5).
+  const std::string sidecar = xdmf_path_for(path);
+  std::error_code error;
+  text += "sidecar:       " +
+          (sidecar != path && std::filesystem::exists(sidecar, error)
+               ? sidecar + " (open it in ParaView)"
+               : "none (`jelly xdmf " + path + "` writes it, for ParaView)") +
+          '\n';
   std::fputs(text.c_str(), stdout);
-  if (!text.empty() && text.back() != '\n') std::fputc('\n', stdout);
   return kExitOk;
 }
 

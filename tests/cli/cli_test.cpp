@@ -241,7 +241,11 @@ TEST(Cli, XdmfWritesTheSidecarOfARecording) {
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string written = read_file(sidecar);
   ASSERT_THAT(written, HasSubstr("<Xdmf"));
+  r = jelly("info '" + file + "'");
+  EXPECT_THAT(r.out, HasSubstr("sidecar:       " + sidecar + " (open it in ParaView)"));
   ASSERT_EQ(std::remove(sidecar.c_str()), 0);
+  r = jelly("info '" + file + "'");
+  EXPECT_THAT(r.out, HasSubstr("sidecar:       none (`jelly xdmf " + file + "` writes it"));
   r = jelly("xdmf '" + file + "'");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("wrote " + sidecar));
