@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/io/memory_estimate.hpp>
 #include <jelly/io/detail/json_parse.hpp>
+#include <jelly/io/memory_estimate.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
@@ -92,6 +92,7 @@ void Scene::validate() const {
     terrains[i]->validate(prefix);
     terrains[i]->contact.validate(prefix + "contact.");
   }
+  body_contact.validate("body_contact.");
   const std::vector<std::string> names = integrator_names();
   std::string known;
   for (const std::string& n : names) known += (known.empty() ? "\"" : ", \"") + n + "\"";
@@ -125,6 +126,8 @@ Simulator make_simulator(const Scene& scene) {
                 make_integrator(scene.integrator.name, scene.integrator.options),
                 simulator_options(scene));
   for (const auto& t : scene.terrains) sim.add_terrain(t->make());
+  sim.set_body_contact(scene.body_contact);
+  sim.check_no_overlap();  // bodies that start inside each other: an error naming both
   return sim;
 }
 

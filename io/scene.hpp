@@ -32,6 +32,8 @@ struct Scene {
   std::vector<BodySpec> bodies{seed_cube_body()};
   Vec3 gravity{0, -9.8, 0};
   std::vector<PolymorphicValue<TerrainSpec>> terrains;
+  // Contact between bodies (and, with self_contact, within a body): docs/contact.md.
+  BodyContactParams body_contact;
   IntegratorSpec integrator;
   Real duration = 5;                // s simulated by `jelly run`; required in a scene file
   Real output_interval = 1.0 / 60;  // s between recorded frames; 0 = every step

@@ -91,6 +91,11 @@ Scene scene_from_json(const Json& j) {
     }
   }
 
+  if (const Json* b = root.value("body_contact")) {
+    JsonFields f(*b, "body_contact");
+    s.body_contact = BodyContactParams::read(f);
+  }
+
   const Json* in = root.value("integrator");
   if (in == nullptr) throw InputError("integrator is missing: it is required ({\"name\": ...})");
   {
@@ -135,6 +140,7 @@ std::string scene_to_json(const Scene& s) {
   j["max_particles"] = s.max_particles;
   j["terrains"] = Json::array();
   for (const auto& t : s.terrains) j["terrains"].push_back(terrain_json(*t));
+  j["body_contact"] = s.body_contact.to_json();
   j["integrator"] = {
       {"name", s.integrator.name},
       {"dt", s.integrator.dt},

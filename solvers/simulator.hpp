@@ -7,6 +7,7 @@
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/divergence_guard.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
@@ -57,6 +58,12 @@ class Simulator {
   Simulator& operator=(Simulator&&) noexcept;
 
   void add_terrain(std::unique_ptr<Terrain> terrain);
+  // Contact between bodies and within a body (default: between bodies, when there are two or
+  // more). Throws InputError for invalid parameters.
+  void set_body_contact(const BodyContactParams& params);
+  // Throws InputError naming both bodies when two bodies (or, with self-contact, two parts of
+  // one body) overlap in the current state.
+  void check_no_overlap();
   // The observer must outlive the runs it observes.
   void add_observer(Observer& observer);
 
@@ -86,6 +93,7 @@ class Simulator {
   Integrator& integrator() { return *integrator_; }
   const SimulatorOptions& options() const { return options_; }
   const ContactSolver& contacts() const { return contacts_; }
+  const BodyContact& body_contact() const { return body_contact_; }
   long total_steps() const { return total_steps_; }
   long force_evaluations() const { return force_evaluations_; }
 
@@ -99,6 +107,7 @@ class Simulator {
   SimulatorOptions options_;
   Terrains terrains_;
   ContactSolver contacts_;
+  BodyContact body_contact_;
   State before_;  // the state at the start of the current step
   std::vector<Observer*> observers_;
   AnchorSprings anchors_;

@@ -166,6 +166,13 @@ TEST(Cli, ObstacleKindsRunAndNameTheirBadFields) {
   EXPECT_THAT(r.err, StartsWith("error: terrains[2].size = "));
 }
 
+TEST(Cli, OverlappingBodiesExitTwoNamingBoth) {
+  const Result r = jelly("run '" + scene("jelly_stack.json") +
+                         "' --set bodies[1].origin=[-0.5,0.8,-0.5] --duration 0.01");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: bodies \"bottom\" and \"middle\" overlap at the start: "));
+}
+
 TEST(Cli, CommandLineParseErrorsExitTwo) {
   Result r = jelly("run " + kSmallSlope + " --bogus");
   EXPECT_EQ(r.code, 2);

@@ -163,6 +163,9 @@ TEST(Scenes, RoundTripKeepsEveryNonDefaultField) {
   s.output_interval = 0;
   s.divergence = {100, 50};
   s.max_particles = 5000;
+  s.body_contact.self_contact = true;
+  s.body_contact.friction = 0.2;
+  s.body_contact.iterations = 7;
   const Scene back = parse_scene(scene_to_json(s));
   expect_same_scene(s, back);
   EXPECT_EQ(back.cube().n, 3);
@@ -204,8 +207,8 @@ TEST(BadScenes, UnknownKeysNameTheirPathAndTheAllowedKeys) {
   EXPECT_THAT(error_of(kGood, {"durration=3"}),
               StartsWith("durration = 3 is invalid: unknown key; allowed here: \"description\", "
                          "\"bodies\", \"cube\", \"springs\", \"gravity\", \"max_particles\", "
-                         "\"terrains\", \"integrator\", \"duration\", \"output_interval\", "
-                         "\"divergence\""));
+                         "\"terrains\", \"body_contact\", \"integrator\", \"duration\", "
+                         "\"output_interval\", \"divergence\""));
   EXPECT_EQ(error_of(kGood, {"integrator.options.newton=2"}),
             "integrator.options.newton = 2 is invalid: unknown key; allowed here: none");
 }
@@ -345,6 +348,64 @@ TEST(MakeSimulator, BuildsTheSceneAndRunsIt) {
   const Vec3 com = center_of_mass(sim.model(), sim.state());
   // Free fall for 0.2 s (the cube is still far above the slope): y drops by g t^2 / 2.
   EXPECT_NEAR(com.y(), 79.0 / 9 - 0.5 * 9.8 * 0.2 * 0.2, 1e-2);
+}
+
+// scenes/jelly_stack.json: the three cubes come to rest on each other, no particle of one body
+// closer to one of another than the sum of their radii less 1 %.
+TEST(MakeSimulator, JellyStackComesToRestWithoutOverlap) {
+  Simulator sim = make_simulator(load_scene(scene_path("jelly_stack.json")));
+  const auto centres = [&sim] {
+    std::vector<Vec3> c;
+    for (const Body& b : sim.model().bodies) {
+      Vec3 sum = Vec3::Zero();
+      for (int i = b.first_particle; i < b.end_particle(); ++i) sum += particle(sim.state().x, i);
+      c.push_back(sum / b.num_particles);
+    }
+    return c;
+  };
+  ASSERT_TRUE(sim.run_until(5.0).ok());
+  const std::vector<Vec3> settled = centres();
+  ASSERT_TRUE(sim.run_until(6.0).ok());
+  const Model& m = sim.model();
+  for (int b = 0; b < 3; ++b) EXPECT_LT((centres()[b] - settled[b]).norm(), 1e-3) << b;
+  ASSERT_EQ(m.num_bodies(), 3);
+  Real worst = 1e9, fastest = 0;
+  for (int i = 0; i < m.num_particles(); ++i) {
+    fastest = std::max(fastest, particle(sim.state().v, i).norm());
+    for (int j = i + 1; j < m.num_particles(); ++j) {
+      const Body& a = m.body_of(i);
+      const Body& b = m.body_of(j);
+      if (&a == &b) continue;
+      const Real d = (particle(sim.state().x, j) - particle(sim.state().x, i)).norm();
+      worst = std::min(worst, d / (a.radius + b.radius));
+    }
+  }
+  EXPECT_GT(worst, 0.99);
+  // Single particles in resting contact keep a buzz of a few cm/s (docs/contact.md).
+  EXPECT_LT(fastest, 0.1);
+  // Stacked: each cube's centre above the one below it.
+  std::vector<Real> y;
+  for (const Body& b : m.bodies) {
+    Real sum = 0;
+    for (int i = b.first_particle; i < b.end_particle(); ++i) sum += sim.state().x[3 * i + 1];
+    y.push_back(sum / b.num_particles);
+  }
+  EXPECT_GT(y[1], y[0] + 0.9);
+  EXPECT_GT(y[2], y[1] + 0.9);
+}
+
+// Bodies that start inside each other: an error naming both, not a silent explosion.
+TEST(MakeSimulator, OverlappingBodiesNameBoth) {
+  Scene scene = load_scene(scene_path("jelly_stack.json"), {"bodies[1].origin=[-0.5,0.8,-0.5]"});
+  try {
+    make_simulator(scene);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), StartsWith("bodies \"bottom\" and \"middle\" overlap at the start: "))
+        << e.what();
+  }
+  scene.body_contact.enabled = false;  // passing through each other is then allowed
+  EXPECT_NO_THROW(make_simulator(scene));
 }
 
 TEST(MakeSimulator, RejectsAnInvalidSceneBuiltInCode) {

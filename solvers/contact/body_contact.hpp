@@ -1,0 +1,85 @@
+#pragma once
+// Contact between bodies, and within a body (docs/contact.md, "Body-body and self contact").
+// Particles are spheres of their body's contact radius. After every step (for every integrator,
+// after the terrains' contact) a broad phase (a spatial hash, linear in the number of particles)
+// finds the pairs closer than the sum of their radii: pairs of different bodies, and with
+// self-contact pairs of one body that no spring joins. Each such pair is resolved with
+// equal and opposite impulses: the overlap is projected out along the line of centres (weighted
+// by inverse mass), the approach along it is absorbed or, above a resting speed, reflected with
+// restitution, and Coulomb friction bounded by mu times the normal impulse slows the sliding.
+// Pinned particles count as infinitely heavy. Linear momentum is conserved exactly; angular
+// momentum is conserved exactly by the normal response and the projection (the projection's
+// lever is compensated), and changed by friction only (by the torque of a tangential impulse
+// between two particle centres, which the particles cannot take up as spin).
+#include <string>
+#include <vector>
+
+#include <jelly/core/json.hpp>
+#include <jelly/core/model.hpp>
+#include <jelly/core/state.hpp>
+#include <jelly/solvers/contact/broad_phase.hpp>
+
+namespace jelly {
+
+struct BodyContactParams {
+  bool enabled = true;         // contact between different bodies
+  bool self_contact = false;   // contact between parts of one body that no spring joins
+  Real restitution = 0.2;      // in [0, 1]
+  Real friction = 0.5;         // kinetic mu >= 0
+  Real static_friction = 0.5;  // >= friction
+  Real resting_speed = 0.05;   // an approach slower than this (m/s) is absorbed, never reflected
+  int iterations = 4;          // passes over the contact pairs per step, >= 1
+
+  // Throws InputError naming `prefix`field.
+  void validate(const std::string& prefix) const;
+  // The keys of a scene's "body_contact" object (missing keys keep their defaults), validated.
+  static BodyContactParams read(JsonFields& fields);
+  Json to_json() const;
+};
+
+class BodyContact {
+ public:
+  struct Stats {
+    long pairs = 0;             // contact pairs resolved, summed over the steps
+    double broad_seconds = 0;   // time in the broad phase
+    double narrow_seconds = 0;  // time filtering and resolving the pairs
+    long steps = 0;
+  };
+
+  BodyContact() = default;
+  explicit BodyContact(BodyContactParams params);
+
+  const BodyContactParams& params() const { return params_; }
+  // Whether resolve() can do anything for this model: two bodies, or a body with self-contact.
+  bool active(const Model& model) const;
+  // Resolves the contacts of `state` after a step of size h from `before`.
+  void resolve(const Model& model, const State& before, State& state, Real h);
+  // The pairs of the last resolve() (global particle indices, i < j).
+  const std::vector<BroadPhase::Pair>& pairs() const { return contacts_; }
+  const Stats& stats() const { return stats_; }
+
+  // Throws InputError naming both bodies when two bodies' particles overlap in `x` (closer than
+  // their radii sum less `tolerance` relative), and for self-contact two particles of one body
+  // that no spring joins.
+  void check_no_overlap(const Model& model, const VecX& x, Real tolerance = 1e-9);
+
+ private:
+  // Per-particle radius, inverse mass (0 for pins), body index, and the springs' neighbour lists,
+  // made once per model.
+  void prepare(const Model& model);
+  // Keeps the broad phase's pairs that may touch: other bodies, or (self-contact) no spring.
+  void filter(const Model& model);
+  bool joined(int i, int j) const;
+
+  BodyContactParams params_;
+  BroadPhase broad_;
+  const Model* prepared_for_ = nullptr;
+  int prepared_particles_ = -1, prepared_springs_ = -1;
+  VecX radius_, inverse_mass_;
+  std::vector<int> body_;
+  std::vector<int> neighbour_start_, neighbours_;  // CSR, sorted
+  std::vector<BroadPhase::Pair> candidates_, contacts_;
+  Stats stats_;
+};
+
+}  // namespace jelly
