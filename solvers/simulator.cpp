@@ -1,5 +1,6 @@
 #include <jelly/solvers/simulator.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -53,10 +54,23 @@ void Simulator::set_anchors(AnchorSprings anchors) {
   anchors_ = std::move(anchors);
 }
 
+void Simulator::remove_observer(Observer& observer) {
+  observers_.erase(std::remove(observers_.begin(), observers_.end(), &observer), observers_.end());
+}
+
+namespace {
+// Copies into the existing buffers (same sizes), so that they keep their address.
+void assign_state(State& to, const State& from) {
+  to.t = from.t;
+  to.x = from.x;
+  to.v = from.v;
+}
+}  // namespace
+
 void Simulator::set_state(State state) {
   require(state.x.size() == model_.num_dofs() && state.v.size() == model_.num_dofs(),
           "state.x.size", state.x.size(), "3 x the number of particles");
-  state_ = std::move(state);
+  assign_state(state_, state);
   contacts_.clear();
   next_output_ = state_.t;
   frames_ = 0;
@@ -80,7 +94,7 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
             "snapshot.seed_contacts.particle", c.particle, "a particle index of the model");
   }
   integrator_->restore_internal_state(snapshot.integrator_state);
-  state_ = std::move(s);
+  assign_state(state_, s);
   contacts_.restore(std::move(snapshot.seed_contacts), snapshot.contact_count);
   total_steps_ = snapshot.total_steps;
   next_output_ = snapshot.next_output;

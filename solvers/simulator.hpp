@@ -66,6 +66,8 @@ class Simulator {
   void check_no_overlap();
   // The observer must outlive the runs it observes.
   void add_observer(Observer& observer);
+  // Stops calling `observer` (one added before; any other is ignored).
+  void remove_observer(Observer& observer);
 
   // One step of options().dt, then contact. Returns the integrator's failure, if any; does not
   // check divergence (run_until does).
@@ -81,6 +83,11 @@ class Simulator {
   // InputError for an invalid anchor (validate_anchors). Not part of snapshots.
   void set_anchors(AnchorSprings anchors);
   const AnchorSprings& anchors() const { return anchors_; }
+  // For changing positions or velocities between steps in place (an external force, a drag),
+  // keeping the active contacts, the step count and the output clock; sizes must not change.
+  // The buffers of state().x and state().v keep their address for the simulator's life (also
+  // across set_state and restore), so views of them (Python, the viewer) stay valid.
+  State& mutable_state() { return state_; }
   // Replaces the state (a restart); forgets the active contacts.
   void set_state(State state);
   SimulatorSnapshot snapshot() const;

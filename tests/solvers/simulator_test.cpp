@@ -56,6 +56,47 @@ TEST(Simulator, ObserversAtTheOutputInterval) {
   EXPECT_EQ(times.size(), 13u);
 }
 
+TEST(Simulator, RemovedObserverIsNotCalled) {
+  const Model m = build_cube(testing::small_cube(2));
+  Simulator sim = testing::make_sim(m, rest_state(m), "rk4", 0.001, 0.1);
+  int a = 0, b = 0;
+  testing::Probe pa([&](const Simulator&) { ++a; });
+  testing::Probe pb([&](const Simulator&) { ++b; });
+  sim.add_observer(pa);
+  sim.add_observer(pb);
+  ASSERT_TRUE(sim.run_until(0.2).ok());
+  EXPECT_EQ(a, 3);
+  EXPECT_EQ(b, 3);
+  sim.remove_observer(pa);
+  ASSERT_TRUE(sim.run_until(0.4).ok());
+  EXPECT_EQ(a, 3);
+  EXPECT_EQ(b, 5);
+}
+
+// Views of the state (Python's NumPy arrays) rely on its buffers staying where they are.
+TEST(Simulator, StateBuffersKeepTheirAddressAndInPlaceChangesAreSeen) {
+  const Model m = build_cube(testing::small_cube(3));
+  Simulator sim = testing::make_sim(m, rest_state(m), "rk4", 0.001);
+  const Real* x = sim.state().x.data();
+  const Real* v = sim.state().v.data();
+  ASSERT_TRUE(sim.step().ok);
+  const SimulatorSnapshot snap = sim.snapshot();
+  sim.set_state(rest_state(m));
+  sim.restore(snap);
+  EXPECT_EQ(sim.state().x.data(), x);
+  EXPECT_EQ(sim.state().v.data(), v);
+  EXPECT_EQ(sim.state().x, snap.state.x);
+
+  // A velocity set in place moves the jelly in the next step (no gravity: only that motion).
+  const long steps = sim.total_steps();
+  sim.mutable_model().gravity.setZero();
+  sim.set_state(rest_state(m));
+  sim.mutable_state().v.setConstant(1.0);
+  ASSERT_TRUE(sim.step().ok);
+  EXPECT_EQ(sim.total_steps(), steps + 1);
+  EXPECT_NEAR(sim.state().x[0] - rest_state(m).x[0], 0.001, 1e-12);
+}
+
 // Explicit Euler far past its stability limit: the guard stops the run and says why.
 TEST(Simulator, DivergenceGuardStopsExplicitEuler) {
   const Model m = build_cube(testing::small_cube(4));
