@@ -15,6 +15,8 @@ packages=(
   # test jelly_paraview's screenshot)
   libglfw3-dev libimgui-dev libstb-dev libopengl-dev libegl-dev libegl-mesa0 libglx-mesa0
   libgl1-mesa-dri xvfb xauth
+  # the Python module jelly (python/): bindings, its tests, sweeps on Dask
+  pybind11-dev python3-pybind11 python3-dev python3-pytest python3-distributed python3-pandas
 )
 if [ "${1:-}" = "--tests" ]; then
   # The test jelly_paraview (tests/io/paraview_test.py; it skips without them): ParaView and its

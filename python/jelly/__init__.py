@@ -1,0 +1,74 @@
+"""jelly: a mass-spring soft-body solver (C++17) in Python.
+
+Scenes (``load_scene``, attributes by JSON path), simulation with NumPy views of the C++ state
+(``Simulator``), recordings (``H5Recorder``, ``read_recording``, checkpoints), fitting
+(``fit_recording``) and parameter sweeps on Dask (``sweep``). See docs/python.md.
+"""
+
+import os as _os
+from typing import Any as _Any, Optional as _Optional, Union as _Union
+
+from . import _jelly
+from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module folder)
+    ArkodeOptions, Checkpoint, ContactParams, CubeSpec, DivergenceGuard, Elevator, ElevatorSpec,
+    FitOptions, FitResult, FittedParameter, H5Recorder, ImplicitEulerOptions, InputError,
+    Integrator, IntegratorOptions, Model, Observer, Plane, RecorderOptions, Recording, RunReport,
+    SimulatorOptions, SimulatorSnapshot, Simulator, SpringCoefficients, Springs, SpringType, State,
+    StepResult, Terrain, __version__, angular_momentum, apply_override, build_cube,
+    center_of_mass, cube_index, describe_recording, elastic_energy, gravitational_energy,
+    integrator_infos, integrator_names, kinetic_energy, linear_momentum, parse_free_parameters,
+    read_checkpoint, read_recording, rest_state, restore, scene_to_json, spring_type_names,
+    total_energy, write_xdmf_for_recording)
+from ._scene import Scene, load_scene
+from ._sweep import sweep, sweep_points
+
+_FIT_KEYWORDS = ("free", "window", "initial", "max_iterations", "function_tolerance",
+                 "gradient_tolerance", "parameter_tolerance", "fit_restart_velocities",
+                 "relative_step", "num_threads", "compute_covariance", "progress_to_stdout")
+
+
+def fit_recording(recording: _Union[Recording, str, _os.PathLike],
+                  options: _Optional[FitOptions] = None, *,
+                  write_scene: _Optional[_Union[str, _os.PathLike]] = None,
+                  **keywords: _Any) -> FitResult:
+    """Fits spring and damper coefficients to a recording (a Recording or the path of a file
+    written by ``jelly run -o`` or H5Recorder with a scene), as ``jelly fit`` does: the terrains,
+    integrator and dt come from the scene stored in it.
+
+    Options are a FitOptions and/or keywords of its fields: free ('ks,kd', the default), window
+    (0.1 s), initial ({'ks': 1400}), max_iterations (50), ... write_scene: also write the
+    recording's scene with the fitted values (``jelly fit --write-scene``). Returns a FitResult
+    (``print(result)`` prints jelly fit's report); the GIL is released while fitting.
+    """
+    if isinstance(recording, (str, _os.PathLike)):
+        recording = read_recording(_os.fspath(recording))
+    chosen = FitOptions()
+    if options is not None:
+        for name in _FIT_KEYWORDS:
+            setattr(chosen, name, getattr(options, name))
+    for name, value in keywords.items():
+        if name not in _FIT_KEYWORDS:
+            raise TypeError(f"fit_recording() got an unknown option '{name}'; options: "
+                            + ", ".join(_FIT_KEYWORDS))
+        setattr(chosen, name, value)
+    result = _jelly._fit_recording(recording, chosen)
+    if write_scene is not None:
+        fitted_scene(recording, result).save(write_scene)
+    return result
+
+
+def fitted_scene(recording: Recording, result: FitResult) -> Scene:
+    """The recording's scene with the fitted coefficients written into its spring types."""
+    return Scene(scene_to_json(_jelly._fitted_scene(recording, result)))
+
+
+def _recording_scene(self: Recording) -> Scene:
+    """The scene the recording was made from (InputError if it stores none)."""
+    if not self.scene_json:
+        raise InputError("the recording stores no scene (it was not written from a scene)")
+    return Scene(self.scene_json, (), "recording")
+
+
+Recording.scene = property(_recording_scene, doc=_recording_scene.__doc__)
+
+__all__ = sorted(name for name in dir() if not name.startswith("_"))

@@ -1,0 +1,314 @@
+"""Scenes whose fields read and write as attributes, by their JSON paths.
+
+A Scene keeps the JSON text it was made from (with every change applied to it) and the C++ scene
+parsed from that text. Reading ``scene.springs.structural.ks`` looks the path up in the scene's
+full JSON (``to_json()``: every field written out, defaults included). Writing
+``scene.springs.structural.ks = 2400`` is the override ``springs.structural.ks=2400`` of
+``jelly run --set``: the C++ ``apply_override`` edits the JSON and the C++ parser validates the
+whole scene again, so a bad value raises ``jelly.InputError`` naming its JSON path and leaves the
+scene unchanged. Nothing here knows the scene's fields: whatever the C++ format grows (bodies,
+registries of kinds) reads and writes the same way.
+"""
+
+from __future__ import annotations
+
+import copy as _copy
+import json
+import os
+from typing import Any, Iterable, Iterator, Mapping, Union
+
+from . import _jelly
+
+__all__ = ["Scene", "load_scene"]
+
+Overrides = Union[Iterable[str], Mapping[str, Any]]
+
+
+def _json_value(value: Any) -> str:
+    """A Python value as the JSON text of an override's right-hand side."""
+    if isinstance(value, (_Node, _List)):
+        value = value._value()
+    if hasattr(value, "tolist"):  # NumPy arrays and scalars
+        value = value.tolist()
+    return json.dumps(value)
+
+
+def assignments(overrides: Overrides) -> list[str]:
+    """Overrides as 'path=value' strings: strings pass through, a mapping's values become JSON."""
+    if isinstance(overrides, Mapping):
+        return [f"{path}={_json_value(value)}" for path, value in overrides.items()]
+    if isinstance(overrides, str):
+        raise TypeError("overrides: a list of 'path=value' strings or a {path: value} mapping, "
+                        "not a single string")
+    return [str(o) for o in overrides]
+
+
+def _child(path: str, key: Union[str, int]) -> str:
+    if isinstance(key, int):
+        return f"{path}[{key}]"
+    return f"{path}.{key}" if path else key
+
+
+def _split(path: str) -> list[Union[str, int]]:
+    """'terrains[0].contact.model' or 'terrains.0.contact.model' -> ['terrains', 0, ...]."""
+    steps: list[Union[str, int]] = []
+    for segment in path.split("."):
+        name, _, rest = segment.partition("[")
+        if name:
+            steps.append(int(name) if name.isdigit() else name)
+        while rest:
+            index, _, rest = rest.partition("]")
+            steps.append(int(index))
+            rest = rest[1:] if rest.startswith("[") else rest
+    return steps
+
+
+class Scene(_jelly._Scene):
+    """A scene (docs/scenes.md): fields are attributes (``scene.integrator.dt``), lists index
+    (``scene.terrains[0].contact.restitution``), every write is validated by the C++ parser.
+
+    ``Scene(json_text_or_dict, overrides=(), source="scene")``; ``jelly.load_scene(path)`` reads a
+    file. ``jelly.Simulator(scene)`` builds what ``jelly run`` builds from the same scene.
+    """
+
+    def __init__(self, json_text: Union[str, Mapping[str, Any]], overrides: Overrides = (),
+                 source: str = "scene") -> None:
+        if isinstance(json_text, Mapping):
+            json_text = json.dumps(json_text)
+        todo = assignments(overrides)
+        super().__init__(json_text, todo, source)  # validates, C++ messages
+        for assignment in todo:
+            json_text = _jelly.apply_override(json_text, assignment)
+        object.__setattr__(self, "_source", json_text)
+        object.__setattr__(self, "_name", source)
+        object.__setattr__(self, "_cache", None)
+
+    # --- whole-scene operations -------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The scene's full JSON (every field, defaults included) as a new dict."""
+        return _copy.deepcopy(self._full())
+
+    def get(self, path: str) -> Any:
+        """The value at a JSON path ('springs.structural.ks', 'terrains[0].kind'), as plain
+        Python data (a copy). Raises KeyError for a path the scene does not have."""
+        value: Any = self._full()
+        for step in _split(path):
+            try:
+                value = value[step]
+            except (KeyError, IndexError, TypeError):
+                raise KeyError(f"the scene has no field '{path}'") from None
+        return _copy.deepcopy(value)
+
+    def set(self, path: str, value: Any) -> None:
+        """Sets the value at a JSON path (as ``jelly run --set path=value``) and validates the
+        scene; raises InputError naming the path, leaving the scene unchanged."""
+        self.update({path: value})
+
+    def update(self, overrides: Overrides) -> None:
+        """Applies several overrides ({path: value} or 'path=value' strings) at once, validated
+        together; raises InputError and leaves the scene unchanged if the result is invalid."""
+        text = self._source
+        for assignment in assignments(overrides):
+            text = _jelly.apply_override(text, assignment)
+        self._assign(text, self._name)  # raises before anything changes
+        object.__setattr__(self, "_source", text)
+        object.__setattr__(self, "_cache", None)
+
+    def with_overrides(self, overrides: Overrides) -> "Scene":
+        """A new scene: this one with overrides applied ({path: value} or 'path=value')."""
+        return Scene(self._source, overrides, self._name)
+
+    def copy(self) -> "Scene":
+        """An independent copy."""
+        return Scene(self._source, (), self._name)
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the full JSON (to_json()) to a file."""
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(self.to_json())
+
+    @property
+    def source_json(self) -> str:
+        """The JSON the scene was made from, with every change applied (only the fields that
+        were written; to_json() writes them all)."""
+        return self._source
+
+    # --- attribute access by JSON path ---------------------------------------------------------
+    def _full(self) -> dict[str, Any]:
+        if self._cache is None:
+            object.__setattr__(self, "_cache", json.loads(self.to_json()))
+        return self._cache
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        full = self._full()
+        if name not in full:
+            raise AttributeError(f"the scene has no field '{name}'; its fields: "
+                                 + ", ".join(full))
+        return _wrap(self, name, full[name])
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name.startswith("_") or hasattr(type(self), name):
+            raise AttributeError(f"'{name}' is not a scene field and cannot be set")
+        self.set(name, value)
+
+    def __dir__(self) -> list[str]:
+        return sorted(set(super().__dir__()) | set(self._full()))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, _jelly._Scene):
+            return NotImplemented
+        return self.to_json() == other.to_json()
+
+    __hash__ = None  # type: ignore[assignment]  # mutable
+
+    def __repr__(self) -> str:
+        full = self._full()
+        return (f"<jelly.Scene '{self._name}': integrator {full['integrator']['name']}, "
+                f"dt {full['integrator']['dt']}, duration {full['duration']}>")
+
+    def __reduce__(self):
+        return (Scene, (self._source, (), self._name))
+
+    def __copy__(self) -> "Scene":
+        return self.copy()
+
+    def __deepcopy__(self, memo: dict) -> "Scene":
+        return self.copy()
+
+
+def _wrap(scene: Scene, path: str, value: Any) -> Any:
+    if isinstance(value, dict):
+        return _Node(scene, path)
+    if isinstance(value, list):
+        return _List(scene, path)
+    return value
+
+
+class _Node:
+    """A JSON object of a scene: its keys read and write as attributes or items."""
+
+    __slots__ = ("_scene", "_path")
+
+    def __init__(self, scene: Scene, path: str) -> None:
+        object.__setattr__(self, "_scene", scene)
+        object.__setattr__(self, "_path", path)
+
+    def _value(self) -> dict[str, Any]:
+        return self._scene.get(self._path)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        value = self._value()
+        if name not in value:
+            raise AttributeError(f"the scene has no field '{_child(self._path, name)}'; fields "
+                                 f"of {self._path}: " + ", ".join(value))
+        return _wrap(self._scene, _child(self._path, name), value[name])
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        self._scene.set(_child(self._path, name), value)
+
+    def __getitem__(self, key: str) -> Any:
+        try:
+            return self.__getattr__(key)
+        except AttributeError as e:
+            raise KeyError(str(e)) from None
+
+    def __setitem__(self, key: str, value: Any) -> None:
+        self._scene.set(_child(self._path, key), value)
+
+    def __contains__(self, key: object) -> bool:
+        return key in self._value()
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._value())
+
+    def __len__(self) -> int:
+        return len(self._value())
+
+    def keys(self):
+        return self._value().keys()
+
+    def to_dict(self) -> dict[str, Any]:
+        return self._value()
+
+    def __dir__(self) -> list[str]:
+        return sorted(self._value())
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, (_Node, dict)):
+            return self._value() == (other._value() if isinstance(other, _Node) else other)
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return repr(self._value())
+
+
+class _List:
+    """A JSON array of a scene: elements read and write by index."""
+
+    __slots__ = ("_scene", "_path")
+
+    def __init__(self, scene: Scene, path: str) -> None:
+        self._scene = scene
+        self._path = path
+
+    def _value(self) -> list[Any]:
+        return self._scene.get(self._path)
+
+    def _index(self, i: int) -> int:
+        n = len(self._value())
+        j = i + n if i < 0 else i
+        if not 0 <= j < n:
+            raise IndexError(f"{self._path}[{i}] does not exist ({self._path} has {n} elements)")
+        return j
+
+    def __getitem__(self, i: Union[int, slice]) -> Any:
+        if isinstance(i, slice):
+            return self._value()[i]
+        j = self._index(i)
+        return _wrap(self._scene, _child(self._path, j), self._value()[j])
+
+    def __setitem__(self, i: int, value: Any) -> None:
+        self._scene.set(_child(self._path, self._index(i)), value)
+
+    def __len__(self) -> int:
+        return len(self._value())
+
+    def __iter__(self) -> Iterator[Any]:
+        return (self[i] for i in range(len(self)))
+
+    def to_list(self) -> list[Any]:
+        return self._value()
+
+    def __array__(self, dtype=None):
+        import numpy
+        return numpy.asarray(self._value(), dtype=dtype)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, (_List, list, tuple)):
+            return self._value() == (other._value() if isinstance(other, _List) else list(other))
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return repr(self._value())
+
+
+def load_scene(path: Union[str, os.PathLike], overrides: Overrides = ()) -> Scene:
+    """Reads and validates a scene file (docs/scenes.md), applying overrides first ('path=value'
+    strings as ``jelly run --set`` takes them, or a {path: value} mapping). Raises InputError
+    naming the JSON path of the first invalid field."""
+    path = os.fspath(path)
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError:
+        _jelly._load_scene(path)  # raises the C++ InputError for an unreadable file
+        raise
+    return Scene(text, overrides, path)

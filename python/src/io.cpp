@@ -1,0 +1,253 @@
+// io/: scenes (JSON in, JSON out, validated by the C++ parser), simulators made from scenes,
+// the HDF5 recorder, recordings read back as NumPy arrays, checkpoints and restarts.
+#include <jelly/io/checkpoint.hpp>
+#include <jelly/io/h5_recorder.hpp>
+#include <jelly/io/recording.hpp>
+#include <jelly/io/scene.hpp>
+#include <jelly/io/xdmf.hpp>
+
+#include "common.hpp"
+
+namespace jelly::python {
+
+namespace {
+
+// H5Recorder with an explicit close(): the file must be closed before h5py or read_recording
+// can open it in the same process, and Python does not promise when an object is destroyed.
+class PyH5Recorder final : public Observer {
+ public:
+  PyH5Recorder(const std::string& path, const Simulator& sim, RecorderOptions options)
+      : path_(path), impl_(std::make_unique<H5Recorder>(path, sim, std::move(options))) {}
+  void on_frame(const Simulator& sim) override { open().on_frame(sim); }
+  void on_finish(const Simulator& sim, const RunReport& report) override {
+    open().on_finish(sim, report);
+  }
+  void close() {
+    if (impl_) frames_ = impl_->frames();
+    impl_.reset();
+  }
+  bool closed() const { return impl_ == nullptr; }
+  const std::string& path() const { return path_; }
+  long frames() const { return impl_ ? impl_->frames() : frames_; }
+
+ private:
+  H5Recorder& open() {
+    if (!impl_) {
+      throw InputError("the recorder of '" + path_ +
+                       "' is closed: remove it from the simulator (remove_observer) first");
+    }
+    return *impl_;
+  }
+  std::string path_;
+  std::unique_ptr<H5Recorder> impl_;
+  long frames_ = 0;  // at close()
+};
+
+py::array stack_frames(const std::vector<VecX>& frames, int n) {
+  py::array_t<Real> out(
+      {static_cast<py::ssize_t>(frames.size()), static_cast<py::ssize_t>(n), py::ssize_t{3}});
+  Real* p = out.mutable_data();
+  for (const VecX& f : frames) p = std::copy(f.data(), f.data() + f.size(), p);
+  return out;
+}
+
+}  // namespace
+
+void bind_io(py::module_& m) {
+  py::class_<Scene>(m, "_Scene",
+                    "The C++ scene (jelly.Scene wraps it: attribute access by JSON path).")
+      .def(py::init(
+               [](const std::string& json_text, const std::vector<std::string>& overrides,
+                  const std::string& source) { return parse_scene(json_text, overrides, source); }),
+           py::arg("json_text"), py::arg("overrides") = std::vector<std::string>{},
+           py::arg("source") = "scene",
+           "Parses and validates scene JSON (after applying overrides); raises InputError naming "
+           "the JSON path of the first invalid field.")
+      .def(
+          "_assign",
+          [](Scene& s, const std::string& json_text, const std::string& source) {
+            s = parse_scene(json_text, {}, source);
+          },
+          py::arg("json_text"), py::arg("source") = "scene",
+          "Replaces this scene by the parsed JSON text; unchanged when it is invalid.")
+      .def(
+          "to_json", [](const Scene& s) { return scene_to_json(s); },
+          "The scene as pretty-printed JSON with every field written out.")
+      .def("validate", &Scene::validate, "Raises InputError naming the first invalid field.");
+
+  m.def(
+      "_load_scene",
+      [](const std::string& path, const std::vector<std::string>& overrides) {
+        return load_scene(path, overrides);
+      },
+      py::arg("path"), py::arg("overrides") = std::vector<std::string>{},
+      "The C++ load_scene (jelly.load_scene wraps it in a jelly.Scene).");
+  m.def(
+      "apply_override",
+      [](const std::string& json_text, const std::string& assignment) {
+        return apply_override(json_text, assignment);
+      },
+      py::arg("json_text"), py::arg("assignment"),
+      "Applies one 'path=value' assignment (jelly run --set) to scene JSON text and returns the "
+      "new text (not validated).");
+  m.def(
+      "scene_to_json", [](const Scene& s) { return scene_to_json(s); }, py::arg("scene"),
+      "The scene as pretty-printed JSON with every field written out.");
+
+  auto simulator = py::reinterpret_borrow<py::class_<Simulator>>(m.attr("Simulator"));
+  simulator.def(py::init([](const Scene& scene) { return make_simulator(scene); }),
+                py::arg("scene"),
+                "The scene's cube at rest among its terrains, with its integrator and options "
+                "(as jelly run makes it). Run it with sim.run_until(scene.duration).");
+
+  py::class_<RecorderOptions>(m, "RecorderOptions", "Options of H5Recorder (docs/output.md).")
+      .def(py::init<>(), "The defaults.")
+      .def_readwrite("scene_json", &RecorderOptions::scene_json, "The scene stored in the file.")
+      .def_readwrite("integrator_name", &RecorderOptions::integrator_name,
+                     "Attribute; default: the simulator's.")
+      .def_readwrite("flush_every_frames", &RecorderOptions::flush_every_frames,
+                     "Frames per block; the file is flushed after each block.")
+      .def_readwrite("compression_level", &RecorderOptions::compression_level,
+                     "Deflate 0..9, 0 = off.")
+      .def_readwrite("write_xdmf", &RecorderOptions::write_xdmf,
+                     "Write the .xdmf sidecar at each run's end.")
+      .def_readwrite("background_writer", &RecorderOptions::background_writer,
+                     "Compress and write on a second thread.");
+
+  py::class_<PyH5Recorder, Observer>(m, "H5Recorder",
+                                     "An observer recording a run to HDF5 (+ XDMF sidecar). Add it "
+                                     "with sim.add_observer(recorder); close() (or a with block) "
+                                     "before reading the file in the same process.")
+      .def(py::init([](const std::string& path, const Simulator& sim, const Scene* scene,
+                       std::optional<RecorderOptions> options) {
+             RecorderOptions o = options ? *options : RecorderOptions{};
+             if (scene != nullptr) {  // as `jelly run -o` records a scene
+               o.scene_json = scene_to_json(*scene);
+               o.integrator_name = scene->integrator.name;
+             }
+             return std::make_unique<PyH5Recorder>(path, sim, std::move(o));
+           }),
+           py::arg("path"), py::arg("simulator"), py::arg("scene") = nullptr,
+           py::arg("options") = py::none(),
+           "Creates the file and writes the static parts of the simulator. With a scene, the "
+           "scene's JSON and integrator name are stored as jelly run stores them. Raises "
+           "InputError when the file cannot be created.")
+      .def("close", &PyH5Recorder::close,
+           "Writes what is pending and closes the file (afterwards frames raise).")
+      .def_property_readonly("closed", &PyH5Recorder::closed, "Whether close() was called.")
+      .def_property_readonly("path", &PyH5Recorder::path, "The file's path.")
+      .def_property_readonly("frames", &PyH5Recorder::frames, "Frames received so far.")
+      .def(
+          "__enter__", [](py::object self) { return self; }, "Returns the recorder.")
+      .def(
+          "__exit__", [](PyH5Recorder& r, py::args) { r.close(); }, "Closes the recorder.");
+
+  py::class_<PyRecording>(m, "Recording",
+                          "A recording read back from HDF5: arrays of time, positions, "
+                          "velocities and observables.")
+      .def_property_readonly(
+          "model", [](const PyRecording& r) -> const Model& { return r.recording.model; },
+          py::return_value_policy::reference_internal, "Masses, springs and gravity.")
+      .def_property_readonly(
+          "time", [](const PyRecording& r) { return py::array(py::cast(r.recording.time)); },
+          "Time of each frame (s), [T].")
+      .def_property_readonly(
+          "step", [](const PyRecording& r) { return py::array(py::cast(r.recording.step)); },
+          "The simulator's total step count at each frame, [T].")
+      .def_property_readonly(
+          "position",
+          [](PyRecording& r) {
+            if (!r.position)
+              r.position = stack_frames(r.recording.position, r.recording.model.num_particles());
+            return r.position;
+          },
+          "Positions (m), [T, N, 3] (built once).")
+      .def_property_readonly(
+          "velocity",
+          [](PyRecording& r) {
+            if (!r.velocity)
+              r.velocity = stack_frames(r.recording.velocity, r.recording.model.num_particles());
+            return r.velocity;
+          },
+          "Velocities (m/s), [T, N, 3] (built once).")
+      .def_property_readonly(
+          "observables",
+          [](const PyRecording& r) {
+            py::dict d;
+            for (const auto& [name, value] : r.recording.observables) {
+              if (value.cols() == 1) {
+                d[py::str(name)] = Eigen::VectorXd(value.col(0));
+              } else {
+                d[py::str(name)] = value;
+              }
+            }
+            return d;
+          },
+          "{name: array [T] or [T, 3]}: kinetic_energy, elastic_energy, gravitational_energy, "
+          "total_energy, center_of_mass, linear_momentum, angular_momentum.")
+      .def_property_readonly(
+          "terrains",
+          [](const PyRecording& r) {
+            py::list out;
+            for (const TerrainTrack& t : r.recording.terrains) {
+              py::dict d;
+              d["name"] = t.name;
+              d["kind"] = t.kind;
+              Eigen::Matrix<Real, Eigen::Dynamic, 3, Eigen::RowMajor> p(t.position.size(), 3);
+              for (std::size_t k = 0; k < t.position.size(); ++k)
+                p.row(k) = t.position[k].transpose();
+              d["position"] = p;
+              d["attributes"] = t.attributes;
+              out.append(d);
+            }
+            return out;
+          },
+          "The terrains' recorded motion: [{name, kind, position [T, 3], attributes}].")
+      .def_property_readonly(
+          "scene_json", [](const PyRecording& r) { return r.recording.scene_json; },
+          "The scene the run was made from (JSON text; empty if none was stored).")
+      .def_property_readonly(
+          "attributes", [](const PyRecording& r) { return r.recording.attributes; },
+          "The attributes of /parameters, as text (run_status, dt, integrator, ...).")
+      .def_property_readonly(
+          "frames", [](const PyRecording& r) { return r.recording.frames(); },
+          "Number of frames T.")
+      .def("__repr__", [](const PyRecording& r) {
+        return "<jelly.Recording " + std::to_string(r.recording.frames()) + " frames of " +
+               std::to_string(r.recording.model.num_particles()) + " particles>";
+      });
+
+  m.def(
+      "read_recording",
+      [](const std::string& path) {
+        PyRecording r;
+        {
+          py::gil_scoped_release release;
+          r.recording = read_recording(path);
+        }
+        return r;
+      },
+      py::arg("path"),
+      "Reads a recording written by H5Recorder or jelly run -o. Raises InputError naming the "
+      "file when it is missing, not HDF5 or not a jelly recording.");
+  m.def("describe_recording", &describe_recording, py::arg("path"),
+        "What a recording holds, one item per line (as jelly info prints it).");
+  m.def("write_xdmf_for_recording", &write_xdmf_for_recording, py::arg("path"),
+        "Writes <path without .h5>.xdmf for an existing recording (e.g. of a killed run).");
+
+  py::class_<Checkpoint>(m, "Checkpoint", "A restart point stored in a recording's /checkpoint.")
+      .def_readonly("state", &Checkpoint::state, "The state (a copy).")
+      .def_readonly("total_steps", &Checkpoint::total_steps, "Steps taken by then.")
+      .def_readonly("next_output", &Checkpoint::next_output, "Time of the next frame (s).")
+      .def_readonly("integrator", &Checkpoint::integrator,
+                    "The integrator of the run that wrote it.")
+      .def_readonly("dt", &Checkpoint::dt, "The time step of the run that wrote it (s).")
+      .def("snapshot", &Checkpoint::snapshot, "As a SimulatorSnapshot (Simulator.restore).");
+  m.def("read_checkpoint", &read_checkpoint, py::arg("path"),
+        "The checkpoint a recording holds. Raises InputError for a missing or invalid file.");
+  m.def("restore", &restore, py::arg("simulator"), py::arg("checkpoint"),
+        "Continues a simulator from a checkpoint, bit for bit; raises InputError when its "
+        "particle count, integrator or time step differ from the run that wrote it.");
+}
+
+}  // namespace jelly::python

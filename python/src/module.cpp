@@ -1,0 +1,20 @@
+// The Python module jelly._jelly (re-exported by the package `jelly`): the C++ library's
+// modules bound one file each, in layer order.
+#include <jelly/version.hpp>
+
+#include "common.hpp"
+
+PYBIND11_MODULE(_jelly, m) {
+  namespace py = pybind11;
+  m.doc() = "jelly: a mass-spring soft-body solver (C++17), bound with pybind11.";
+  // Bad user input: the C++ message names the field (a scene's JSON path), the value and what
+  // is allowed.
+  py::register_exception<jelly::InputError>(m, "InputError", PyExc_ValueError).attr("__module__") =
+      "jelly";
+  m.attr("__version__") = JELLY_VERSION_STRING;
+  jelly::python::bind_core(m);
+  jelly::python::bind_terrain(m);
+  jelly::python::bind_solvers(m);
+  jelly::python::bind_io(m);
+  jelly::python::bind_fit(m);
+}

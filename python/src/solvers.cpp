@@ -1,0 +1,360 @@
+// solvers/: integrators by name with their options, the Simulator (step, run_until with Python
+// observers, the state as NumPy views), run reports. The GIL is released while C++ steps.
+#include <optional>
+
+#include <jelly/core/cube.hpp>
+#include <jelly/core/measures.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
+#include <jelly/solvers/run_report.hpp>
+#include <jelly/solvers/simulator.hpp>
+#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/plane.hpp>
+
+#include "common.hpp"
+
+namespace jelly::python {
+
+namespace {
+
+// An Observer subclassed in Python (on_frame, optionally on_finish). Called with the GIL
+// released by run_until, so each call takes it back. The simulator is passed by pointer so that
+// Python sees the simulator object it already has; the report is passed as a copy.
+class PyObserver : public Observer {
+ public:
+  void on_frame(const Simulator& sim) override {
+    py::gil_scoped_acquire gil;
+    py::function f = py::get_override(static_cast<const Observer*>(this), "on_frame");
+    if (!f) py::pybind11_fail("jelly.Observer.on_frame must be overridden");
+    f(const_cast<Simulator*>(&sim));
+  }
+  void on_finish(const Simulator& sim, const RunReport& report) override {
+    py::gil_scoped_acquire gil;
+    py::function f = py::get_override(static_cast<const Observer*>(this), "on_finish");
+    if (f) f(const_cast<Simulator*>(&sim), report);
+  }
+};
+
+// run_until's `callback`: a Python callable called with the simulator at every frame.
+class CallbackObserver final : public Observer {
+ public:
+  CallbackObserver(py::object callback, py::object simulator)
+      : callback_(std::move(callback)), simulator_(std::move(simulator)) {}
+  void on_frame(const Simulator& /*sim*/) override {
+    py::gil_scoped_acquire gil;
+    callback_(simulator_);
+  }
+
+ private:
+  py::object callback_, simulator_;
+};
+
+// Removes the callback observer however run_until ends (also by a Python exception).
+class ObserverGuard {
+ public:
+  ObserverGuard(Simulator& sim, Observer& observer) : sim_(sim), observer_(observer) {
+    sim_.add_observer(observer_);
+  }
+  ~ObserverGuard() { sim_.remove_observer(observer_); }
+  ObserverGuard(const ObserverGuard&) = delete;
+  ObserverGuard& operator=(const ObserverGuard&) = delete;
+
+ private:
+  Simulator& sim_;
+  Observer& observer_;
+};
+
+py::dict statistics_dict(const Statistics& s) {
+  py::dict d;
+  for (const auto& [name, value] : s) d[py::str(name)] = value;
+  return d;
+}
+
+py::dict report_dict(const RunReport& r) {
+  py::dict d;
+  d["status"] = std::string(run_status_name(r.status));
+  d["t"] = r.t;
+  d["steps"] = r.steps;
+  d["reason"] = r.reason;
+  d["wall_seconds"] = r.wall_seconds;
+  d["force_evaluations"] = r.force_evaluations;
+  d["statistics"] = statistics_dict(r.statistics);
+  return d;
+}
+
+}  // namespace
+
+void bind_solvers(py::module_& m) {
+  m.def("integrator_names", &integrator_names, "Every registered integrator's name, sorted.");
+  m.def(
+      "integrator_infos",
+      [] {
+        py::dict d;
+        for (const IntegratorInfo& i : integrator_infos()) {
+          d[py::str(std::string(i.name))] = std::string(i.description);
+        }
+        return d;
+      },
+      "Every registered integrator as {name: description}, sorted by name.");
+
+  py::class_<ImplicitEulerOptions>(m, "ImplicitEulerOptions",
+                                   "Options of implicit_euler (docs/implicit.md).")
+      .def(py::init<>(), "The defaults.")
+      .def_readwrite("newton_iterations", &ImplicitEulerOptions::newton_iterations,
+                     "1 = linearized backward Euler; > 1 = Newton, at most this many solves.")
+      .def_readwrite("newton_tolerance", &ImplicitEulerOptions::newton_tolerance,
+                     "Newton's relative tolerance.")
+      .def_property(
+          "definiteness",
+          [](const ImplicitEulerOptions& o) {
+            return std::string(definiteness_name(o.definiteness));
+          },
+          [](ImplicitEulerOptions& o, const std::string& s) {
+            require(parse_definiteness(s, &o.definiteness), "integrator.options.definiteness",
+                    "\"" + s + "\"", "one of \"clamp\", \"project\", \"none\"");
+          },
+          "\"clamp\", \"project\" or \"none\".")
+      .def_readwrite("linear_solver", &ImplicitEulerOptions::linear_solver,
+                     "\"auto\", \"cholmod\", \"ldlt\" or \"cg\".")
+      .def_readwrite("cg_preconditioner", &ImplicitEulerOptions::cg_preconditioner,
+                     "\"jacobi\" or \"cholmod\".")
+      .def_readwrite("cg_tolerance", &ImplicitEulerOptions::cg_tolerance,
+                     "Relative residual of CG.")
+      .def_readwrite("cg_max_iterations", &ImplicitEulerOptions::cg_max_iterations,
+                     "CG iteration cap.")
+      .def_readwrite("refactor_iterations", &ImplicitEulerOptions::refactor_iterations,
+                     "CG iterations that trigger a new CHOLMOD preconditioner.")
+      .def_readwrite("ordering", &ImplicitEulerOptions::ordering,
+                     "\"metis\", \"amd\", \"nesdis\" or \"best\".")
+      .def_readwrite("contact", &ImplicitEulerOptions::contact, "\"implicit\" or \"after_step\".")
+      .def_readwrite("contact_iterations", &ImplicitEulerOptions::contact_iterations,
+                     "Solves per step while the contact set changes.");
+
+  py::class_<ArkodeOptions>(m, "ArkodeOptions",
+                            "Options of arkode_erk and arkode_dirk (docs/arkode.md).")
+      .def(py::init<>(), "The defaults.")
+      .def_readwrite("rtol", &ArkodeOptions::rtol, "Relative tolerance.")
+      .def_readwrite("atol", &ArkodeOptions::atol, "Absolute tolerance.")
+      .def_readwrite("method", &ArkodeOptions::method,
+                     "An ARKODE Butcher table name; empty = default.")
+      .def_readwrite("max_step", &ArkodeOptions::max_step, "Largest internal step (s); 0 = dt.")
+      .def_readwrite("linear_solver", &ArkodeOptions::linear_solver,
+                     "arkode_dirk: \"schur\" or \"klu\".")
+      .def_readwrite("max_steps", &ArkodeOptions::max_steps,
+                     "Internal steps per contact interval.");
+
+  py::class_<IntegratorOptions>(
+      m, "IntegratorOptions",
+      "Options of the integrators that take any (scene key integrator.options).")
+      .def(py::init<>(), "The defaults.")
+      .def_readwrite("implicit", &IntegratorOptions::implicit, "implicit_euler's options.")
+      .def_readwrite("arkode", &IntegratorOptions::arkode,
+                     "arkode_erk's and arkode_dirk's options.")
+      .def("validate", &IntegratorOptions::validate,
+           "Raises InputError naming the first invalid option.");
+
+  py::class_<Integrator>(m, "Integrator", "A time integrator (one of integrator_names()).")
+      .def_property_readonly(
+          "name", [](const Integrator& i) { return std::string(i.name()); }, "Its registry name.")
+      .def_property_readonly("order", &Integrator::order, "Its order of accuracy.")
+      .def_property_readonly("is_implicit", &Integrator::is_implicit,
+                             "Whether it solves implicit equations.")
+      .def_property_readonly("is_adaptive", &Integrator::is_adaptive,
+                             "Whether it chooses internal steps itself.")
+      .def_property_readonly("steps", &Integrator::steps, "Steps taken.")
+      .def(
+          "statistics", [](const Integrator& i) { return statistics_dict(i.statistics()); },
+          "Its counters and timings as a dict {name: value}.");
+
+  py::class_<DivergenceGuard>(m, "DivergenceGuard",
+                              "What counts as diverged (scene key divergence).")
+      .def(py::init<>(), "The defaults: 500 m/s, 1e4 m, no energy cap.")
+      .def_readwrite("max_speed", &DivergenceGuard::max_speed, "m/s.")
+      .def_readwrite("max_distance", &DivergenceGuard::max_distance, "m from the origin.")
+      .def_readwrite("max_energy", &DivergenceGuard::max_energy, "J; inf = not checked.");
+
+  py::class_<SimulatorOptions>(m, "SimulatorOptions",
+                               "Time step, output interval and divergence limits.")
+      .def(py::init<>(), "dt 0.001 s, a frame every step.")
+      .def_readwrite("dt", &SimulatorOptions::dt, "Time step (s), > 0.")
+      .def_readwrite("output_interval", &SimulatorOptions::output_interval,
+                     "Seconds between observer frames; 0 = every step.")
+      .def_readwrite("divergence", &SimulatorOptions::divergence, "The DivergenceGuard.")
+      .def("validate", &SimulatorOptions::validate,
+           "Raises InputError naming the first invalid option.");
+
+  py::class_<StepResult>(m, "StepResult", "The outcome of one step: ok, or a failure message.")
+      .def_readonly("ok", &StepResult::ok, "False when the integrator failed (e.g. a solve).")
+      .def_readonly("message", &StepResult::message, "Why it failed; empty when ok.")
+      .def(
+          "__bool__", [](const StepResult& r) { return r.ok; }, "Same as ok.")
+      .def("__repr__", [](const StepResult& r) {
+        return r.ok ? std::string("StepResult(ok=True)")
+                    : "StepResult(ok=False, message='" + r.message + "')";
+      });
+
+  py::class_<RunReport>(m, "RunReport",
+                        "How a run ended: status \"completed\", \"diverged\" or \"solver_failed\" "
+                        "(a diverged run returns its report, it does not raise).")
+      .def_property_readonly(
+          "status", [](const RunReport& r) { return std::string(run_status_name(r.status)); },
+          "\"completed\", \"diverged\" or \"solver_failed\".")
+      .def_property_readonly("ok", &RunReport::ok, "True when completed.")
+      .def_readonly("t", &RunReport::t, "Simulated time reached (s).")
+      .def_readonly("steps", &RunReport::steps, "Steps taken in this run.")
+      .def_readonly("reason", &RunReport::reason,
+                    "Why the run stopped early; empty when completed.")
+      .def_readonly("wall_seconds", &RunReport::wall_seconds, "Wall time of the run (s).")
+      .def_readonly("force_evaluations", &RunReport::force_evaluations,
+                    "Force evaluations in this run.")
+      .def_property_readonly(
+          "statistics", [](const RunReport& r) { return statistics_dict(r.statistics); },
+          "The integrator's counters at the end, as a dict.")
+      .def("brief", &RunReport::brief, "One line: status, time, steps, wall time (and the reason).")
+      .def("as_dict", &report_dict,
+           "The report as a dict (status, t, steps, reason, wall_seconds, ...).")
+      .def("__repr__", [](const RunReport& r) { return "<jelly.RunReport " + r.brief() + ">"; });
+
+  py::class_<Observer, PyObserver>(m, "Observer",
+                                   "Subclass and override on_frame(sim) (and optionally "
+                                   "on_finish(sim, report)); add with Simulator.add_observer.")
+      .def(py::init<>(), "An observer; override on_frame.")
+      .def("on_frame", &Observer::on_frame, py::arg("simulator"),
+           "Called at the first output time and then every output interval.")
+      .def("on_finish", &Observer::on_finish, py::arg("simulator"), py::arg("report"),
+           "Called at the end of each run_until with its report.");
+
+  py::class_<SimulatorSnapshot>(m, "SimulatorSnapshot",
+                                "Everything the future of a run depends on besides the model, "
+                                "terrains, integrator and options (bit-for-bit restarts).")
+      .def_readonly("state", &SimulatorSnapshot::state, "The state (a copy).")
+      .def_readonly("total_steps", &SimulatorSnapshot::total_steps, "Steps taken so far.")
+      .def_readonly("next_output", &SimulatorSnapshot::next_output, "Time of the next frame (s).")
+      .def_readonly("contact_count", &SimulatorSnapshot::contact_count,
+                    "Contacts of the last step.");
+
+  py::class_<Simulator>(m, "Simulator",
+                        "Steps a model among terrains with an integrator. Build it from a Scene, "
+                        "or from a Model, a State, an integrator name and options.")
+      .def(py::init([](const Model& model, const std::optional<State>& state,
+                       const std::string& integrator, const IntegratorOptions& integrator_options,
+                       const SimulatorOptions& options) {
+             return Simulator(model, state ? *state : rest_state(model),
+                              make_integrator(integrator, integrator_options), options);
+           }),
+           py::arg("model"), py::arg("state") = py::none(), py::arg("integrator") = "rk4",
+           py::arg("integrator_options") = IntegratorOptions{},
+           py::arg("options") = SimulatorOptions{},
+           "A simulator of a model (copied) from a state (default: at rest) with the named "
+           "integrator. Raises InputError for an invalid model, state or option.")
+      .def(
+          "add_terrain",
+          [](Simulator& s, const Plane& p) { s.add_terrain(std::make_unique<Plane>(p)); },
+          py::arg("terrain"), "Adds a copy of a terrain.")
+      .def(
+          "add_terrain",
+          [](Simulator& s, const Elevator& e) { s.add_terrain(std::make_unique<Elevator>(e)); },
+          py::arg("terrain"), "Adds a copy of a terrain.")
+      .def("add_observer", &Simulator::add_observer, py::arg("observer"), py::keep_alive<1, 2>(),
+           "Calls observer.on_frame at every output frame of run_until (and on_finish at its end).")
+      .def("remove_observer", &Simulator::remove_observer, py::arg("observer"),
+           "Stops calling an observer added before.")
+      .def("step", &Simulator::step, py::call_guard<py::gil_scoped_release>(),
+           "One step of options.dt, then contact (the GIL is released). Returns a StepResult; "
+           "does not check divergence (run_until does).")
+      .def(
+          "run_until",
+          [](py::object self, Real t_end, py::object callback) {
+            Simulator& sim = self.cast<Simulator&>();
+            std::optional<CallbackObserver> observer;
+            std::optional<ObserverGuard> guard;
+            if (!callback.is_none()) {
+              observer.emplace(callback, self);
+              guard.emplace(sim, *observer);
+            }
+            py::gil_scoped_release release;
+            return sim.run_until(t_end);
+          },
+          py::arg("t_end"), py::arg("callback") = py::none(),
+          "Steps until t_end, calling observers (and callback(sim), if given) at every output "
+          "frame, and returns a RunReport; stops early on divergence or solver failure, which "
+          "the report's status says (no exception). The GIL is released while stepping and "
+          "taken back for each Python call.")
+      .def_property_readonly(
+          "model", [](const Simulator& s) -> const Model& { return s.model(); },
+          py::return_value_policy::reference_internal, "The model (read-only views).")
+      .def_property(
+          "state", [](Simulator& s) -> State& { return s.mutable_state(); },
+          [](Simulator& s, const State& state) { s.set_state(state); },
+          py::return_value_policy::reference_internal,
+          "The current State; its x and v are (N, 3) views of the simulator's memory, and "
+          "assigning state.x / state.v copies into it in place (kept contacts and clock). "
+          "Assigning a whole State is a restart (set_state).")
+      .def(
+          "set_state", [](Simulator& s, const State& state) { s.set_state(state); },
+          py::arg("state"),
+          "Replaces the state (a restart): forgets the active contacts, restarts the output clock.")
+      .def(
+          "set_spring_coefficients",
+          [](Simulator& s, SpringType type, Real ks, Real kd) {
+            require(std::isfinite(ks) && ks >= 0, "ks", ks, "a finite stiffness >= 0");
+            require(std::isfinite(kd) && kd >= 0, "kd", kd, "a finite damping >= 0");
+            s.mutable_model().springs.set_coefficients(type, {ks, kd});
+          },
+          py::arg("type"), py::arg("ks"), py::arg("kd"),
+          "Sets ks and kd of every spring of a type (taken by the next step).")
+      .def(
+          "set_gravity", [](Simulator& s, const Vec3& g) { s.mutable_model().gravity = g; },
+          py::arg("gravity"), "Sets gravity (m/s^2), taken by the next step.")
+      .def("snapshot", &Simulator::snapshot, "A SimulatorSnapshot to restore later (bit for bit).")
+      .def("restore", &Simulator::restore, py::arg("snapshot"),
+           "Continues from a snapshot of a simulator with the same model, terrains, integrator "
+           "and options.")
+      .def_property_readonly(
+          "integrator", [](Simulator& s) -> Integrator& { return s.integrator(); },
+          py::return_value_policy::reference_internal, "The Integrator (name, statistics()).")
+      .def_property_readonly("options", &Simulator::options, "The SimulatorOptions (a copy).")
+      .def_property_readonly(
+          "terrains",
+          [](py::object self) {
+            py::list out;
+            for (const auto& t : self.cast<const Simulator&>().terrains()) {
+              out.append(py::cast(t.get(), py::return_value_policy::reference_internal, self));
+            }
+            return out;
+          },
+          "The terrains (views; alive with the simulator).")
+      .def_property_readonly(
+          "t", [](const Simulator& s) { return s.state().t; }, "The current time (s).")
+      .def_property_readonly("total_steps", &Simulator::total_steps, "Steps taken since creation.")
+      .def_property_readonly("force_evaluations", &Simulator::force_evaluations,
+                             "Force evaluations since creation.")
+      .def_property_readonly(
+          "contact_count", [](const Simulator& s) { return s.contacts().contact_count(); },
+          "Particles in contact after the last step.")
+      .def(
+          "kinetic_energy", [](const Simulator& s) { return kinetic_energy(s.model(), s.state()); },
+          "Kinetic energy of the current state (J).")
+      .def(
+          "elastic_energy", [](const Simulator& s) { return elastic_energy(s.model(), s.state()); },
+          "Elastic energy of the current state (J).")
+      .def(
+          "gravitational_energy",
+          [](const Simulator& s) { return gravitational_energy(s.model(), s.state()); },
+          "Gravitational energy of the current state (J).")
+      .def(
+          "total_energy", [](const Simulator& s) { return total_energy(s.model(), s.state()); },
+          "Kinetic + elastic + gravitational energy of the current state (J).")
+      .def(
+          "center_of_mass", [](const Simulator& s) { return center_of_mass(s.model(), s.state()); },
+          "Centre of mass of the current state (m), [3].")
+      .def(
+          "linear_momentum",
+          [](const Simulator& s) { return linear_momentum(s.model(), s.state()); },
+          "Linear momentum of the current state (kg m/s), [3].")
+      .def(
+          "angular_momentum",
+          [](const Simulator& s) { return angular_momentum(s.model(), s.state()); },
+          "Angular momentum about the origin (kg m^2/s), [3].");
+}
+
+}  // namespace jelly::python

@@ -1,0 +1,138 @@
+#!/usr/bin/env python3
+"""Figures of the Python module jelly (docs/python.md): what calling C++ from Python costs.
+
+1. step: sim.step() called from Python on the seed cube (n = 10 on the 20-degree slope, rk4,
+   dt = 1 ms, after 0.5 s of settling: the set-up of jelly_core_benchmark's
+   BM_SeedSlopeStep/rk4) against the same steps taken by the C++ loop of run_until, in the same
+   process, interleaved, best and median of the repeats; and the bare per-call overhead on a
+   2 x 2 x 2 cube, where a step costs almost nothing.
+2. view: reading the positions of a 64,000-particle jelly (n = 40): the view's address is the
+   C++ buffer's, and reading costs the same whatever the size, against copying them.
+3. sweep: the same 8 runs on a 2-worker LocalCluster and in a serial loop.
+
+    PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python.py [step|view|sweep ...]
+"""
+
+import os
+import pathlib
+import statistics
+import sys
+import time
+
+import numpy as np
+
+import jelly
+
+SCENES = pathlib.Path(__file__).resolve().parents[1] / "scenes"
+
+
+def seed_simulator(n=10):
+    spec = jelly.CubeSpec()
+    spec.n = n
+    model = jelly.build_cube(spec)
+    options = jelly.SimulatorOptions()
+    options.dt = 0.001
+    options.output_interval = 1.0
+    sim = jelly.Simulator(model, integrator="rk4", options=options)
+    sim.add_terrain(jelly.Plane.slope(20))
+    sim.run_until(0.5)
+    return sim
+
+
+def per_step_python(sim, steps):
+    step = sim.step
+    start = time.perf_counter()
+    for _ in range(steps):
+        step()
+    return (time.perf_counter() - start) / steps
+
+
+def per_step_cpp(sim, steps):
+    start = time.perf_counter()
+    sim.run_until(sim.t + steps * sim.options.dt - 1e-9)
+    return (time.perf_counter() - start) / steps
+
+
+def bench_step(repeats=15, steps=400):
+    for label, n, count in (("seed cube n = 10 (1000 particles, 12,876 springs)", 10, steps),
+                            ("2 x 2 x 2 cube (call overhead)", 2, 20000)):
+        sim = seed_simulator(n)
+        py, cpp = [], []
+        for _ in range(repeats):  # interleaved, so that load changes hit both alike
+            py.append(per_step_python(sim, count))
+            cpp.append(per_step_cpp(sim, count))
+        print(f"step, {label}, {repeats} x {count} steps:")
+        print(f"  sim.step() from Python: best {min(py) * 1e6:8.2f} us, median "
+              f"{statistics.median(py) * 1e6:8.2f} us")
+        print(f"  C++ loop (run_until):   best {min(cpp) * 1e6:8.2f} us, median "
+              f"{statistics.median(cpp) * 1e6:8.2f} us")
+        print(f"  Python / C++: best {min(py) / min(cpp):.3f}, median "
+              f"{statistics.median(py) / statistics.median(cpp):.3f}, difference of the bests "
+              f"{(min(py) - min(cpp)) * 1e6:+.2f} us per step")
+
+
+def bench_view():
+    scene = jelly.load_scene(SCENES / "seed_slope.json", {"cube.n": 40})
+    sim = jelly.Simulator(scene)
+    x = sim.state.x
+    print(f"view, n = 40: {sim.model.num_particles} particles, positions {x.nbytes / 1e6:.3f} MB")
+    address = sim.state.x.__array_interface__["data"][0]
+    print(f"  sim.state.x: shape {x.shape}, owndata {x.flags.owndata}, writeable "
+          f"{x.flags.writeable}, same buffer on every read: "
+          f"{all(sim.state.x.__array_interface__['data'][0] == address for _ in range(10))}, "
+          f"np.shares_memory(sim.state.x, sim.state.x): "
+          f"{np.shares_memory(sim.state.x, sim.state.x)}")
+    sim.step()
+    print(f"  a view read before a step shows the state after it: "
+          f"{np.array_equal(x, sim.state.x)}")
+    for label, read in (("read sim.state.x (view)", lambda: sim.state.x),
+                        ("x.sum() on the view", lambda: sim.state.x.sum()),
+                        ("np.array(sim.state.x) (a copy)", lambda: np.array(sim.state.x))):
+        times = []
+        for _ in range(7):
+            start = time.perf_counter()
+            for _ in range(200):
+                read()
+            times.append((time.perf_counter() - start) / 200)
+        print(f"  {label:32s} best {min(times) * 1e6:9.2f} us")
+    small = jelly.Simulator(jelly.load_scene(SCENES / "seed_slope.json", {"cube.n": 2}))
+    times = []
+    for _ in range(7):
+        start = time.perf_counter()
+        for _ in range(2000):
+            small.state.x
+        times.append((time.perf_counter() - start) / 2000)
+    print(f"  {'read sim.state.x, 8 particles':32s} best {min(times) * 1e6:9.2f} us")
+
+
+def bench_sweep(workers=2):
+    from distributed import Client, LocalCluster
+    scene = jelly.load_scene(SCENES / "seed_slope.json", {"duration": 1.5})
+    parameters = {"springs.structural.ks": [1000, 1400, 2000, 2800],
+                  "integrator.name": ["rk4", "midpoint"]}
+    points = jelly.sweep_points(parameters)
+    start = time.perf_counter()
+    for point in points:
+        sim = jelly.Simulator(scene.with_overrides(point))
+        sim.run_until(scene.duration)
+    serial = time.perf_counter() - start
+    start = time.perf_counter()
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as client:
+        started = time.perf_counter()
+        table = jelly.sweep(scene, parameters, client=client, out_dir=None)
+        swept = time.perf_counter() - started
+    total = time.perf_counter() - start
+    print(f"sweep, {len(points)} runs of the seed slope ({scene.duration} s each, no files), "
+          f"{os.cpu_count()} cores:")
+    print(f"  serial loop: {serial:.2f} s")
+    print(f"  jelly.sweep on {workers} workers: {swept:.2f} s (with starting and stopping the "
+          f"cluster: {total:.2f} s); speed-up {serial / swept:.2f}")
+    print(f"  statuses: {sorted(set(table['status']))}, worker time summed "
+          f"{table['wall_seconds'].sum():.2f} s")
+
+
+if __name__ == "__main__":
+    chosen = sys.argv[1:] or ["step", "view", "sweep"]
+    for name in chosen:
+        {"step": bench_step, "view": bench_view, "sweep": bench_sweep}[name]()

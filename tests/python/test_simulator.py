@@ -1,0 +1,243 @@
+"""Simulation from Python: equal to `jelly run` bit for bit, NumPy views of the C++ state,
+callbacks at every frame, reports (also of diverged runs), the GIL released while stepping."""
+
+import threading
+import weakref
+
+import h5py
+import numpy as np
+import pytest
+
+import jelly
+
+
+def h5_contents(path):
+    """Every dataset's data and every attribute of a file, except the wall-clock ones."""
+    out = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, obj):
+            for key, value in obj.attrs.items():
+                if "wall" not in key and "seconds" not in key:
+                    out[f"{name}@{key}"] = value
+            if isinstance(obj, h5py.Dataset):
+                out[name] = obj[()]
+        f.visititems(visit)
+        for key, value in f.attrs.items():
+            out[f"@{key}"] = value
+    return out
+
+
+def assert_same_file(a, b):
+    ca, cb = h5_contents(a), h5_contents(b)
+    assert sorted(ca) == sorted(cb)
+    for key in ca:
+        va, vb = np.asarray(ca[key]), np.asarray(cb[key])
+        assert va.dtype == vb.dtype and va.shape == vb.shape, key
+        assert va.tobytes() == vb.tobytes(), key  # bit for bit (NaN-safe)
+
+
+@pytest.mark.parametrize("scene_file,sets", [
+    ("seed_slope.json", ["springs.shear.ks=1800"]),
+    ("drop_coulomb.json", ["integrator.name=implicit_euler", "integrator.dt=0.01"]),
+])
+def test_run_equals_jelly_run_bit_for_bit(scenes, run_cli, tmp_path, scene_file, sets):
+    cli_file, py_file = tmp_path / "cli.h5", tmp_path / "py.h5"
+    args = [a for s in sets for a in ("--set", s)]
+    done = run_cli("run", scenes / scene_file, *args, "--duration", "0.4", "-o", cli_file,
+                   "--quiet")
+    assert done.returncode == 0, done.stderr
+
+    scene = jelly.load_scene(scenes / scene_file, sets + ["duration=0.4"])
+    sim = jelly.Simulator(scene)
+    with jelly.H5Recorder(str(py_file), sim, scene) as recorder:
+        sim.add_observer(recorder)
+        report = sim.run_until(scene.duration)
+    assert report.status == "completed" and report.ok
+    assert_same_file(cli_file, py_file)
+
+
+def test_state_views_alias_the_cpp_memory(scenes):
+    sim = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json"))
+    x = sim.state.x
+    assert x.shape == (1000, 3) and x.dtype == np.float64
+    assert np.shares_memory(x, sim.state.x)
+    address = x.__array_interface__["data"][0]
+    assert sim.state.x.__array_interface__["data"][0] == address
+    assert not x.flags.writeable and not x.flags.owndata
+    with pytest.raises(ValueError):
+        x[0, 0] = 1.0
+    before = x.copy()
+    sim.step()
+    assert not np.array_equal(x, before)  # the old view shows the new state
+    assert np.array_equal(x, sim.state.x)
+
+    # A write through the setter lands in the same memory and is seen by the next step.
+    reference = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json"))
+    reference.step()
+    kicked = sim.state.v + np.array([0.0, 2.0, 0.5])
+    sim.state.v = kicked
+    assert np.array_equal(sim.state.v, kicked)
+    assert sim.state.v.__array_interface__["data"][0] == \
+        sim.state.v.__array_interface__["data"][0]
+    reference.state = jelly.State(reference.state.x, kicked, reference.state.t)
+    sim.step()
+    reference.step()
+    assert np.array_equal(sim.state.x, reference.state.x)
+    assert np.array_equal(sim.state.v, reference.state.v)
+    assert x.__array_interface__["data"][0] == address  # still the simulator's buffer
+    with pytest.raises(jelly.InputError, match=r"state\.x .*shape \(1000, 3\)"):
+        sim.state.x = np.zeros((10, 3))
+    sim.state.x = sim.state.x.reshape(-1)  # flat (3N,) is accepted too
+
+
+def test_views_keep_the_simulator_alive(scenes):
+    sim = jelly.Simulator(jelly.load_scene(scenes / "drop_coulomb.json"))
+    alive = weakref.ref(sim)
+    x = sim.state.x
+    ks = sim.model.springs.ks
+    expected = x.copy()
+    del sim
+    assert alive() is not None  # the arrays hold it
+    assert np.array_equal(x, expected) and ks.size > 0
+    del x, ks
+    assert alive() is None
+
+
+def test_callback_sees_every_frame(scenes, tmp_path):
+    scene = jelly.load_scene(scenes / "seed_slope.json", ["duration=0.5"])
+    sim = jelly.Simulator(scene)
+    seen = []
+
+    def callback(s):
+        assert s is sim
+        seen.append((s.t, s.state.x.copy()))
+
+    with jelly.H5Recorder(str(tmp_path / "r.h5"), sim, scene) as recorder:
+        sim.add_observer(recorder)
+        report = sim.run_until(0.5, callback=callback)
+    assert report.ok
+    recording = jelly.read_recording(str(tmp_path / "r.h5"))
+    assert len(seen) == recording.frames == 31  # t = 0, 1/60, ..., 0.5
+    assert np.array_equal([t for t, _ in seen], recording.time)
+    for k, (_, x) in enumerate(seen):
+        assert np.array_equal(x, recording.position[k])
+    # The callback is called only during its run.
+    sim.remove_observer(recorder)
+    sim.run_until(0.6)
+    assert len(seen) == 31
+
+
+def test_callback_exception_propagates_and_the_simulator_goes_on(scenes):
+    sim = jelly.Simulator(jelly.load_scene(scenes / "drop_coulomb.json"))
+
+    def fail(s):
+        if s.t > 0.05:
+            raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        sim.run_until(1.0, callback=fail)
+    t = sim.t
+    assert 0.05 < t < 0.1
+    assert sim.run_until(t + 0.1).ok
+
+
+def test_python_observer(scenes):
+    class Counter(jelly.Observer):
+        def __init__(self):
+            super().__init__()
+            self.frames, self.reports = 0, []
+
+        def on_frame(self, simulator):
+            self.frames += 1
+
+        def on_finish(self, simulator, report):
+            self.reports.append(report.status)
+
+    sim = jelly.Simulator(jelly.load_scene(scenes / "drop_coulomb.json"))
+    counter = Counter()
+    sim.add_observer(counter)
+    sim.run_until(0.5)
+    assert counter.reports == ["completed"] and counter.frames == 31
+    sim.remove_observer(counter)
+    sim.run_until(1.0)
+    assert counter.frames == 31
+
+
+def test_diverged_run_returns_a_report(scenes):
+    scene = jelly.load_scene(scenes / "seed_slope.json", {
+        "integrator.name": "explicit_euler", "integrator.dt": 0.02, "duration": 5})
+    report = jelly.Simulator(scene).run_until(5.0)
+    assert report.status == "diverged" and not report.ok
+    assert report.t < 5.0 and report.reason
+    d = report.as_dict()
+    assert d["status"] == "diverged" and d["t"] == report.t and "steps" in d["statistics"]
+
+
+def test_measures_statistics_and_model(scenes):
+    sim = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json"))
+    assert np.allclose(sim.center_of_mass(), [-2 / 9, 79 / 9, -2 / 9])
+    assert sim.kinetic_energy() == 0 and sim.elastic_energy() == 0
+    assert sim.total_energy() == pytest.approx(sim.gravitational_energy())
+    assert np.array_equal(sim.linear_momentum(), [0, 0, 0])
+    assert jelly.total_energy(sim.model, sim.state) == sim.total_energy()
+    model = sim.model
+    assert model.num_particles == 1000 and model.mass.sum() == 1000
+    springs = model.springs
+    assert len(springs) == model.num_springs == 12876
+    assert [springs.count(t) for t in ("structural", "shear", "bending")] == [2700, 7776, 2400]
+    assert springs.a.dtype == np.int32 and springs.type.dtype == np.uint8
+    assert not springs.ks.flags.writeable
+    assert set(jelly.integrator_names()) >= {"explicit_euler", "implicit_euler", "midpoint", "rk4"}
+    assert "rk4" in jelly.integrator_infos()
+    sim.run_until(0.1)
+    assert sim.integrator.statistics()["steps"] == 100
+    assert sim.integrator.name == "rk4" and sim.total_steps == 100
+
+
+def test_simulator_from_code_and_coefficient_setters(scenes):
+    spec = jelly.CubeSpec()
+    spec.n = 4
+    spec.set_springs("shear", 900, 20)
+    model = jelly.build_cube(spec)
+    options = jelly.SimulatorOptions()
+    options.dt = 0.002
+    options.output_interval = 0.1
+    sim = jelly.Simulator(model, integrator="midpoint", options=options)
+    sim.add_terrain(jelly.Plane.slope(20))
+    assert sim.run_until(0.5).ok
+    # The same run from a scene gives the same numbers.
+    scene = jelly.Scene({"cube": {"n": 4}, "springs": {"shear": {"ks": 900, "kd": 20}},
+                         "terrains": [{"kind": "slope"}], "duration": 0.5,
+                         "integrator": {"name": "midpoint", "dt": 0.002}, "output_interval": 0.1})
+    other = jelly.Simulator(scene)
+    other.run_until(0.5)
+    assert np.array_equal(sim.state.x, other.state.x)
+    # Changing coefficients between runs equals building with them.
+    a = jelly.Simulator(jelly.load_scene(scenes / "drop_coulomb.json"))
+    a.set_spring_coefficients(jelly.SpringType.bending, 700, 10)
+    b = jelly.Simulator(jelly.load_scene(scenes / "drop_coulomb.json",
+                                         {"springs.bending.ks": 700, "springs.bending.kd": 10}))
+    a.run_until(0.3)
+    b.run_until(0.3)
+    assert np.array_equal(a.state.x, b.state.x)
+    with pytest.raises(jelly.InputError, match="unknown integrator 'rk5'"):
+        jelly.Simulator(model, integrator="rk5")
+
+
+def test_run_until_releases_the_gil(scenes):
+    sim = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json"))
+    started = threading.Event()
+
+    def run():
+        started.set()
+        sim.run_until(0.3)
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    started.wait()
+    spins = 0
+    while thread.is_alive():
+        spins += 1
+    thread.join()
+    # With the GIL held by run_until this loop could not run while the thread simulates.
+    assert spins > 10000

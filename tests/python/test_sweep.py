@@ -1,0 +1,71 @@
+"""Sweeps on Dask distributed: a LocalCluster of 2 workers gives what a serial loop gives."""
+
+import math
+
+import numpy as np
+import pandas
+import pytest
+from distributed import Client, LocalCluster
+
+import jelly
+
+PARAMETERS = {"springs.structural.ks": [800, 4000], "integrator.dt": [0.002, 0.008]}
+
+
+@pytest.fixture(scope="module")
+def client():
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as c:
+        yield c
+
+
+def small_scene(scenes):
+    return jelly.load_scene(scenes / "drop_coulomb.json", {
+        "cube.n": 5, "integrator.name": "explicit_euler", "duration": 0.6})
+
+
+def test_sweep_equals_a_serial_loop(scenes, tmp_path, client):
+    scene = small_scene(scenes)
+    table = jelly.sweep(scene, PARAMETERS, client=client, out_dir=tmp_path / "sweep")
+    assert list(table.columns) == ["run", *PARAMETERS, *jelly._sweep.SUMMARY_COLUMNS]
+    assert len(table) == 4
+    assert pandas.read_csv(tmp_path / "sweep" / "summary.csv").shape == table.shape
+
+    for i, point in enumerate(jelly.sweep_points(PARAMETERS)):
+        row = table.iloc[i]
+        assert [row[p] for p in PARAMETERS] == list(point.values())
+        one = scene.with_overrides(point)
+        sim = jelly.Simulator(one)
+        serial_file = str(tmp_path / f"serial_{i}.h5")
+        with jelly.H5Recorder(serial_file, sim, one) as recorder:
+            sim.add_observer(recorder)
+            report = sim.run_until(0.6)
+        assert row["status"] == report.status
+        assert row["t_end"] == report.t and row["steps"] == report.steps
+        energy = sim.total_energy()
+        if math.isfinite(energy):
+            assert row["final_energy"] == energy
+        if report.status == "diverged":
+            assert row["t_diverged"] == report.t
+        else:
+            assert math.isnan(row["t_diverged"])
+        swept, serial = jelly.read_recording(row["file"]), jelly.read_recording(serial_file)
+        assert np.array_equal(swept.time, serial.time)
+        assert np.array_equal(swept.position, serial.position)
+        assert np.array_equal(swept.velocity, serial.velocity)
+    # explicit Euler at dt = 0.008 with the stiff springs does not survive
+    assert set(table["status"]) == {"completed", "diverged"}
+
+
+def test_sweep_rejects_a_bad_point_before_running(scenes, tmp_path):
+    with pytest.raises(jelly.InputError, match=r"integrator\.dt = -1 is invalid"):
+        jelly.sweep(small_scene(scenes), {"integrator.dt": [0.001, -1]}, out_dir=tmp_path)
+    with pytest.raises(TypeError, match="must be a list"):
+        jelly.sweep(small_scene(scenes), {"integrator.dt": 0.001}, out_dir=tmp_path)
+
+
+def test_sweep_on_its_own_local_cluster_without_files(scenes):
+    table = jelly.sweep(small_scene(scenes), {"springs.shear.kd": [5, 40]}, out_dir=None,
+                        n_workers=2)
+    assert list(table["status"]) == ["completed", "completed"]
+    assert list(table["file"]) == ["", ""]
