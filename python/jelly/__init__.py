@@ -10,7 +10,7 @@ from typing import Any as _Any, Optional as _Optional, Union as _Union
 
 from . import _jelly
 from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module folder)
-    ArkodeOptions, Checkpoint, ContactParams, CubeSpec, DivergenceGuard, Elevator, ElevatorSpec,
+    AnchorSpring, ArkodeOptions, Checkpoint, ContactParams, CubeSpec, DivergenceGuard, Elevator, ElevatorSpec,
     FitOptions, FitResult, FittedParameter, H5Recorder, ImplicitEulerOptions, InputError,
     Integrator, IntegratorOptions, Model, Observer, Plane, RecorderOptions, Recording, RunReport,
     SimulatorOptions, SimulatorSnapshot, Simulator, SpringCoefficients, Springs, SpringType, State,

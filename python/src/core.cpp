@@ -1,5 +1,6 @@
 // core/: the model (masses, springs as NumPy arrays), the state, the cube builder, energies and
 // momenta.
+#include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/cube.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/core/model.hpp>
@@ -54,7 +55,7 @@ void bind_core(py::module_& m) {
 
   py::class_<Springs>(m, "Springs",
                       "Springs stored once each as parallel arrays (read-only NumPy views of the "
-                      "C++ memory; change coefficients with Simulator.set_spring_coefficients).")
+                      "C++ memory; other coefficients: a scene with them, or build_cube).")
       .def_property_readonly(
           "a",
           [](py::object self) {
@@ -200,6 +201,24 @@ void bind_core(py::module_& m) {
         "The model at rest in its construction pose, at t = 0.");
   m.def("cube_index", &cube_index, py::arg("n"), py::arg("i"), py::arg("j"), py::arg("k"),
         "Index of lattice particle (i, j, k) of an n x n x n cube: (i*n + j)*n + k.");
+
+  py::class_<AnchorSpring>(m, "AnchorSpring",
+                           "A spring from a particle to a point in space (a pull from outside the "
+                           "model, as the viewer's mouse drag): f = -k (x_p - target) - c v_p.")
+      .def(py::init([](int particle, const Vec3& target, Real stiffness, Real damping) {
+             return AnchorSpring{particle, target, stiffness, damping};
+           }),
+           py::arg("particle"), py::arg("target"), py::arg("stiffness"), py::arg("damping") = 0.0,
+           "An anchor of a particle to a target point (m) with stiffness k (N/m) and damping c "
+           "(N s/m) on the particle's own velocity.")
+      .def_readwrite("particle", &AnchorSpring::particle, "The particle's index.")
+      .def_readwrite("target", &AnchorSpring::target, "The point it is pulled to (m).")
+      .def_readwrite("stiffness", &AnchorSpring::stiffness, "k (N/m), >= 0.")
+      .def_readwrite("damping", &AnchorSpring::damping, "c (N s/m), >= 0.")
+      .def("__repr__", [](const AnchorSpring& a) {
+        return "AnchorSpring(particle=" + std::to_string(a.particle) +
+               ", stiffness=" + to_text(a.stiffness) + ", damping=" + to_text(a.damping) + ")";
+      });
 
   m.def("kinetic_energy", py::overload_cast<const Model&, const State&>(&kinetic_energy),
         py::arg("model"), py::arg("state"), "sum m |v|^2 / 2 (J).");

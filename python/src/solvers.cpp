@@ -293,18 +293,11 @@ void bind_solvers(py::module_& m) {
           "set_state", [](Simulator& s, const State& state) { s.set_state(state); },
           py::arg("state"),
           "Replaces the state (a restart): forgets the active contacts, restarts the output clock.")
-      .def(
-          "set_spring_coefficients",
-          [](Simulator& s, SpringType type, Real ks, Real kd) {
-            require(std::isfinite(ks) && ks >= 0, "ks", ks, "a finite stiffness >= 0");
-            require(std::isfinite(kd) && kd >= 0, "kd", kd, "a finite damping >= 0");
-            s.mutable_model().springs.set_coefficients(type, {ks, kd});
-          },
-          py::arg("type"), py::arg("ks"), py::arg("kd"),
-          "Sets ks and kd of every spring of a type (taken by the next step).")
-      .def(
-          "set_gravity", [](Simulator& s, const Vec3& g) { s.mutable_model().gravity = g; },
-          py::arg("gravity"), "Sets gravity (m/s^2), taken by the next step.")
+      .def("set_anchors", &Simulator::set_anchors, py::arg("anchors"),
+           "Springs pulling particles to points (a list of AnchorSpring), part of the forces of "
+           "every step until replaced ([] removes them); implicit integrators take them into "
+           "their solve. Raises InputError for an invalid anchor. Not part of snapshots.")
+      .def_property_readonly("anchors", &Simulator::anchors, "The anchors in force (copies).")
       .def("snapshot", &Simulator::snapshot, "A SimulatorSnapshot to restore later (bit for bit).")
       .def("restore", &Simulator::restore, py::arg("snapshot"),
            "Continues from a snapshot of a simulator with the same model, terrains, integrator "
