@@ -29,7 +29,9 @@ def main():
                                      "duration": 0.5,
                                      **{f"springs.{t}": truth for t in jelly.spring_type_names()}})
     sim = jelly.Simulator(scene)
-    with jelly.H5Recorder(recording_path, sim, scene) as recorder:
+    options = jelly.RecorderOptions()
+    options.overwrite = True  # this example's own file of an earlier run
+    with jelly.H5Recorder(recording_path, sim, scene, options) as recorder:
         sim.add_observer(recorder)
         print(sim.run_until(scene.duration).brief())
 

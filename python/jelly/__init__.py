@@ -15,7 +15,7 @@ from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module f
     Integrator, IntegratorOptions, Model, Observer, Plane, RecorderOptions, Recording, RunReport,
     SimulatorOptions, SimulatorSnapshot, Simulator, SpringCoefficients, Springs, SpringType, State,
     StepResult, Terrain, __version__, angular_momentum, apply_override, build_cube,
-    center_of_mass, cube_index, describe_recording, elastic_energy, gravitational_energy,
+    center_of_mass, check_same_scene, cube_index, describe_recording, elastic_energy, gravitational_energy,
     integrator_infos, integrator_names, kinetic_energy, linear_momentum, parse_free_parameters,
     read_checkpoint, read_recording, rest_state, restore, scene_to_json, spring_type_names,
     total_energy, write_xdmf_for_recording)

@@ -112,7 +112,10 @@ void bind_io(py::module_& m) {
       .def_readwrite("write_xdmf", &RecorderOptions::write_xdmf,
                      "Write the .xdmf sidecar at each run's end.")
       .def_readwrite("background_writer", &RecorderOptions::background_writer,
-                     "Compress and write on a second thread.");
+                     "Compress and write on a second thread.")
+      .def_readwrite("overwrite", &RecorderOptions::overwrite,
+                     "Replace an existing file (written aside, moved on at the first on_finish); "
+                     "False: an existing file is an InputError.");
 
   py::class_<PyH5Recorder, Observer>(m, "H5Recorder",
                                      "An observer recording a run to HDF5 (+ XDMF sidecar). Add it "
@@ -232,8 +235,11 @@ void bind_io(py::module_& m) {
       "file when it is missing, not HDF5 or not a jelly recording.");
   m.def("describe_recording", &describe_recording, py::arg("path"),
         "What a recording holds, one item per line (as jelly info prints it).");
-  m.def("write_xdmf_for_recording", &write_xdmf_for_recording, py::arg("path"),
-        "Writes <path without .h5>.xdmf for an existing recording (e.g. of a killed run).");
+  m.def(
+      "write_xdmf_for_recording",
+      [](const std::string& path) { return write_xdmf_for_recording(path); }, py::arg("path"),
+      "Writes the XDMF sidecar of an existing recording (e.g. of a killed run) and returns its "
+      "path.");
 
   py::class_<Checkpoint>(m, "Checkpoint", "A restart point stored in a recording's /checkpoint.")
       .def_readonly("state", &Checkpoint::state, "The state (a copy).")
@@ -242,9 +248,22 @@ void bind_io(py::module_& m) {
       .def_readonly("integrator", &Checkpoint::integrator,
                     "The integrator of the run that wrote it.")
       .def_readonly("dt", &Checkpoint::dt, "The time step of the run that wrote it (s).")
+      .def_readonly("output_interval", &Checkpoint::output_interval,
+                    "The output interval of the run that wrote it (s).")
+      .def_readonly("scene_json", &Checkpoint::scene_json,
+                    "The scene of the run that wrote it (empty when none was stored).")
       .def("snapshot", &Checkpoint::snapshot, "As a SimulatorSnapshot (Simulator.restore).");
   m.def("read_checkpoint", &read_checkpoint, py::arg("path"),
         "The checkpoint a recording holds. Raises InputError for a missing or invalid file.");
+  m.def(
+      "check_same_scene",
+      [](const Checkpoint& cp, const Scene& scene, const std::string& source) {
+        check_same_scene(cp, scene, source);
+      },
+      py::arg("checkpoint"), py::arg("scene"), py::arg("source") = "checkpoint",
+      "Raises InputError naming the first JSON path at which the scene differs from the one the "
+      "checkpoint's run was recorded with (duration, output_interval, divergence and "
+      "description may differ): a restart continues the same run.");
   m.def("restore", &restore, py::arg("simulator"), py::arg("checkpoint"),
         "Continues a simulator from a checkpoint, bit for bit; raises InputError when its "
         "particle count, integrator or time step differ from the run that wrote it.");

@@ -65,6 +65,9 @@ def test_checkpoint_restart_is_bit_for_bit(scenes, tmp_path):
     b.run_until(0.9)
     assert np.array_equal(a.state.x, b.state.x)
 
+    jelly.check_same_scene(checkpoint, scene.with_overrides({"duration": 5}))
+    with pytest.raises(jelly.InputError, match=r"springs\.structural\.ks"):
+        jelly.check_same_scene(checkpoint, scene.with_overrides({"springs.structural.ks": 9}))
     other = jelly.Simulator(scene.with_overrides({"integrator.name": "midpoint"}))
     with pytest.raises(jelly.InputError, match="integrator"):
         jelly.restore(other, checkpoint)
@@ -94,3 +97,8 @@ def test_recorder_errors_and_close(scenes, tmp_path):
         rec.scene
     with pytest.raises(jelly.InputError):
         jelly.read_recording(str(tmp_path / "missing.h5"))
+    # An existing file is replaced only when told to.
+    with pytest.raises(jelly.InputError):
+        jelly.H5Recorder(str(tmp_path / "r.h5"), jelly.Simulator(scene))
+    options.overwrite = True
+    jelly.H5Recorder(str(tmp_path / "r.h5"), jelly.Simulator(scene), None, options).close()
