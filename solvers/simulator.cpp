@@ -54,8 +54,11 @@ void Simulator::set_anchors(AnchorSprings anchors) {
   anchors_ = std::move(anchors);
 }
 
-void Simulator::remove_observer(Observer& observer) {
-  observers_.erase(std::remove(observers_.begin(), observers_.end(), &observer), observers_.end());
+bool Simulator::remove_observer(const Observer& observer) {
+  const auto end = std::remove(observers_.begin(), observers_.end(), &observer);
+  const bool found = end != observers_.end();
+  observers_.erase(end, observers_.end());
+  return found;
 }
 
 namespace {

@@ -66,8 +66,8 @@ class Simulator {
   void check_no_overlap();
   // The observer must outlive the runs it observes.
   void add_observer(Observer& observer);
-  // Stops calling `observer` (one added before; any other is ignored).
-  void remove_observer(Observer& observer);
+  // Stops calling `observer`; false when it was not added.
+  bool remove_observer(const Observer& observer);
 
   // One step of options().dt, then contact. Returns the integrator's failure, if any; does not
   // check divergence (run_until does).

@@ -257,7 +257,7 @@ void bind_solvers(py::module_& m) {
       .def("add_observer", &Simulator::add_observer, py::arg("observer"), py::keep_alive<1, 2>(),
            "Calls observer.on_frame at every output frame of run_until (and on_finish at its end).")
       .def("remove_observer", &Simulator::remove_observer, py::arg("observer"),
-           "Stops calling an observer added before.")
+           "Stops calling an observer added before; False when it was not added.")
       .def("step", &Simulator::step, py::call_guard<py::gil_scoped_release>(),
            "One step of options.dt, then contact (the GIL is released). Returns a StepResult; "
            "does not check divergence (run_until does).")

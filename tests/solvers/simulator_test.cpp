@@ -67,7 +67,8 @@ TEST(Simulator, RemovedObserverIsNotCalled) {
   ASSERT_TRUE(sim.run_until(0.2).ok());
   EXPECT_EQ(a, 3);
   EXPECT_EQ(b, 3);
-  sim.remove_observer(pa);
+  EXPECT_TRUE(sim.remove_observer(pa));
+  EXPECT_FALSE(sim.remove_observer(pa));
   ASSERT_TRUE(sim.run_until(0.4).ok());
   EXPECT_EQ(a, 3);
   EXPECT_EQ(b, 5);
