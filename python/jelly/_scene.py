@@ -89,10 +89,17 @@ class Scene(_jelly._Scene):
         return _copy.deepcopy(self._full())
 
     def get(self, path: str) -> Any:
-        """The value at a JSON path ('springs.structural.ks', 'terrains[0].kind'), as plain
-        Python data (a copy). Raises KeyError for a path the scene does not have."""
+        """The value at a JSON path ('bodies[0].springs.structural.ks', 'terrains[0].kind'), as
+        plain Python data (a copy). Raises KeyError for a path the scene does not have.
+
+        Paths read the full JSON (to_json()), where every scene has its ``bodies``; a one-cube
+        scene file's own keys ``cube`` and ``springs`` (which the full JSON writes as bodies[0])
+        read as the file wrote them."""
         value: Any = self._full()
-        for step in _split(path):
+        steps = _split(path)
+        if steps and steps[0] not in value:
+            value = self._source_dict()
+        for step in steps:
             try:
                 value = value[step]
             except (KeyError, IndexError, TypeError):
@@ -109,6 +116,7 @@ class Scene(_jelly._Scene):
         together; raises InputError and leaves the scene unchanged if the result is invalid."""
         text = self._source
         for assignment in assignments(overrides):
+            text = self._target_text(text, assignment)
             text = _jelly.apply_override(text, assignment)
         self._assign(text, self._name)  # raises before anything changes
         object.__setattr__(self, "_source", text)
@@ -139,11 +147,29 @@ class Scene(_jelly._Scene):
             object.__setattr__(self, "_cache", json.loads(self.to_json()))
         return self._cache
 
+    def _source_dict(self) -> dict[str, Any]:
+        return json.loads(self._source)
+
+    def _target_text(self, text: str, assignment: str) -> str:
+        """The JSON an override applies to: the scene's own text, unless the path goes into a
+        list that only the full JSON has (``bodies[0]...`` of a one-cube scene file written
+        with ``cube`` and ``springs``): then the full JSON, the same scene with its bodies."""
+        steps = _split(assignment.partition("=")[0])
+        if not steps or not isinstance(steps[0], str) or steps[0] in json.loads(text):
+            return text
+        full = json.loads(Scene(text, (), self._name).to_json())
+        if isinstance(full.get(steps[0]), list):
+            return json.dumps(full)
+        return text
+
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_"):
             raise AttributeError(name)
         full = self._full()
         if name not in full:
+            source = self._source_dict()
+            if name in source:  # a one-cube scene file's "cube" and "springs"
+                return _wrap(self, name, source[name])
             raise AttributeError(f"the scene has no field '{name}'; its fields: "
                                  + ", ".join(full))
         return _wrap(self, name, full[name])
@@ -154,7 +180,7 @@ class Scene(_jelly._Scene):
         self.set(name, value)
 
     def __dir__(self) -> list[str]:
-        return sorted(set(super().__dir__()) | set(self._full()))
+        return sorted(set(super().__dir__()) | set(self._full()) | set(self._source_dict()))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, _jelly._Scene):

@@ -9,8 +9,10 @@
 #include <string>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/springs.hpp>
 #include <jelly/core/types.hpp>
 #include <jelly/io/recording.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 namespace jelly::python {
 
@@ -75,8 +77,25 @@ struct PyRecording {
   py::object position, velocity;
 };
 
+// A spring type from a SpringType or its name ("structural", "shear", "bending").
+inline SpringType spring_type_from(const py::object& type) {
+  if (py::isinstance<py::str>(type)) {
+    const std::string name = type.cast<std::string>();
+    for (int t = 0; t < kSpringTypeCount; ++t) {
+      if (spring_type_name(static_cast<SpringType>(t)) == name) return static_cast<SpringType>(t);
+    }
+    throw InputError("spring type", "\"" + name + "\"", "\"structural\", \"shear\" or \"bending\"");
+  }
+  return type.cast<SpringType>();
+}
+
+// A terrain of any registered kind from its scene JSON (a dict or JSON text), validated with
+// messages naming "terrain.<field>" (terrain.cpp).
+std::unique_ptr<Terrain> terrain_from_spec(const py::object& spec);
+
 // One binding function per C++ module folder, called in layer order by module.cpp.
 void bind_core(py::module_& m);
+void bind_geometry(py::module_& m);
 void bind_terrain(py::module_& m);
 void bind_solvers(py::module_& m);
 void bind_io(py::module_& m);

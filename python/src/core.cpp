@@ -1,10 +1,13 @@
-// core/: the model (masses, springs as NumPy arrays), the state, the cube builder, energies and
-// momenta.
+// core/: the model (masses, springs as NumPy arrays, its bodies with their render surfaces,
+// pins and external forces), the state, energies and momenta.
 #include <jelly/core/anchor_springs.hpp>
-#include <jelly/core/cube.hpp>
+#include <jelly/core/body.hpp>
+#include <jelly/core/external_force.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/core/model.hpp>
+#include <jelly/core/pins.hpp>
 #include <jelly/core/state.hpp>
+#include <jelly/core/surface.hpp>
 
 #include "common.hpp"
 
@@ -12,15 +15,33 @@ namespace jelly::python {
 
 namespace {
 
-SpringType spring_type_from(const py::object& type) {
-  if (py::isinstance<py::str>(type)) {
-    const std::string name = type.cast<std::string>();
-    for (int t = 0; t < kSpringTypeCount; ++t) {
-      if (spring_type_name(static_cast<SpringType>(t)) == name) return static_cast<SpringType>(t);
-    }
-    throw InputError("spring type", "\"" + name + "\"", "\"structural\", \"shear\" or \"bending\"");
+// The positions of a State, or an (N, 3) / (3N,) array of them, as the flat vector they are
+// in C++ (copied only for an array).
+VecX positions_of(const py::object& x, const std::string& field) {
+  if (py::isinstance<State>(x)) return x.cast<const State&>().x;
+  return flat_n3(x.cast<DoubleArray>(), field);
+}
+
+// Rows [first, first + count) of a flat 3N vector as an (count, 3) view owned by `owner`.
+py::array rows_view(const VecX& v, int first, int count, py::handle owner) {
+  py::array a(py::dtype::of<Real>(), {py::ssize_t{count}, py::ssize_t{3}},
+              {static_cast<py::ssize_t>(3 * sizeof(Real)), static_cast<py::ssize_t>(sizeof(Real))},
+              v.data() + 3 * static_cast<py::ssize_t>(first), owner);
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+// The vertex positions of a surface for the positions of a State (or an array of them), a new
+// (V, 3) array.
+py::array vertices_of(const Surface& surface, const py::object& x) {
+  const VecX flat = positions_of(x, "x");
+  for (int p : surface.particles) {
+    require(3 * static_cast<Eigen::Index>(p) + 2 < flat.size(), "x.size", flat.size() / 3,
+            "the model's particles (the surface uses particle " + std::to_string(p) + ")");
   }
-  return type.cast<SpringType>();
+  RowMatrixX3 out;
+  surface.vertices(flat, out);
+  return py::array(py::cast(std::move(out)));
 }
 
 }  // namespace
@@ -105,6 +126,186 @@ void bind_core(py::module_& m) {
           [](const Springs& s, const py::object& type) { return s.count(spring_type_from(type)); },
           py::arg("type"), "The number of springs of a type (a SpringType or its name).");
 
+  py::class_<Surface>(m, "Surface",
+                      "The triangle surface a person sees of a body: vertex v is the weighted sum "
+                      "of particle positions sum_k weights[k] x[particles[k]] for k in "
+                      "[offsets[v], offsets[v+1]); triangles are counter-clockwise seen from "
+                      "outside. Arrays are read-only views of the C++ memory; particle indices "
+                      "are the model's (global).")
+      .def_property_readonly(
+          "triangles",
+          [](py::object self) {
+            const Surface& s = self.cast<const Surface&>();
+            static_assert(sizeof(Triangle) == 3 * sizeof(int));
+            py::array a(
+                py::dtype::of<int>(), {py::ssize_t{s.num_triangles()}, py::ssize_t{3}},
+                {static_cast<py::ssize_t>(sizeof(Triangle)), static_cast<py::ssize_t>(sizeof(int))},
+                s.triangles.empty() ? nullptr : s.triangles.front().data(), self);
+            py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+            return a;
+          },
+          "Vertex indices of each triangle, int32 [T, 3].")
+      .def_property_readonly(
+          "offsets",
+          [](py::object self) {
+            const Surface& s = self.cast<const Surface&>();
+            return view(s.offsets.data(), static_cast<py::ssize_t>(s.offsets.size()), self);
+          },
+          "Where each vertex's particles and weights start, int32 [V + 1].")
+      .def_property_readonly(
+          "particles",
+          [](py::object self) {
+            const Surface& s = self.cast<const Surface&>();
+            return view(s.particles.data(), static_cast<py::ssize_t>(s.particles.size()), self);
+          },
+          "The particles of the vertices' weighted sums, int32.")
+      .def_property_readonly(
+          "weights",
+          [](py::object self) {
+            const Surface& s = self.cast<const Surface&>();
+            return view(s.weights.data(), static_cast<py::ssize_t>(s.weights.size()), self);
+          },
+          "The weights of the vertices' weighted sums, float64.")
+      .def_property_readonly("num_vertices", &Surface::num_vertices, "The number of vertices V.")
+      .def_property_readonly("num_triangles", &Surface::num_triangles, "The number of triangles T.")
+      .def("vertices", &vertices_of, py::arg("x"),
+           "The vertex positions (m), a new float64 [V, 3] array, for the positions of a State "
+           "(or an (N, 3) array of the whole model's particles).")
+      .def("__len__", &Surface::num_triangles, "The number of triangles.")
+      .def("__repr__", [](const Surface& s) {
+        return "<jelly.Surface with " + std::to_string(s.num_vertices()) + " vertices and " +
+               std::to_string(s.num_triangles()) + " triangles>";
+      });
+
+  py::class_<Body>(m, "Body",
+                   "A body of the model: a named range of its particles and springs (kind "
+                   "\"cube\", \"box\", \"cloth\", ...: jelly.body_kinds()) with its render "
+                   "surface. Scenes describe bodies in their \"bodies\" list.")
+      .def_readonly("name", &Body::name, "Unique in the model (the HDF5 group /particles/<name>).")
+      .def_readonly("kind", &Body::kind, "The body kind that built it.")
+      .def_readonly("first_particle", &Body::first_particle, "Its first particle's index.")
+      .def_readonly("num_particles", &Body::num_particles, "Its number of particles.")
+      .def_readonly("first_spring", &Body::first_spring, "Its first spring's index.")
+      .def_readonly("num_springs", &Body::num_springs, "Its number of springs.")
+      .def_readonly("spacing", &Body::spacing,
+                    "Typical distance between neighbouring particles (m).")
+      .def_readonly("radius", &Body::radius, "Contact radius of its particles (m).")
+      .def_property_readonly(
+          "particles",
+          [](const Body& b) {
+            return py::module_::import("builtins")
+                .attr("range")(b.first_particle, b.end_particle());
+          },
+          "Its particle indices, range(first_particle, first_particle + num_particles): "
+          "state.x[body.particles] are its positions.")
+      .def_property_readonly(
+          "springs",
+          [](const Body& b) {
+            return py::module_::import("builtins").attr("range")(b.first_spring, b.end_spring());
+          },
+          "Its spring indices, a range into model.springs' arrays.")
+      .def_property_readonly(
+          "surface", [](const Body& b) -> const Surface& { return b.surface; },
+          py::return_value_policy::reference_internal,
+          "Its render Surface (triangles over vertices that follow the particles).")
+      .def_property_readonly(
+          "groups",
+          [](py::object self) {
+            py::dict d;
+            for (const ParticleGroup& g : self.cast<const Body&>().groups) {
+              d[py::str(g.name)] =
+                  view(g.particles.data(), static_cast<py::ssize_t>(g.particles.size()), self);
+            }
+            return d;
+          },
+          "Named particle groups (a cloth's corners, ...) as {name: int32 array of global "
+          "indices}.")
+      .def("contains", &Body::contains, py::arg("particle"), "Whether it holds particle i.")
+      .def(
+          "x",
+          [](const Body& b, py::object state) {
+            const State& s = state.cast<const State&>();
+            require(b.end_particle() <= s.x.size() / 3, "state.num_particles", s.x.size() / 3,
+                    "at least " + std::to_string(b.end_particle()) + " (body " + b.name + ")");
+            return rows_view(s.x, b.first_particle, b.num_particles, state);
+          },
+          py::arg("state"),
+          "Its particles' positions in a State, a read-only (num_particles, 3) view (no copy).")
+      .def(
+          "v",
+          [](const Body& b, py::object state) {
+            const State& s = state.cast<const State&>();
+            require(b.end_particle() <= s.v.size() / 3, "state.num_particles", s.v.size() / 3,
+                    "at least " + std::to_string(b.end_particle()) + " (body " + b.name + ")");
+            return rows_view(s.v, b.first_particle, b.num_particles, state);
+          },
+          py::arg("state"),
+          "Its particles' velocities in a State, a read-only (num_particles, 3) view (no copy).")
+      .def(
+          "surface_vertices",
+          [](const Body& b, const py::object& x) { return vertices_of(b.surface, x); },
+          py::arg("x"),
+          "Its render surface's vertex positions (m), a new float64 [V, 3] array, for the "
+          "positions of a State (or an (N, 3) array of the whole model's particles).")
+      .def("__repr__", [](const Body& b) {
+        return "<jelly.Body '" + b.name + "' (" + b.kind + ") particles [" +
+               std::to_string(b.first_particle) + ", " + std::to_string(b.end_particle()) + "), " +
+               std::to_string(b.surface.num_triangles()) + " surface triangles>";
+      });
+
+  py::class_<Pins>(m, "Pins",
+                   "Pinned particles: held at their anchor or moved along a prescribed path; "
+                   "every integrator honours them exactly.")
+      .def_property_readonly(
+          "particles",
+          [](py::object self) {
+            const Pins& p = self.cast<const Pins&>();
+            return view(p.particles.data(), static_cast<py::ssize_t>(p.particles.size()), self);
+          },
+          "The pinned particles' global indices, int32 [P].")
+      .def_property_readonly(
+          "anchors",
+          [](const Pins& p) {
+            RowMatrixX3 a(p.size(), 3);
+            for (int k = 0; k < p.size(); ++k) a.row(k) = p.anchors[k].transpose();
+            return a;
+          },
+          "Their positions at t = 0 (m), a copy [P, 3].")
+      .def(
+          "positions",
+          [](const Pins& p, Real t) {
+            RowMatrixX3 a(p.size(), 3);
+            for (int k = 0; k < p.size(); ++k) a.row(k) = p.position(k, t).transpose();
+            return a;
+          },
+          py::arg("t"), "Where their paths put them at time t (m), [P, 3].")
+      .def_property_readonly("all_fixed", &Pins::all_fixed, "Whether no pin moves.")
+      .def("__len__", &Pins::size, "The number of pinned particles.");
+
+  py::class_<ExternalForce>(m, "ExternalForce",
+                            "A force from outside the bodies (a scene body's \"forces\"): "
+                            "constant (N, spread by mass), wind (drag towards the air's "
+                            "velocity) or point (N on each particle), with an optional gust and "
+                            "time window.")
+      .def_property_readonly(
+          "kind",
+          [](const ExternalForce& f) { return std::string(external_force_kind_name(f.kind)); },
+          "\"constant\", \"wind\" or \"point\".")
+      .def_property_readonly(
+          "particles",
+          [](py::object self) {
+            const ExternalForce& f = self.cast<const ExternalForce&>();
+            return view(f.particles.data(), static_cast<py::ssize_t>(f.particles.size()), self);
+          },
+          "The global indices of the particles it acts on, int32.")
+      .def_readonly("vector", &ExternalForce::vector, "Force (N) or, for wind, air velocity (m/s).")
+      .def_readonly("drag", &ExternalForce::drag, "Wind: N s/m per particle.")
+      .def_readonly("gust", &ExternalForce::gust, "vector(t) = vector (1 + gust sin(2 pi f t)).")
+      .def_readonly("gust_frequency", &ExternalForce::gust_frequency, "f (Hz).")
+      .def_readonly("start", &ExternalForce::start, "It acts for start <= t < end (s).")
+      .def_readonly("end", &ExternalForce::end, "See start (s; inf = for ever).")
+      .def("vector_at", &ExternalForce::vector_at, py::arg("t"), "vector(t).");
+
   py::class_<Model>(m, "Model",
                     "The mass-spring model: particle masses, springs and gravity. Arrays are "
                     "read-only NumPy views of the C++ memory.")
@@ -125,6 +326,52 @@ void bind_core(py::module_& m) {
       .def_property_readonly(
           "gravity", [](const Model& md) { return Vec3(md.gravity); },
           "Gravity (m/s^2), a copy [3].")
+      .def_property_readonly(
+          "bodies",
+          [](py::object self) {
+            py::list out;
+            for (const Body& b : self.cast<const Model&>().bodies) {
+              out.append(py::cast(&b, py::return_value_policy::reference_internal, self));
+            }
+            return out;
+          },
+          "Its bodies in particle order (Body; views alive with the model).")
+      .def(
+          "body",
+          [](py::object self, const std::string& name) {
+            const Model& md = self.cast<const Model&>();
+            const Body* b = md.find_body(name);
+            if (!b) {
+              std::string names;
+              for (const Body& other : md.bodies) names += (names.empty() ? "" : ", ") + other.name;
+              throw py::key_error("the model has no body '" + name + "'; its bodies: " + names);
+            }
+            return py::cast(b, py::return_value_policy::reference_internal, self);
+          },
+          py::arg("name"), "The body of that name (KeyError listing the names otherwise).")
+      .def(
+          "body_of",
+          [](py::object self, int particle) {
+            const Model& md = self.cast<const Model&>();
+            require(particle >= 0 && particle < md.num_particles(), "particle", particle,
+                    "an index in [0, " + std::to_string(md.num_particles()) + ")");
+            return py::cast(&md.body_of(particle), py::return_value_policy::reference_internal,
+                            self);
+          },
+          py::arg("particle"), "The body that holds a particle.")
+      .def_property_readonly(
+          "pins", [](const Model& md) -> const Pins& { return md.pins; },
+          py::return_value_policy::reference_internal, "The pinned particles (Pins).")
+      .def_property_readonly(
+          "external_forces",
+          [](py::object self) {
+            py::list out;
+            for (const ExternalForce& f : self.cast<const Model&>().external_forces) {
+              out.append(py::cast(&f, py::return_value_policy::reference_internal, self));
+            }
+            return out;
+          },
+          "Forces from outside the bodies (ExternalForce), besides gravity.")
       .def_property_readonly("num_particles", &Model::num_particles, "The number of particles N.")
       .def_property_readonly(
           "num_springs", [](const Model& md) { return md.springs.size(); },
@@ -170,38 +417,8 @@ void bind_core(py::module_& m) {
                " particles>";
       });
 
-  py::class_<CubeSpec>(m, "CubeSpec",
-                       "The seed's jelly cube: an n x n x n lattice with structural, shear and "
-                       "bending springs. Defaults are the seed's (n 10, edge 4 m, ks 1400, kd 50).")
-      .def(py::init<>(), "The seed cube.")
-      .def_readwrite("n", &CubeSpec::n, "Particles per edge, >= 2.")
-      .def_readwrite("edge_length", &CubeSpec::edge_length, "Edge length (m), > 0.")
-      .def_readwrite("origin", &CubeSpec::origin, "Position of particle (0, 0, 0) (m).")
-      .def_readwrite("particle_mass", &CubeSpec::particle_mass, "Mass of each particle (kg).")
-      .def_readwrite("gravity", &CubeSpec::gravity, "Gravity (m/s^2).")
-      .def(
-          "springs",
-          [](CubeSpec& c, const py::object& type) -> SpringCoefficients& {
-            return c.springs[static_cast<int>(spring_type_from(type))];
-          },
-          py::arg("type"), py::return_value_policy::reference_internal,
-          "The coefficients of one spring type (a SpringType or its name), modifiable in place.")
-      .def(
-          "set_springs",
-          [](CubeSpec& c, const py::object& type, Real ks, Real kd) {
-            c.springs[static_cast<int>(spring_type_from(type))] = {ks, kd};
-          },
-          py::arg("type"), py::arg("ks"), py::arg("kd"),
-          "Sets ks (N/m) and kd (N s/m) of one spring type (a SpringType or its name).")
-      .def("validate", &CubeSpec::validate, "Raises InputError naming the first invalid field.");
-
-  m.def("build_cube", &build_cube, py::arg("spec"),
-        "The cube model of a CubeSpec: particle (i, j, k) has index (i*n + j)*n + k.");
   m.def("rest_state", &rest_state, py::arg("model"),
         "The model at rest in its construction pose, at t = 0.");
-  m.def("cube_index", &cube_index, py::arg("n"), py::arg("i"), py::arg("j"), py::arg("k"),
-        "Index of lattice particle (i, j, k) of an n x n x n cube: (i*n + j)*n + k.");
-
   py::class_<AnchorSpring>(m, "AnchorSpring",
                            "A spring from a particle to a point in space (a pull from outside the "
                            "model, as the viewer's mouse drag): f = -k (x_p - target) - c v_p.")

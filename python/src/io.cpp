@@ -97,7 +97,8 @@ void bind_io(py::module_& m) {
   auto simulator = py::reinterpret_borrow<py::class_<Simulator>>(m.attr("Simulator"));
   simulator.def(py::init([](const Scene& scene) { return make_simulator(scene); }),
                 py::arg("scene"),
-                "The scene's cube at rest among its terrains, with its integrator and options "
+                "The scene's bodies at rest (with their pins and forces) among its terrains, with "
+                "its integrator and options "
                 "(as jelly run makes it). Run it with sim.run_until(scene.duration).");
 
   py::class_<RecorderOptions>(m, "RecorderOptions", "Options of H5Recorder (docs/output.md).")

@@ -13,6 +13,7 @@ PYBIND11_MODULE(_jelly, m) {
       "jelly";
   m.attr("__version__") = JELLY_VERSION_STRING;
   jelly::python::bind_core(m);
+  jelly::python::bind_geometry(m);
   jelly::python::bind_terrain(m);
   jelly::python::bind_solvers(m);
   jelly::python::bind_io(m);

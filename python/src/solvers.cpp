@@ -2,7 +2,6 @@
 // observers, the state as NumPy views), run reports. The GIL is released while C++ steps.
 #include <optional>
 
-#include <jelly/core/cube.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/run_report.hpp>
@@ -254,6 +253,12 @@ void bind_solvers(py::module_& m) {
           "add_terrain",
           [](Simulator& s, const Elevator& e) { s.add_terrain(std::make_unique<Elevator>(e)); },
           py::arg("terrain"), "Adds a copy of a terrain.")
+      .def(
+          "add_terrain",
+          [](Simulator& s, const py::object& spec) { s.add_terrain(terrain_from_spec(spec)); },
+          py::arg("spec"),
+          "Adds a terrain of any kind from its scene JSON (a dict or JSON text, see "
+          "make_terrain).")
       .def("add_observer", &Simulator::add_observer, py::arg("observer"), py::keep_alive<1, 2>(),
            "Calls observer.on_frame at every output frame of run_until (and on_finish at its end).")
       .def("remove_observer", &Simulator::remove_observer, py::arg("observer"),

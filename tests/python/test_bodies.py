@@ -1,0 +1,209 @@
+"""Bodies from Python: the scene's "bodies" list, the model's bodies (particle and spring ranges,
+render surfaces as NumPy, groups), pins and external forces, body and terrain kinds, checked
+against geometry (enclosed volumes, spheres) and mechanics (free fall, a constant force, pins
+held exactly)."""
+
+import json
+
+import numpy as np
+import pytest
+
+import jelly
+
+G = np.array([0.0, -9.8, 0.0])
+
+
+def scene_of(bodies, terrains=(), gravity=(0, -9.8, 0), integrator="rk4", dt=1e-3):
+    return jelly.Scene({"bodies": list(bodies), "gravity": list(gravity),
+                        "terrains": list(terrains),
+                        "integrator": {"name": integrator, "dt": dt}, "duration": 1})
+
+
+def enclosed_volume(vertices, triangles):
+    """Volume inside a closed triangle surface (divergence theorem); > 0 when the triangles are
+    counter-clockwise seen from outside."""
+    a, b, c = (vertices[triangles[:, k]] for k in range(3))
+    return np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6
+
+
+def body_com(model, body, state):
+    m = model.mass[body.first_particle:body.first_particle + body.num_particles]
+    return (m[:, None] * body.x(state)).sum(axis=0) / m.sum()
+
+
+def test_body_kinds_are_listed_and_each_builds_its_body():
+    kinds = jelly.body_kinds()
+    assert {"cube", "box", "cloth"} <= set(kinds)
+    assert all(isinstance(d, str) and d for d in kinds.values())
+    for kind in kinds:
+        sim = jelly.Simulator(scene_of([{"kind": kind, "name": "b_" + kind}]))
+        (body,) = sim.model.bodies
+        assert (body.kind, body.name) == (kind, "b_" + kind)
+        assert body.num_particles == sim.model.num_particles
+    assert {"plane", "slope", "elevator", "sphere"} <= set(jelly.terrain_kinds())
+    assert set(jelly.contact_models()) == {"coulomb", "seed"}
+    assert jelly.cube_particle_count(10) == 1000 and jelly.cube_spring_count(10) == 12876
+
+
+def test_bodies_cover_the_model_in_order(scenes):
+    scene = jelly.load_scene(scenes / "two_jellies.json")
+    assert [b.name for b in scene.bodies] == ["soft", "stiff"]  # the scene's list
+    model = jelly.Simulator(scene).model
+    soft, stiff = model.bodies
+    assert (soft.particles, stiff.particles) == (range(0, 216), range(216, 432))
+    assert soft.springs.stop == stiff.springs.start and stiff.springs.stop == model.num_springs
+    assert soft.num_springs == jelly.cube_spring_count(6)
+    # Each body's springs join its own particles.
+    a, b = model.springs.a[stiff.first_spring:], model.springs.b[stiff.first_spring:]
+    assert a.min() >= 216 and b.min() >= 216
+    assert model.body("stiff").name == "stiff" and model.body_of(300).name == "stiff"
+    assert stiff.contains(431) and not stiff.contains(215)
+    with pytest.raises(KeyError, match="its bodies: soft, stiff"):
+        model.body("medium")
+    with pytest.raises(jelly.InputError, match="particle = 432 is invalid"):
+        model.body_of(432)
+
+
+@pytest.mark.parametrize("spec, volume", [
+    ({"kind": "cube", "n": 5, "edge_length": 1.5, "origin": [0, 2, 0]}, 1.5**3),
+    ({"kind": "box", "nx": 4, "ny": 3, "nz": 5, "size": [2, 0.5, 1.2],
+      "rotation_degrees": [10, 20, 30]}, 2 * 0.5 * 1.2),
+])
+def test_closed_surfaces_enclose_the_body_volume(spec, volume):
+    sim = jelly.Simulator(scene_of([dict(spec, name="b")]))
+    body = sim.model.bodies[0]
+    triangles = body.surface.triangles
+    assert triangles.dtype == np.int32 and triangles.shape == (body.surface.num_triangles, 3)
+    assert not triangles.flags.writeable
+    vertices = body.surface_vertices(sim.state)
+    assert vertices.shape == (body.surface.num_vertices, 3)
+    assert enclosed_volume(vertices, triangles) == pytest.approx(volume, rel=1e-12)
+
+
+def test_cloth_surface_is_its_flat_sheet():
+    sim = jelly.Simulator(scene_of([{"kind": "cloth", "name": "c", "nu": 6, "nv": 4,
+                                     "size_u": 2, "size_v": 1.5, "position": [0, 3, 0]}]))
+    body = sim.model.bodies[0]
+    v = body.surface_vertices(sim.state)
+    t = body.surface.triangles
+    normals = np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]) / 2
+    assert np.allclose(v[:, 1], 3.0)
+    assert np.allclose(normals[:, [0, 2]], 0)
+    # One side of the sheet, or both: the area seen from +y is the sheet's.
+    assert np.abs(normals[:, 1][normals[:, 1] > 0]).sum() == pytest.approx(2 * 1.5, rel=1e-12)
+    assert set(body.groups) >= {"corner_00", "corner_10", "corner_01", "corner_11"}
+    corners = np.concatenate([body.groups[k] for k in ("corner_00", "corner_10",
+                                                       "corner_01", "corner_11")])
+    x = sim.state.x[corners]
+    assert sorted(np.round(x[:, 0], 12)) == [-1, -1, 1, 1]
+
+
+def test_surface_vertices_are_the_weighted_particles_and_views_follow_the_state(scenes):
+    scene = jelly.load_scene(scenes / "two_jellies.json", {"duration": 0.2})
+    sim = jelly.Simulator(scene)
+    stiff = sim.model.body("stiff")
+    x_view = stiff.x(sim.state)
+    assert np.shares_memory(x_view, sim.state.x) and not x_view.flags.writeable
+    before = x_view.copy()
+    assert sim.run_until(0.2).ok
+    assert not np.array_equal(x_view, before)  # the same memory, stepped
+    assert np.array_equal(x_view, sim.state.x[stiff.particles.start:stiff.particles.stop])
+    s = stiff.surface
+    x = sim.state.x
+    expected = np.add.reduceat(s.weights[:, None] * x[s.particles], s.offsets[:-1])
+    assert np.allclose(stiff.surface_vertices(sim.state), expected, rtol=0, atol=1e-14)
+    assert np.array_equal(stiff.surface_vertices(sim.state), s.vertices(np.array(x)))
+    with pytest.raises(jelly.InputError, match="x.size"):
+        s.vertices(np.zeros((10, 3)))
+
+
+def test_each_body_falls_freely_at_g():
+    # Two cubes without terrain: each body's centre of mass follows x0 + g t^2 / 2 and each
+    # body's momentum is M g t (its springs are internal forces; RK4 is exact for this
+    # quadratic).
+    sim = jelly.Simulator(scene_of([
+        {"kind": "cube", "name": "a", "n": 3, "edge_length": 1, "origin": [0, 5, 0]},
+        {"kind": "box", "name": "b", "nx": 3, "ny": 2, "nz": 4, "size": [1, 0.5, 2],
+         "position": [3, 5, 0], "particle_mass": 0.5}]))
+    model = sim.model
+    x0 = [body_com(model, b, sim.state) for b in model.bodies]
+    t = 0.5
+    assert sim.run_until(t).ok
+    for body, c0 in zip(model.bodies, x0):
+        assert body_com(model, body, sim.state) == pytest.approx(c0 + G * t**2 / 2, abs=1e-9)
+        m = model.mass[body.particles.start:body.particles.stop]
+        p = (m[:, None] * body.v(sim.state)).sum(axis=0)
+        assert p == pytest.approx(m.sum() * G * t, abs=1e-9)
+
+
+def test_a_constant_external_force_accelerates_its_body_by_f_over_m():
+    force = [2.0, 0.0, -1.0]
+    sim = jelly.Simulator(scene_of(
+        [{"kind": "cube", "name": "a", "n": 3, "edge_length": 1, "particle_mass": 0.25,
+          "forces": [{"kind": "constant", "force": force}]}], gravity=(0, 0, 0)))
+    (f,) = sim.model.external_forces
+    assert f.kind == "constant" and list(f.vector) == force and len(f.particles) == 27
+    assert f.start == 0 and f.end == float("inf")
+    body = sim.model.bodies[0]
+    c0 = body_com(sim.model, body, sim.state)
+    t = 0.4
+    assert sim.run_until(t).ok
+    m = 27 * 0.25
+    assert body_com(sim.model, body, sim.state) == pytest.approx(
+        c0 + np.array(force) / m * t**2 / 2, abs=1e-9)
+
+
+def test_pins_hold_their_particles_on_their_paths(scenes):
+    # A driven pin (oscillation of 0.4 m at 0.5 Hz) under RK4 and fixed cloth corners under
+    # implicit Euler at 1/60 s: the pinned particles are exactly where their paths say.
+    sim = jelly.Simulator(jelly.load_scene(scenes / "pinned_jelly.json"))
+    pins = sim.model.pins
+    assert len(pins) >= 1 and not pins.all_fixed
+    assert np.array_equal(pins.anchors, sim.state.x[pins.particles])
+    assert sim.run_until(0.5).ok
+    assert np.allclose(sim.state.x[pins.particles], pins.positions(sim.t), rtol=0, atol=1e-12)
+    assert np.allclose(pins.positions(0.5) - pins.anchors, [0, 0.4, 0], atol=1e-12)
+
+    sim = jelly.Simulator(jelly.load_scene(scenes / "hanging_cloth.json"))
+    pins = sim.model.pins
+    cloth = sim.model.body("cloth")
+    assert pins.all_fixed and sorted(pins.particles) == sorted(
+        np.concatenate([cloth.groups["corner_00"], cloth.groups["corner_10"]]))
+    assert sim.run_until(1.0).ok
+    assert np.array_equal(sim.state.x[pins.particles], pins.anchors)
+    assert sim.state.x[:, 1].min() < pins.anchors[:, 1].min() - 0.5  # the rest hangs down
+
+
+def test_terrains_of_every_kind_from_their_specs():
+    sphere = jelly.make_terrain({"kind": "sphere", "center": [1, 2, 3], "radius": 1.5,
+                                 "contact": {"restitution": 0.2}})
+    assert sphere.kind == "sphere" and sphere.contact.restitution == 0.2
+    p = np.array([1.0, 6.0, 3.0])
+    assert sphere.signed_distance(p, 0) == pytest.approx(4 - 1.5)
+    assert sphere.normal(p, 0) == pytest.approx([0, 1, 0])
+    vertices, triangles = sphere.render_mesh()
+    pose = sphere.pose(0)
+    world = vertices @ pose[:3, :3].T + pose[:3, 3]
+    assert np.allclose(np.linalg.norm(world - [1, 2, 3], axis=1), 1.5)
+    assert enclosed_volume(world - [1, 2, 3], triangles) > 0
+    with pytest.raises(jelly.InputError, match=r"terrain\.radius = -1 is invalid"):
+        jelly.make_terrain({"kind": "sphere", "radius": -1})
+    with pytest.raises(jelly.InputError, match=r"terrain\.kind"):
+        jelly.make_terrain('{"kind": "torus"}')
+
+
+def test_a_terrain_added_from_its_spec_equals_the_scene_s():
+    cube = {"kind": "cube", "name": "a", "n": 3, "edge_length": 1, "origin": [-0.5, 1.6, -0.5]}
+    sphere = {"kind": "sphere", "center": [0.2, 0, 0], "radius": 1,
+              "contact": {"model": "coulomb", "restitution": 0.5}}
+    from_scene = jelly.Simulator(scene_of([cube], terrains=[sphere]))
+    added = jelly.Simulator(scene_of([cube]))
+    added.add_terrain(json.dumps(sphere))
+    free = jelly.Simulator(scene_of([cube]))
+    for sim in (from_scene, added, free):
+        assert sim.run_until(0.6).ok
+    assert np.array_equal(from_scene.state.x, added.state.x)
+    # It reached the sphere (0.6 m below it, at about 0.35 s): free fall went further down.
+    assert from_scene.state.x[:, 1].min() > free.state.x[:, 1].min() + 0.1
+    with pytest.raises(jelly.InputError, match="a Plane, an Elevator, or the spec"):
+        added.add_terrain(added.terrains[0])
