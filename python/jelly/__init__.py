@@ -18,7 +18,7 @@ from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module f
     angular_momentum, apply_override, body_kinds, build_cube, center_of_mass, check_same_scene,
     contact_models, cube_index, cube_particle_count, cube_spring_count, describe_recording,
     elastic_energy, gravitational_energy, integrator_infos, integrator_names, kinetic_energy,
-    linear_momentum, make_terrain, parse_free_parameters, read_checkpoint, read_recording,
+    linear_momentum, make_model, make_terrain, parse_free_parameters, read_checkpoint, read_recording,
     rest_state, restore, scene_to_json, spring_type_names, terrain_kinds, total_energy,
     write_xdmf_for_recording)
 from ._scene import Scene, load_scene

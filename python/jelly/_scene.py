@@ -76,6 +76,8 @@ class Scene(_jelly._Scene):
         if isinstance(json_text, Mapping):
             json_text = json.dumps(json_text)
         todo = assignments(overrides)
+        for assignment in todo:
+            json_text = _override_target(json_text, assignment, source)
         super().__init__(json_text, todo, source)  # validates, C++ messages
         for assignment in todo:
             json_text = _jelly.apply_override(json_text, assignment)
@@ -116,8 +118,8 @@ class Scene(_jelly._Scene):
         together; raises InputError and leaves the scene unchanged if the result is invalid."""
         text = self._source
         for assignment in assignments(overrides):
-            text = self._target_text(text, assignment)
-            text = _jelly.apply_override(text, assignment)
+            text = _jelly.apply_override(_override_target(text, assignment, self._name),
+                                         assignment)
         self._assign(text, self._name)  # raises before anything changes
         object.__setattr__(self, "_source", text)
         object.__setattr__(self, "_cache", None)
@@ -149,18 +151,6 @@ class Scene(_jelly._Scene):
 
     def _source_dict(self) -> dict[str, Any]:
         return json.loads(self._source)
-
-    def _target_text(self, text: str, assignment: str) -> str:
-        """The JSON an override applies to: the scene's own text, unless the path goes into a
-        list that only the full JSON has (``bodies[0]...`` of a one-cube scene file written
-        with ``cube`` and ``springs``): then the full JSON, the same scene with its bodies."""
-        steps = _split(assignment.partition("=")[0])
-        if not steps or not isinstance(steps[0], str) or steps[0] in json.loads(text):
-            return text
-        full = json.loads(Scene(text, (), self._name).to_json())
-        if isinstance(full.get(steps[0]), list):
-            return json.dumps(full)
-        return text
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_"):
@@ -202,6 +192,23 @@ class Scene(_jelly._Scene):
 
     def __deepcopy__(self, memo: dict) -> "Scene":
         return self.copy()
+
+
+def _override_target(text: str, assignment: str, source: str) -> str:
+    """The JSON an override applies to: the scene's text, unless the path indexes a list that
+    only the full JSON has (``bodies[0]...`` of a one-cube scene file written with ``cube`` and
+    ``springs``): then the full JSON, the same scene with its bodies."""
+    steps = _split(assignment.partition("=")[0])
+    if len(steps) < 2 or not isinstance(steps[0], str) or not isinstance(steps[1], int):
+        return text
+    try:
+        own = json.loads(text)
+    except ValueError:
+        return text  # the C++ parser says what is wrong with it
+    if not isinstance(own, dict) or steps[0] in own:
+        return text
+    full = json.loads(_jelly._Scene(text, [], source).to_json())
+    return json.dumps(full) if isinstance(full.get(steps[0]), list) else text
 
 
 def _wrap(scene: Scene, path: str, value: Any) -> Any:

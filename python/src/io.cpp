@@ -94,6 +94,11 @@ void bind_io(py::module_& m) {
       "scene_to_json", [](const Scene& s) { return scene_to_json(s); }, py::arg("scene"),
       "The scene as pretty-printed JSON with every field written out.");
 
+  m.def("make_model", &make_model, py::arg("scene"),
+        "The scene's model: its bodies (every kind of body_kinds()) with their pins and "
+        "external forces, and gravity; jelly.Simulator(model, ...) runs it without the scene's "
+        "terrains.");
+
   auto simulator = py::reinterpret_borrow<py::class_<Simulator>>(m.attr("Simulator"));
   simulator.def(py::init([](const Scene& scene) { return make_simulator(scene); }),
                 py::arg("scene"),

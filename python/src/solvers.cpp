@@ -231,7 +231,8 @@ void bind_solvers(py::module_& m) {
       .def_readonly("contact_count", &SimulatorSnapshot::contact_count,
                     "Contacts of the last step.");
 
-  py::class_<Simulator>(m, "Simulator",
+  // dynamic_attr: the report of the last run_until is kept on the Python object (report).
+  py::class_<Simulator>(m, "Simulator", py::dynamic_attr(),
                         "Steps a model among terrains with an integrator. Build it from a Scene, "
                         "or from a Model, a State, an integrator name and options.")
       .def(py::init([](const Model& model, const std::optional<State>& state,
@@ -276,14 +277,26 @@ void bind_solvers(py::module_& m) {
               observer.emplace(callback, self);
               guard.emplace(sim, *observer);
             }
-            py::gil_scoped_release release;
-            return sim.run_until(t_end);
+            RunReport report;
+            {
+              py::gil_scoped_release release;
+              report = sim.run_until(t_end);
+            }
+            self.attr("_last_report") = report;
+            return report;
           },
           py::arg("t_end"), py::arg("callback") = py::none(),
           "Steps until t_end, calling observers (and callback(sim), if given) at every output "
           "frame, and returns a RunReport; stops early on divergence or solver failure, which "
           "the report's status says (no exception). The GIL is released while stepping and "
           "taken back for each Python call.")
+      .def_property_readonly(
+          "report",
+          [](py::object self) -> py::object {
+            return py::getattr(self, "_last_report", py::none());
+          },
+          "The RunReport of the last run_until (None before the first): status, t, steps, "
+          "as_dict(), the integrator's statistics.")
       .def_property_readonly(
           "model", [](const Simulator& s) -> const Model& { return s.model(); },
           py::return_value_policy::reference_internal, "The model (read-only views).")

@@ -207,3 +207,20 @@ def test_a_terrain_added_from_its_spec_equals_the_scene_s():
     assert from_scene.state.x[:, 1].min() > free.state.x[:, 1].min() + 0.1
     with pytest.raises(jelly.InputError, match="a Plane, an Elevator, or the spec"):
         added.add_terrain(added.terrains[0])
+
+
+def test_a_model_of_several_bodies_from_a_scene_runs_in_a_simulator_built_in_code():
+    scene = scene_of([
+        {"kind": "cloth", "name": "sheet", "nu": 4, "nv": 4, "position": [0, 2, 0],
+         "pins": [{"group": "corner_00"}]},
+        {"kind": "box", "name": "brick", "nx": 2, "ny": 2, "nz": 2, "position": [3, 2, 0]}])
+    model = jelly.make_model(scene)
+    assert [b.kind for b in model.bodies] == ["cloth", "box"] and len(model.pins) == 1
+    sim = jelly.Simulator(model, integrator="rk4")
+    assert sim.report is None
+    report = sim.run_until(0.3)
+    assert sim.report.status == report.status == "completed" and sim.report.steps == 300
+    brick = sim.model.body("brick")
+    com = body_com(sim.model, brick, sim.state)
+    assert com[1] == pytest.approx(2 + G[1] * 0.3**2 / 2, abs=1e-9)
+    assert np.array_equal(sim.state.x[model.pins.particles], model.pins.anchors)

@@ -134,8 +134,8 @@ def test_bodies_read_and_write_by_their_json_paths(scenes):
 
 def test_a_one_cube_file_reads_as_written_and_as_bodies(scenes):
     # seed_slope.json describes its cube with the top-level keys "cube" and "springs"; the
-    # full JSON writes it as bodies[0]. Both paths read, and a write through either is seen by
-    # the other.
+    # full JSON writes it as bodies[0]. Both paths read; a write to the file's own keys is seen
+    # in bodies[0]; a write to bodies[0] turns the scene into its full JSON (no "springs" key).
     scene = jelly.load_scene(scenes / "seed_slope.json")
     assert scene.cube.n == 10 and scene.bodies[0].n == 10
     assert scene.bodies[0].name == "jelly" and scene.bodies[0].kind == "cube"
@@ -143,4 +143,10 @@ def test_a_one_cube_file_reads_as_written_and_as_bodies(scenes):
     assert scene.bodies[0].springs.shear.kd == 40
     scene.bodies[0].springs.shear.kd = 30
     assert scene.bodies[0].springs.shear.kd == 30
-    assert jelly.Simulator(scene).model.springs.kd[jelly.Simulator(scene).model.springs.type == 1][0] == 30
+    assert "springs" not in json.loads(scene.source_json)
+    springs = jelly.Simulator(scene).model.springs
+    assert (springs.kd[springs.type == 1] == 30).all()
+    # Overrides by either path, also when loading (as sweeps make their points).
+    a = jelly.load_scene(scenes / "seed_slope.json", {"bodies[0].n": 4})
+    b = jelly.load_scene(scenes / "seed_slope.json", {"cube.n": 4})
+    assert a == b and jelly.Simulator(a).model.num_particles == 64
