@@ -35,7 +35,7 @@ def test_fit_recovers_the_coefficients_like_jelly_fit(scenes, tmp_path, run_cli)
     assert result.values()["kd"] == pytest.approx(20, rel=1e-2)
     assert [p.name for p in result.parameters] == ["ks", "kd"]
     fitted = jelly.load_scene(tmp_path / "fitted.json")
-    assert fitted.springs.shear.ks == pytest.approx(1000, rel=1e-2)
+    assert fitted.bodies[0].springs.shear.ks == pytest.approx(1000, rel=1e-2)
 
     done = run_cli("fit", tmp_path / "run.h5", "--initial", "ks=1400", "--initial", "kd=30",
                    "--write-scene", tmp_path / "cli.json")
