@@ -69,3 +69,21 @@ def test_sweep_on_its_own_local_cluster_without_files(scenes):
                         n_workers=2)
     assert list(table["status"]) == ["completed", "completed"]
     assert list(table["file"]) == ["", ""]
+
+
+def test_sweep_over_a_body_s_path(scenes, client):
+    # A path into one body of a scene of two: each point changes that body only, and the
+    # cluster's runs end where the serial ones do.
+    scene = jelly.load_scene(scenes / "two_jellies.json", {"duration": 0.8})  # lands at ~0.65 s
+    parameters = {"bodies[0].springs.structural.ks": [300, 900]}
+    table = jelly.sweep(scene, parameters, client=client, out_dir=None)
+    for i, point in enumerate(jelly.sweep_points(parameters)):
+        one = scene.with_overrides(point)
+        soft, stiff = one.bodies
+        assert soft.springs.structural.ks == point["bodies[0].springs.structural.ks"]
+        assert stiff.springs.structural.ks == 5000
+        sim = jelly.Simulator(one)
+        report = sim.run_until(0.8)
+        assert table.iloc[i]["status"] == report.status == "completed"
+        assert table.iloc[i]["final_energy"] == sim.total_energy()
+    assert table.iloc[0]["final_energy"] != table.iloc[1]["final_energy"]
