@@ -2,7 +2,9 @@
 // observers, the state as NumPy views), run reports. The GIL is released while C++ steps.
 #include <optional>
 
+#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/simulator.hpp>
@@ -61,6 +63,19 @@ class ObserverGuard {
   Simulator& sim_;
   Observer& observer_;
 };
+
+// A JSON object given as a dict or JSON text, parsed; InputError naming `field` otherwise.
+Json json_object_of(const py::object& spec, const std::string& field) {
+  const std::string text =
+      py::isinstance<py::str>(spec)
+          ? spec.cast<std::string>()
+          : py::module_::import("json").attr("dumps")(spec).cast<std::string>();
+  try {
+    return Json::parse(text);
+  } catch (const Json::exception&) {
+    throw InputError(field, "\"" + text.substr(0, 60) + "\"", "an object as a dict or JSON text");
+  }
+}
 
 py::dict statistics_dict(const Statistics& s) {
   py::dict d;
@@ -341,7 +356,39 @@ void bind_solvers(py::module_& m) {
                              "Force evaluations since creation.")
       .def_property_readonly(
           "contact_count", [](const Simulator& s) { return s.contacts().contact_count(); },
-          "Particles in contact after the last step.")
+          "Particles in contact with terrains after the last step.")
+      .def(
+          "set_body_contact",
+          [](Simulator& s, const py::object& spec) {
+            const Json j = json_object_of(spec, "body_contact");
+            JsonFields f(j, "body_contact");
+            s.set_body_contact(BodyContactParams::read(f));
+          },
+          py::arg("spec"),
+          "Contact between bodies and within one (a scene's \"body_contact\" object as a dict "
+          "or JSON text: enabled, self_contact, restitution, friction, static_friction, "
+          "resting_speed, iterations; missing keys keep their defaults). Raises InputError "
+          "naming the field.")
+      .def_property_readonly(
+          "body_contact",
+          [](const Simulator& s) {
+            return py::module_::import("json").attr("loads")(
+                s.body_contact().params().to_json().dump());
+          },
+          "The body contact parameters in force, as a dict (a scene's \"body_contact\").")
+      .def_property_readonly(
+          "body_contact_pairs",
+          [](const Simulator& s) {
+            const auto& pairs = s.body_contact().pairs();
+            Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor> out(pairs.size(), 2);
+            for (std::size_t k = 0; k < pairs.size(); ++k) {
+              out(k, 0) = pairs[k].first;
+              out(k, 1) = pairs[k].second;
+            }
+            return out;
+          },
+          "The particle pairs (i < j, global indices) of different bodies (or, with "
+          "self_contact, of one body) in contact after the last step, int32 [P, 2] (a copy).")
       .def(
           "kinetic_energy", [](const Simulator& s) { return kinetic_energy(s.model(), s.state()); },
           "Kinetic energy of the current state (J).")
