@@ -13,9 +13,9 @@
 #include <random>
 #include <tuple>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
@@ -240,10 +240,11 @@ void BM_ImplicitStep(benchmark::State& st) {
   const std::string backend = kBackends[st.range(2)];
   IntegratorOptions io;
   if (backend == "cg_jacobi" || backend == "cg_lagged_cholmod") {
-    io.implicit.linear_solver = "cg";
-    io.implicit.cg_preconditioner = backend == "cg_jacobi" ? "jacobi" : "cholmod";
+    io.implicit.linear_solver = ImplicitLinearSolver::kCg;
+    io.implicit.cg_preconditioner =
+        backend == "cg_jacobi" ? CgPreconditionerKind::kJacobi : CgPreconditionerKind::kCholmod;
   } else {
-    io.implicit.linear_solver = backend;
+    io.implicit.linear_solver = value_of(implicit_linear_solvers(), backend, "linear_solver");
   }
   const Model model = build_cube(cube(n, ks_of(st)));
   SimulatorOptions so;

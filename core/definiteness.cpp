@@ -2,27 +2,18 @@
 
 namespace jelly {
 
-std::string_view definiteness_name(DefinitenessFix fix) {
-  switch (fix) {
-    case DefinitenessFix::kClampCompressed:
-      return "clamp";
-    case DefinitenessFix::kProjectPsd:
-      return "project";
-    case DefinitenessFix::kNone:
-      return "none";
-  }
-  return "?";
+const std::vector<EnumName<DefinitenessFix>>& definiteness_fixes() {
+  static const std::vector<EnumName<DefinitenessFix>> table{
+      {DefinitenessFix::kClampCompressed, "clamp",
+       "ks (1 - l0/L) and kd c/L clamped to >= 0 (Choi & Ko 2002)"},
+      {DefinitenessFix::kProjectPsd, "project", "each spring's block projected to PSD"},
+      {DefinitenessFix::kNone, "none", "the exact symmetric Jacobian"},
+  };
+  return table;
 }
 
-bool parse_definiteness(std::string_view text, DefinitenessFix* fix) {
-  for (DefinitenessFix f :
-       {DefinitenessFix::kClampCompressed, DefinitenessFix::kProjectPsd, DefinitenessFix::kNone}) {
-    if (text == definiteness_name(f)) {
-      *fix = f;
-      return true;
-    }
-  }
-  return false;
+std::string_view definiteness_name(DefinitenessFix fix) {
+  return name_of(definiteness_fixes(), fix);
 }
 
 }  // namespace jelly

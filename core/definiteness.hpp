@@ -2,6 +2,9 @@
 // How the geometric (transverse) stiffness of a spring is kept from making -K indefinite
 // (docs/implicit.md): an option of the implicit integrators.
 #include <string_view>
+#include <vector>
+
+#include <jelly/core/enum_names.hpp>
 
 namespace jelly {
 
@@ -13,8 +16,8 @@ enum class DefinitenessFix {
   kProjectPsd,       // the spring's 3x3 block projected to PSD: s clamped to >= 0
   kNone,             // the exact symmetric Jacobian; M - h D - h^2 K may be indefinite
 };
+// "clamp", "project", "none".
+const std::vector<EnumName<DefinitenessFix>>& definiteness_fixes();
 std::string_view definiteness_name(DefinitenessFix fix);
-// "clamp", "project" or "none"; false for anything else.
-bool parse_definiteness(std::string_view text, DefinitenessFix* fix);
 
 }  // namespace jelly

@@ -93,12 +93,8 @@ void Scene::validate() const {
     terrains[i]->contact.validate(prefix + "contact.");
   }
   body_contact.validate("body_contact.");
-  const std::vector<std::string> names = integrator_names();
-  std::string known;
-  for (const std::string& n : names) known += (known.empty() ? "\"" : ", \"") + n + "\"";
-  require(std::find(names.begin(), names.end(), integrator.name) != names.end(), "integrator.name",
-          "\"" + integrator.name + "\"", "one of " + known);
-  integrator.options.validate();
+  const IntegratorInfo& info = find_integrator(integrator.name, "integrator.name");
+  if (info.options.validate) info.options.validate(integrator.options, "integrator.options.");
   simulator_options(*this).validate();  // integrator.dt, output_interval, divergence.*
   require(std::isfinite(duration) && duration > 0, "duration", duration, "a finite duration > 0 s");
 }

@@ -4,10 +4,10 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
-#include <jelly/io/detail/integrator_options_json.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/detail/scene_override.hpp>
 #include <jelly/io/scene.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
 namespace jelly {
@@ -102,9 +102,11 @@ Scene scene_from_json(const Json& j) {
     JsonFields f(*in, "integrator");
     s.integrator.name = f.string("name");
     s.integrator.dt = f.number_or("dt", s.integrator.dt);
+    find_integrator(s.integrator.name, f.path("name"));
     if (const Json* o = f.value("options")) {
-      s.integrator.options =
-          detail::parse_integrator_options(*o, f.path("options"), s.integrator.name);
+      JsonFields g(*o, f.path("options"));
+      s.integrator.options = read_integrator_options(s.integrator.name, g);
+      g.reject_unknown();
     }
     f.reject_unknown();
   }
@@ -141,10 +143,9 @@ std::string scene_to_json(const Scene& s) {
   j["terrains"] = Json::array();
   for (const auto& t : s.terrains) j["terrains"].push_back(terrain_json(*t));
   j["body_contact"] = s.body_contact.to_json();
-  j["integrator"] = {
-      {"name", s.integrator.name},
-      {"dt", s.integrator.dt},
-      {"options", detail::integrator_options_to_json(s.integrator.options, s.integrator.name)}};
+  j["integrator"] = {{"name", s.integrator.name},
+                     {"dt", s.integrator.dt},
+                     {"options", integrator_options_json(s.integrator.name, s.integrator.options)}};
   j["duration"] = s.duration;
   j["output_interval"] = s.output_interval;
   j["divergence"] = {{"max_speed", s.divergence.max_speed},

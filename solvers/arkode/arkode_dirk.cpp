@@ -165,7 +165,7 @@ class DirkDriver final : public arkode::Driver {
 }  // namespace
 
 ArkodeDirk::ArkodeDirk(const ArkodeOptions& options) {
-  options.validate();
+  options.validate("ArkodeOptions.");
   const std::string method = options.method.empty() ? kDefaultMethod : options.method;
   ARKodeButcherTable table = ARKodeButcherTable_LoadDIRKByName(method.c_str());
   const bool embedded = table != nullptr && table->d != nullptr;

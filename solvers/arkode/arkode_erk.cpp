@@ -37,7 +37,7 @@ class ErkDriver final : public arkode::Driver {
 }  // namespace
 
 ArkodeErk::ArkodeErk(const ArkodeOptions& options) {
-  options.validate();
+  options.validate("ArkodeOptions.");
   const std::string method = options.method.empty() ? kDefaultMethod : options.method;
   ARKodeButcherTable table = ARKodeButcherTable_LoadERKByName(method.c_str());
   const bool embedded = table != nullptr && table->d != nullptr;

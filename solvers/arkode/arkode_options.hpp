@@ -2,6 +2,7 @@
 // Options of the adaptive SUNDIALS ARKODE integrators (arkode_erk, arkode_dirk; docs/arkode.md).
 #include <string>
 
+#include <jelly/core/json.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {
@@ -16,9 +17,12 @@ struct ArkodeOptions {
   std::string linear_solver = "schur";  // arkode_dirk: "schur" (default) or "klu"
   long max_steps = 100000;              // internal steps per contact interval, > 0
 
-  // Throws InputError naming the first invalid field (integrator.options.<field>). The method
-  // name is checked by the integrator that uses it.
-  void validate() const;
+  // Throws InputError "<prefix><field> = <value> is invalid: ..." for the first invalid field
+  // (prefix e.g. "integrator.options."). The method name is checked by the integrator using it.
+  void validate(const std::string& prefix) const;
+  // The scene's integrator.options of arkode_erk and arkode_dirk, validated with their paths.
+  static ArkodeOptions read(JsonFields& fields);
+  Json to_json() const;
 };
 
 }  // namespace jelly

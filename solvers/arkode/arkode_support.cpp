@@ -74,9 +74,7 @@ Driver::Driver(std::string name, const StepperApi& api, ArkodeOptions options)
       api_(api),
       options_(std::move(options)),
       context_(make_context()),
-      memory_(nullptr, MemoryDeleter{api.free}) {
-  options_.validate();
-}
+      memory_(nullptr, MemoryDeleter{api.free}) {}
 
 std::string Driver::failure(const char* call, int flag) const {
   // The flag name is allocated with malloc by SUNDIALS.

@@ -21,13 +21,6 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-CholmodOrdering ordering_of(const std::string& name) {
-  if (name == "amd") return CholmodOrdering::kAmd;
-  if (name == "nesdis") return CholmodOrdering::kNesdis;
-  if (name == "best") return CholmodOrdering::kBest;
-  return CholmodOrdering::kMetis;
-}
-
 // Below this many unknowns a fresh CHOLMOD factorization every step is cheap and exact; above
 // it block-Jacobi CG was the fastest backend at every size and stiffness of the benchmark
 // (docs/implicit.md, "Measured speed"; bench/implicit_benchmark.cpp).
@@ -47,14 +40,16 @@ void restore_momentum(const VecX& mass, const VecX& b, VecX& y) {
 
 }  // namespace
 
-std::string auto_linear_solver(int dofs) {
-  return dofs <= kAutoDirectMaxDofs ? "cholmod" : "cg_jacobi";
+ImplicitLinearSolver auto_linear_solver(int dofs) {
+  return dofs <= kAutoDirectMaxDofs ? ImplicitLinearSolver::kCholmod : ImplicitLinearSolver::kCg;
 }
 
 struct ImplicitEuler::Impl {
   explicit Impl(ImplicitEulerOptions o) : options_(std::move(o)) {}
 
-  bool resolves_contact() const { return options_.contact == "implicit" && terrains_seen_; }
+  bool resolves_contact() const {
+    return options_.contact == ImplicitContactMode::kImplicit && terrains_seen_;
+  }
   void add_statistics(Statistics& s) const;
   StepResult step(const Dynamics& dynamics, State& state, Real h);
   StepResult prepare(const Model& model, Real h);
@@ -86,9 +81,9 @@ struct ImplicitEuler::Impl {
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
   const Terrains* contact_terrains_ = nullptr;  // the terrains contact_ resolves this step
-  bool contact_active_ = false;  // the current step constrains contacts
-  bool terrains_seen_ = true;    // the last step's Dynamics had terrains
-  bool anchored_ = false;        // the current step's Dynamics has anchor springs
+  bool contact_active_ = false;                 // the current step constrains contacts
+  bool terrains_seen_ = true;                   // the last step's Dynamics had terrains
+  bool anchored_ = false;                       // the current step's Dynamics has anchor springs
   Real last_h_ = 0;
   bool have_dv_ = false;
   std::vector<Real> residuals_;
@@ -100,8 +95,7 @@ struct ImplicitEuler::Impl {
 
 ImplicitEuler::ImplicitEuler(ImplicitEulerOptions options)
     : impl_(std::make_unique<Impl>(std::move(options))) {
-  std::string why;
-  if (!impl_->options_.is_valid(&why)) throw InputError("integrator." + why);
+  impl_->options_.validate("ImplicitEulerOptions.");
   impl_->jacobian_options_.definiteness = impl_->options_.definiteness;
   impl_->residuals_.reserve(impl_->options_.newton_iterations + 1);
 }
@@ -186,17 +180,17 @@ StepResult ImplicitEuler::Impl::prepare(const Model& model, Real h) {
     const auto start = Clock::now();
     jacobian_.emplace(model);
     a_ = jacobian_->make_matrix();
-    std::string kind = options_.linear_solver;
-    if (kind == "auto") kind = auto_linear_solver(n);
+    const bool automatic = options_.linear_solver == ImplicitLinearSolver::kAuto;
+    const ImplicitLinearSolver kind = automatic ? auto_linear_solver(n) : options_.linear_solver;
     CholmodOptions cholmod;
-    cholmod.ordering = ordering_of(options_.ordering);
-    if (kind == "cholmod") {
+    cholmod.ordering = options_.ordering;
+    if (kind == ImplicitLinearSolver::kCholmod) {
       solver_ = std::make_unique<CholmodSolver>(cholmod);
-    } else if (kind == "ldlt") {
+    } else if (kind == ImplicitLinearSolver::kLdlt) {
       solver_ = std::make_unique<LdltSolver>();
     } else {
-      CgOptions cg;
-      cg.preconditioner = kind == "cg" && options_.cg_preconditioner == "cholmod"
+      CgOptions cg;  // auto's CG is block Jacobi, the fastest measured above its threshold
+      cg.preconditioner = !automatic && options_.cg_preconditioner == CgPreconditionerKind::kCholmod
                               ? CgPreconditioner::kLaggedCholesky
                               : CgPreconditioner::kJacobi;
       cg.tolerance = options_.cg_tolerance;

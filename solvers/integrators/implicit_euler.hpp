@@ -55,6 +55,6 @@ class ImplicitEuler final : public Integrator {
 };
 
 // The backend "auto" picks for a system of `dofs` unknowns (docs/implicit.md).
-std::string auto_linear_solver(int dofs);
+ImplicitLinearSolver auto_linear_solver(int dofs);
 
 }  // namespace jelly

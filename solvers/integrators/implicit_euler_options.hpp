@@ -1,12 +1,38 @@
 #pragma once
-// Options of the implicit Euler integrator (docs/implicit.md), with a validity check that names
-// the offending field.
+// Options of the implicit Euler integrator (docs/implicit.md): each named choice an enum with its
+// name table (core/enum_names.hpp), read from and written to a scene's integrator.options, and
+// validated once with the JSON path of the field.
 #include <string>
+#include <vector>
 
 #include <jelly/core/definiteness.hpp>
+#include <jelly/core/enum_names.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/core/types.hpp>
+#include <jelly/solvers/linear/cholmod_solver.hpp>
 
 namespace jelly {
+
+enum class ImplicitLinearSolver {
+  kAuto,     // CHOLMOD up to 1000 unknowns, block-Jacobi CG above (the fastest measured there)
+  kCholmod,  // CHOLMOD, a numeric factorization every step
+  kLdlt,     // Eigen's simplicial LDL^T, a factorization every step
+  kCg,       // conjugate gradients with cg_preconditioner
+};
+const std::vector<EnumName<ImplicitLinearSolver>>& implicit_linear_solvers();
+
+enum class CgPreconditionerKind {
+  kJacobi,   // 3x3 block Jacobi
+  kCholmod,  // a CHOLMOD factor of an earlier matrix, refreshed when it stops paying
+};
+const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds();
+
+// How coulomb terrains enter the step.
+enum class ImplicitContactMode {
+  kImplicit,   // constraints inside the linear solve, with friction and restitution
+  kAfterStep,  // the resolve after the step of the explicit integrators (crushes at large dt)
+};
+const std::vector<EnumName<ImplicitContactMode>>& implicit_contact_modes();
 
 struct ImplicitEulerOptions {
   // 1 = linearized backward Euler (Baraff & Witkin 1998), one linear solve per step;
@@ -15,29 +41,24 @@ struct ImplicitEulerOptions {
   // Newton stops when |M (v1 - v0) - h f(x0 + h v1, v1)| <= newton_tolerance |h f(x0, v0)|.
   Real newton_tolerance = 1e-8;
   DefinitenessFix definiteness = DefinitenessFix::kClampCompressed;
-  // "cholmod" (factor every step), "ldlt" (Eigen, factor every step), "cg", or "auto":
-  // CHOLMOD for up to 1000 unknowns, block-Jacobi CG above (the fastest measured there).
-  std::string linear_solver = "auto";
-  // For "cg": "jacobi" (3x3 block Jacobi) or "cholmod" (a CHOLMOD factor of an earlier matrix,
-  // refreshed when its solves cost more than the average since the refresh, when CG needs more
-  // than refactor_iterations with it, or when dt changes).
-  std::string cg_preconditioner = "jacobi";
+  ImplicitLinearSolver linear_solver = ImplicitLinearSolver::kAuto;
+  // For kCg: the lagged CHOLMOD factor is refreshed when its solves cost more than the average
+  // since the refresh, when CG needs more than refactor_iterations with it, or when dt changes.
+  CgPreconditionerKind cg_preconditioner = CgPreconditionerKind::kJacobi;
   Real cg_tolerance = 1e-8;  // relative residual |b - A x| / |b|
   int cg_max_iterations = 1000;
   int refactor_iterations = 20;
-  // Fill-reducing ordering of CHOLMOD: "metis", "amd", "nesdis" or "best" (CHOLMOD's default).
-  std::string ordering = "metis";
-  // How coulomb terrains enter the step: "implicit" (constraints inside the linear solve, with
-  // friction and restitution; solvers/contact/detail/implicit_contact.hpp) or "after_step" (the
-  // resolve after the step that the explicit integrators use; it crushes the springs at large
-  // steps).
-  std::string contact = "implicit";
-  // "implicit": at most this many linear solves per step while the active set changes.
+  CholmodOrdering ordering = CholmodOrdering::kMetis;  // CHOLMOD's fill-reducing ordering
+  ImplicitContactMode contact = ImplicitContactMode::kImplicit;
+  // kImplicit: at most this many linear solves per step while the active set changes.
   int contact_iterations = 10;
 
-  // False, with "options.<field> = <value> is invalid: <allowed>" in *why, for the first
-  // invalid field.
-  bool is_valid(std::string* why) const;
+  // Throws InputError "<prefix><field> = <value> is invalid: <allowed>" for the first invalid
+  // field (prefix e.g. "integrator.options.").
+  void validate(const std::string& prefix) const;
+  // The scene's integrator.options of implicit_euler; validated with the fields' JSON path.
+  static ImplicitEulerOptions read(JsonFields& fields);
+  Json to_json() const;
 };
 
 }  // namespace jelly

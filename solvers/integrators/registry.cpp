@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <functional>
+#include <type_traits>
+#include <utility>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/arkode/arkode_dirk.hpp>
@@ -18,10 +20,27 @@ namespace {
 
 using Factory = std::function<std::unique_ptr<Integrator>(const IntegratorOptions&)>;
 
+// The options member `Member` of IntegratorOptions, read, written and validated by its own type.
+template <auto Member>
+IntegratorOptionsIo options_io() {
+  using Options = std::remove_reference_t<decltype(std::declval<IntegratorOptions&>().*Member)>;
+  IntegratorOptionsIo io;
+  io.read = [](JsonFields& f, IntegratorOptions& o) { o.*Member = Options::read(f); };
+  io.write = [](const IntegratorOptions& o) { return (o.*Member).to_json(); };
+  io.validate = [](const IntegratorOptions& o, const std::string& prefix) {
+    (o.*Member).validate(prefix);
+  };
+  return io;
+}
+constexpr auto kImplicit = &IntegratorOptions::implicit;
+constexpr auto kArkode = &IntegratorOptions::arkode;
+
 struct Entry {
   IntegratorInfo info;
   Factory make;
 };
+
+const IntegratorOptionsIo kNoOptions{};
 
 template <typename T>
 Factory plain() {
@@ -32,19 +51,23 @@ const std::vector<Entry>& table() {
   static const std::vector<Entry> entries = [] {
     std::vector<Entry> e{
         {{"arkode_dirk",
-          "SUNDIALS ARKODE adaptive implicit DIRK (Newton, Schur or KLU linear solves)"},
+          "SUNDIALS ARKODE adaptive implicit DIRK (Newton, Schur or KLU linear solves)",
+          options_io<kArkode>()},
          [](const IntegratorOptions& o) { return std::make_unique<ArkodeDirk>(o.arkode); }},
-        {{"arkode_erk", "SUNDIALS ARKODE adaptive explicit Runge-Kutta (default 5(4) pair)"},
+        {{"arkode_erk", "SUNDIALS ARKODE adaptive explicit Runge-Kutta (default 5(4) pair)",
+          options_io<kArkode>()},
          [](const IntegratorOptions& o) { return std::make_unique<ArkodeErk>(o.arkode); }},
-        {{"explicit_euler", "forward Euler, order 1, explicit"}, plain<ExplicitEuler>()},
+        {{"explicit_euler", "forward Euler, order 1, explicit", kNoOptions},
+         plain<ExplicitEuler>()},
         {{"implicit_euler",
-          "backward Euler on a sparse Cholesky/CG solver, order 1, implicit (stable at any dt)"},
+          "backward Euler on a sparse Cholesky/CG solver, order 1, implicit (stable at any dt)",
+          options_io<kImplicit>()},
          [](const IntegratorOptions& o) { return std::make_unique<ImplicitEuler>(o.implicit); }},
-        {{"midpoint", "explicit midpoint (the report's midpoint Euler), order 2"},
+        {{"midpoint", "explicit midpoint (the report's midpoint Euler), order 2", kNoOptions},
          plain<Midpoint>()},
-        {{"rk4", "classical Runge-Kutta, order 4, explicit"}, plain<RungeKutta4>()},
+        {{"rk4", "classical Runge-Kutta, order 4, explicit", kNoOptions}, plain<RungeKutta4>()},
         {{"symplectic_euler",
-          "semi-implicit Euler, order 1 (what the report called implicit Euler)"},
+          "semi-implicit Euler, order 1 (what the report called implicit Euler)", kNoOptions},
          plain<SymplecticEuler>()},
     };
     std::sort(e.begin(), e.end(),
@@ -71,18 +94,40 @@ std::vector<std::string> integrator_names() {
   return names;
 }
 
-std::unique_ptr<Integrator> make_integrator(std::string_view name,
-                                            const IntegratorOptions& options) {
+const IntegratorInfo& find_integrator(std::string_view name, std::string_view field) {
+  for (const IntegratorInfo& info : integrator_infos()) {
+    if (info.name == name) return info;
+  }
+  std::string known;
+  for (const Entry& e : table())
+    known += (known.empty() ? "\"" : ", \"") + std::string(e.info.name) + "\"";
+  throw InputError(field, "\"" + std::string(name) + "\"", "one of " + known);
+}
+
+IntegratorOptions read_integrator_options(std::string_view name, JsonFields& fields) {
+  IntegratorOptions options;
+  const IntegratorInfo& info = find_integrator(name);
+  if (info.options.read) info.options.read(fields, options);
+  return options;
+}
+
+Json integrator_options_json(std::string_view name, const IntegratorOptions& options) {
+  const IntegratorInfo& info = find_integrator(name);
+  return info.options.write ? info.options.write(options) : Json::object();
+}
+
+std::unique_ptr<Integrator> make_integrator(std::string_view name, const IntegratorOptions& options,
+                                            std::string_view options_path) {
   for (const Entry& e : table()) {
     if (e.info.name == name) {
-      options.validate();
+      if (e.info.options.validate) {
+        e.info.options.validate(options, std::string(options_path) + ".");
+      }
       return e.make(options);
     }
   }
-  std::string known;
-  for (const Entry& e : table()) known += (known.empty() ? "" : ", ") + std::string(e.info.name);
-  throw InputError("integrator.name: unknown integrator '" + std::string(name) +
-                   "'. Known: " + known);
+  find_integrator(name);  // throws, naming the known integrators
+  return nullptr;
 }
 
 }  // namespace jelly

@@ -1,25 +1,47 @@
 #pragma once
-// Integrators by name, from one sorted table.
+// Integrators by name, from one sorted table: each entry says what the integrator is, how to
+// make it, and which options it takes in a scene (integrator.options).
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include <jelly/core/json.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 
+// The options of one integrator, as a scene holds them: read (validated, messages naming the
+// fields' JSON paths) into its member of IntegratorOptions, written back, validated. All null for
+// an integrator that takes none.
+struct IntegratorOptionsIo {
+  void (*read)(JsonFields& fields, IntegratorOptions& options) = nullptr;
+  Json (*write)(const IntegratorOptions& options) = nullptr;
+  void (*validate)(const IntegratorOptions& options, const std::string& prefix) = nullptr;
+};
+
 struct IntegratorInfo {
   std::string_view name;
   std::string_view description;
+  IntegratorOptionsIo options;
 };
 
 // Every registered integrator, sorted by name.
 const std::vector<IntegratorInfo>& integrator_infos();
 std::vector<std::string> integrator_names();
-// Throws InputError "Unknown integrator 'rk5'. Known: ..." for an unknown name.
+// Throws InputError "<field> = "rk5" is invalid: one of ..." for an unknown name.
+const IntegratorInfo& find_integrator(std::string_view name,
+                                      std::string_view field = "integrator.name");
+// The integrator's options from a scene's integrator.options (`fields`); the keys of another
+// integrator are left unread (JsonFields::reject_unknown then names them).
+IntegratorOptions read_integrator_options(std::string_view name, JsonFields& fields);
+// Its options as a scene writes them ({} for an integrator without options).
+Json integrator_options_json(std::string_view name, const IntegratorOptions& options);
+// Validates the options the named integrator uses (InputError naming `options_path`.<field>)
+// and makes it.
 std::unique_ptr<Integrator> make_integrator(std::string_view name,
-                                            const IntegratorOptions& options = {});
+                                            const IntegratorOptions& options = {},
+                                            std::string_view options_path = "integrator.options");
 
 }  // namespace jelly

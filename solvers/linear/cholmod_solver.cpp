@@ -6,18 +6,18 @@
 
 namespace jelly {
 
+const std::vector<EnumName<CholmodOrdering>>& cholmod_orderings() {
+  static const std::vector<EnumName<CholmodOrdering>> table{
+      {CholmodOrdering::kAmd, "amd", "approximate minimum degree"},
+      {CholmodOrdering::kMetis, "metis", "METIS nested dissection (least fill on the seed cube)"},
+      {CholmodOrdering::kNesdis, "nesdis", "CHOLMOD's nested dissection"},
+      {CholmodOrdering::kBest, "best", "CHOLMOD's default: AMD, METIS when AMD fills much"},
+  };
+  return table;
+}
+
 std::string_view cholmod_ordering_name(CholmodOrdering ordering) {
-  switch (ordering) {
-    case CholmodOrdering::kAmd:
-      return "amd";
-    case CholmodOrdering::kMetis:
-      return "metis";
-    case CholmodOrdering::kNesdis:
-      return "nesdis";
-    case CholmodOrdering::kBest:
-      return "best";
-  }
-  return "?";
+  return name_of(cholmod_orderings(), ordering);
 }
 
 namespace {

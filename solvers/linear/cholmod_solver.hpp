@@ -3,6 +3,9 @@
 // each factorize is numeric only. CHOLMOD prints nothing; every CHOLMOD status becomes a
 // LinearResult with CHOLMOD's reason (a non-positive-definite matrix is a status, not a crash).
 #include <memory>
+#include <vector>
+
+#include <jelly/core/enum_names.hpp>
 
 #include <jelly/solvers/linear/linear_solver.hpp>
 
@@ -14,6 +17,8 @@ enum class CholmodOrdering {
   kNesdis,  // CHOLMOD's own nested dissection (METIS bisection + constrained minimum degree)
   kBest,    // CHOLMOD's default: AMD, and METIS when AMD gives much fill
 };
+// "amd", "metis", "nesdis", "best".
+const std::vector<EnumName<CholmodOrdering>>& cholmod_orderings();
 std::string_view cholmod_ordering_name(CholmodOrdering ordering);
 
 struct CholmodOptions {

@@ -70,7 +70,7 @@ TEST(Cli, ImplicitEulerResolvesContactInItsSolve) {
             "' --integrator implicit_euler --set integrator.options.contact=penalty");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err,
-            "error: integrator.options.contact = \"penalty\" is invalid: \"implicit\" or "
+            "error: integrator.options.contact = \"penalty\" is invalid: one of \"implicit\", "
             "\"after_step\"\n");
 }
 

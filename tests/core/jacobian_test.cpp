@@ -4,9 +4,9 @@
 
 #include <Eigen/Dense>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/geometry/cube.hpp>
 
 namespace jelly {
 namespace {
@@ -204,12 +204,9 @@ TEST(SpringJacobian, SystemAssemblyMatchesItsDefinition) {
 TEST(SpringJacobian, DefinitenessNamesRoundTrip) {
   for (DefinitenessFix f :
        {DefinitenessFix::kClampCompressed, DefinitenessFix::kProjectPsd, DefinitenessFix::kNone}) {
-    DefinitenessFix parsed;
-    ASSERT_TRUE(parse_definiteness(definiteness_name(f), &parsed));
-    EXPECT_EQ(parsed, f);
+    EXPECT_EQ(value_of(definiteness_fixes(), definiteness_name(f), "definiteness"), f);
   }
-  DefinitenessFix parsed;
-  EXPECT_FALSE(parse_definiteness("psd", &parsed));
+  EXPECT_THROW(value_of(definiteness_fixes(), "psd", "definiteness"), InputError);
 }
 
 }  // namespace

@@ -164,7 +164,7 @@ TEST(ImplicitEulerCeres, AgreesWithNewtonImplicitEuler) {
   IntegratorOptions newton;
   newton.implicit.newton_iterations = 50;
   newton.implicit.newton_tolerance = 1e-13;
-  newton.implicit.linear_solver = "cholmod";  // direct solves: no CG tolerance in the way
+  newton.implicit.linear_solver = ImplicitLinearSolver::kCholmod;  // direct solves: no CG tolerance in the way
   SimulatorOptions options;
   options.dt = h;
   Simulator reference(model, deformed_state(model), make_integrator("implicit_euler", newton),

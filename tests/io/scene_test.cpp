@@ -435,11 +435,11 @@ TEST(SceneIntegratorOptions, ImplicitAndArkodeOptionsRoundTrip) {
               "integrator.options.linear_solver=cholmod", "integrator.options.definiteness=project",
               "integrator.options.ordering=amd"});
   EXPECT_EQ(implicit.integrator.options.implicit.newton_iterations, 4);
-  EXPECT_EQ(implicit.integrator.options.implicit.linear_solver, "cholmod");
+  EXPECT_EQ(implicit.integrator.options.implicit.linear_solver, ImplicitLinearSolver::kCholmod);
   EXPECT_EQ(implicit.integrator.options.implicit.definiteness, DefinitenessFix::kProjectPsd);
   const Scene again = parse_scene(scene_to_json(implicit));
   EXPECT_EQ(again.integrator.options.implicit.newton_iterations, 4);
-  EXPECT_EQ(again.integrator.options.implicit.ordering, "amd");
+  EXPECT_EQ(again.integrator.options.implicit.ordering, CholmodOrdering::kAmd);
   EXPECT_EQ(again.integrator.options.implicit.definiteness, DefinitenessFix::kProjectPsd);
 
   const Scene arkode =

@@ -5,11 +5,11 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
@@ -305,7 +305,7 @@ TEST(ImplicitContact, InternalStateRoundTripsAndIsChecked) {
 // contact after the step); an unknown value names the field.
 TEST(ImplicitContact, AfterStepOptionUsesTheSimulatorsResolve) {
   ImplicitEulerOptions o;
-  o.contact = "after_step";
+  o.contact = ImplicitContactMode::kAfterStep;
   EXPECT_FALSE(ImplicitEuler(o).resolves_contact());
   EXPECT_TRUE(ImplicitEuler().resolves_contact());
   // Stepped with a Dynamics that has no terrains, it has resolved nothing: the caller's resolve
@@ -319,11 +319,16 @@ TEST(ImplicitContact, AfterStepOptionUsesTheSimulatorsResolve) {
   ASSERT_TRUE(alone.step(Dynamics(c.model, contacts, &c.terrains), s, c.h).ok);
   EXPECT_TRUE(alone.resolves_contact());
 
-  o.contact = "penalty";
-  std::string why;
-  EXPECT_FALSE(o.is_valid(&why));
-  EXPECT_NE(why.find("options.contact"), std::string::npos) << why;
-  EXPECT_NE(why.find("\"implicit\" or \"after_step\""), std::string::npos) << why;
+  const Json penalty = Json::parse(R"({"contact": "penalty"})");
+  JsonFields f(penalty, "integrator.options");
+  try {
+    ImplicitEulerOptions::read(f);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "integrator.options.contact = \"penalty\" is invalid: one of \"implicit\", "
+              "\"after_step\"");
+  }
 }
 
 }  // namespace
