@@ -17,6 +17,20 @@ namespace jelly::python {
 
 namespace {
 
+// A named choice of an options struct as a Python str, read and written through its name table;
+// a name outside the table raises jelly.InputError naming integrator.options.<field>.
+template <typename Options, typename E>
+auto choice_getter(E Options::*member, const std::vector<EnumName<E>>& (*table)()) {
+  return [member, table](const Options& o) { return std::string(name_of(table(), o.*member)); };
+}
+template <typename Options, typename E>
+auto choice_setter(E Options::*member, const std::vector<EnumName<E>>& (*table)(),
+                   const char* field) {
+  return [member, table, field](Options& o, const std::string& name) {
+    o.*member = value_of(table(), name, std::string("integrator.options.") + field);
+  };
+}
+
 // An Observer subclassed in Python (on_frame, optionally on_finish). Called with the GIL
 // released by run_until, so each call takes it back. The simulator is passed by pointer so that
 // Python sees the simulator object it already has; the report is passed as a copy.
@@ -118,28 +132,33 @@ void bind_solvers(py::module_& m) {
       .def_readwrite("newton_tolerance", &ImplicitEulerOptions::newton_tolerance,
                      "Newton's relative tolerance.")
       .def_property(
-          "definiteness",
-          [](const ImplicitEulerOptions& o) {
-            return std::string(definiteness_name(o.definiteness));
-          },
-          [](ImplicitEulerOptions& o, const std::string& s) {
-            require(parse_definiteness(s, &o.definiteness), "integrator.options.definiteness",
-                    "\"" + s + "\"", "one of \"clamp\", \"project\", \"none\"");
-          },
+          "definiteness", choice_getter(&ImplicitEulerOptions::definiteness, definiteness_fixes),
+          choice_setter(&ImplicitEulerOptions::definiteness, definiteness_fixes, "definiteness"),
           "\"clamp\", \"project\" or \"none\".")
-      .def_readwrite("linear_solver", &ImplicitEulerOptions::linear_solver,
-                     "\"auto\", \"cholmod\", \"ldlt\" or \"cg\".")
-      .def_readwrite("cg_preconditioner", &ImplicitEulerOptions::cg_preconditioner,
-                     "\"jacobi\" or \"cholmod\".")
+      .def_property("linear_solver",
+                    choice_getter(&ImplicitEulerOptions::linear_solver, implicit_linear_solvers),
+                    choice_setter(&ImplicitEulerOptions::linear_solver, implicit_linear_solvers,
+                                  "linear_solver"),
+                    "\"auto\", \"cholmod\", \"ldlt\" or \"cg\".")
+      .def_property(
+          "cg_preconditioner",
+          choice_getter(&ImplicitEulerOptions::cg_preconditioner, cg_preconditioner_kinds),
+          choice_setter(&ImplicitEulerOptions::cg_preconditioner, cg_preconditioner_kinds,
+                        "cg_preconditioner"),
+          "\"jacobi\" or \"cholmod\".")
       .def_readwrite("cg_tolerance", &ImplicitEulerOptions::cg_tolerance,
                      "Relative residual of CG.")
       .def_readwrite("cg_max_iterations", &ImplicitEulerOptions::cg_max_iterations,
                      "CG iteration cap.")
       .def_readwrite("refactor_iterations", &ImplicitEulerOptions::refactor_iterations,
                      "CG iterations that trigger a new CHOLMOD preconditioner.")
-      .def_readwrite("ordering", &ImplicitEulerOptions::ordering,
-                     "\"metis\", \"amd\", \"nesdis\" or \"best\".")
-      .def_readwrite("contact", &ImplicitEulerOptions::contact, "\"implicit\" or \"after_step\".")
+      .def_property("ordering", choice_getter(&ImplicitEulerOptions::ordering, cholmod_orderings),
+                    choice_setter(&ImplicitEulerOptions::ordering, cholmod_orderings, "ordering"),
+                    "\"metis\", \"amd\", \"nesdis\" or \"best\".")
+      .def_property(
+          "contact", choice_getter(&ImplicitEulerOptions::contact, implicit_contact_modes),
+          choice_setter(&ImplicitEulerOptions::contact, implicit_contact_modes, "contact"),
+          "\"implicit\" or \"after_step\".")
       .def_readwrite("contact_iterations", &ImplicitEulerOptions::contact_iterations,
                      "Solves per step while the contact set changes.");
 
@@ -163,8 +182,13 @@ void bind_solvers(py::module_& m) {
       .def_readwrite("implicit", &IntegratorOptions::implicit, "implicit_euler's options.")
       .def_readwrite("arkode", &IntegratorOptions::arkode,
                      "arkode_erk's and arkode_dirk's options.")
-      .def("validate", &IntegratorOptions::validate,
-           "Raises InputError naming the first invalid option.");
+      .def(
+          "validate",
+          [](const IntegratorOptions& o) {
+            o.implicit.validate("integrator.options.");
+            o.arkode.validate("integrator.options.");
+          },
+          "Raises InputError naming the first invalid option.");
 
   py::class_<Integrator>(m, "Integrator", "A time integrator (one of integrator_names()).")
       .def_property_readonly(

@@ -219,7 +219,7 @@ def test_simulator_from_code_equals_the_same_scene():
     other = jelly.Simulator(scene)
     other.run_until(0.5)
     assert np.array_equal(sim.state.x, other.state.x)
-    with pytest.raises(jelly.InputError, match="unknown integrator 'rk5'"):
+    with pytest.raises(jelly.InputError, match='integrator.name = "rk5" is invalid'):
         jelly.Simulator(model, integrator="rk5")
 
 
