@@ -14,26 +14,6 @@ namespace jelly {
 
 namespace {
 
-std::unique_ptr<TerrainSpec> read_terrain(const Json& j, const std::string& path) {
-  JsonFields f(j, path);
-  const std::string kind = f.string("kind");
-  std::unique_ptr<TerrainSpec> t = find_terrain_kind(kind, f.path("kind")).read(f);
-  if (const Json* c = f.value("contact")) {
-    JsonFields g(*c, f.path("contact"));
-    t->contact = ContactParams::read(g);
-  }
-  f.reject_unknown();
-  return t;
-}
-
-Json terrain_json(const TerrainSpec& t) {
-  Json j;
-  j["kind"] = std::string(t.kind());
-  t.write(j);
-  j["contact"] = t.contact.to_json();
-  return j;
-}
-
 // The one-body form of the seed scenes: "cube" and "springs" at the top.
 BodySpec read_legacy_cube(JsonFields& root) {
   BodySpec body = Scene::seed_cube_body();
@@ -87,7 +67,7 @@ Scene scene_from_json(const Json& j) {
       throw InputError("terrains", json_text(*ts), "a list of terrains [{...}, ...]");
     }
     for (std::size_t i = 0; i < ts->size(); ++i) {
-      s.terrains.emplace_back(read_terrain((*ts)[i], json_element("terrains", i)));
+      s.terrains.emplace_back(read_terrain_spec((*ts)[i], json_element("terrains", i)));
     }
   }
 
@@ -141,7 +121,7 @@ std::string scene_to_json(const Scene& s) {
   j["gravity"] = json_of(s.gravity);
   j["max_particles"] = s.max_particles;
   j["terrains"] = Json::array();
-  for (const auto& t : s.terrains) j["terrains"].push_back(terrain_json(*t));
+  for (const auto& t : s.terrains) j["terrains"].push_back(terrain_spec_json(*t));
   j["body_contact"] = s.body_contact.to_json();
   j["integrator"] = {{"name", s.integrator.name},
                      {"dt", s.integrator.dt},

@@ -41,4 +41,24 @@ const TerrainKindInfo& find_terrain_kind(std::string_view name, const std::strin
   throw InputError(field, "\"" + std::string(name) + "\"", "one of " + known);
 }
 
+std::unique_ptr<TerrainSpec> read_terrain_spec(const Json& object, const std::string& path) {
+  JsonFields f(object, path);
+  const std::string kind = f.string("kind");
+  std::unique_ptr<TerrainSpec> t = find_terrain_kind(kind, f.path("kind")).read(f);
+  if (const Json* c = f.value("contact")) {
+    JsonFields g(*c, f.path("contact"));
+    t->contact = ContactParams::read(g);
+  }
+  f.reject_unknown();
+  return t;
+}
+
+Json terrain_spec_json(const TerrainSpec& spec) {
+  Json j;
+  j["kind"] = std::string(spec.kind());
+  spec.write(j);
+  j["contact"] = spec.contact.to_json();
+  return j;
+}
+
 }  // namespace jelly

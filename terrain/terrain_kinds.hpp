@@ -24,4 +24,10 @@ const std::vector<TerrainKindInfo>& terrain_kinds();
 // Throws InputError naming `field` and listing the known kinds for an unknown name.
 const TerrainKindInfo& find_terrain_kind(std::string_view name, const std::string& field);
 
+// A whole terrain object of a scene ({"kind": ..., the kind's keys, "contact": {...}}) at the JSON
+// path `path`: read, validated, unknown keys refused (InputError naming the path).
+std::unique_ptr<TerrainSpec> read_terrain_spec(const Json& object, const std::string& path);
+// The same object written out with every key.
+Json terrain_spec_json(const TerrainSpec& spec);
+
 }  // namespace jelly

@@ -32,15 +32,7 @@ std::unique_ptr<Terrain> terrain_from_spec(const py::object& spec) {
     throw InputError(field, "\"" + text.substr(0, 60) + "\"",
                      "a terrain object as a dict or JSON text, {\"kind\": ..., ...}");
   }
-  JsonFields f(j, field);
-  const std::string kind = f.string("kind");
-  std::unique_ptr<TerrainSpec> t = find_terrain_kind(kind, f.path("kind")).read(f);
-  if (const Json* c = f.value("contact")) {
-    JsonFields g(*c, f.path("contact"));
-    t->contact = ContactParams::read(g);
-  }
-  f.reject_unknown();
-  return t->make();
+  return read_terrain_spec(j, field)->make();
 }
 
 void bind_terrain(py::module_& m) {
