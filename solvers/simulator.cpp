@@ -130,6 +130,14 @@ void Simulator::emit_frame() {
 
 RunReport Simulator::run_until(Real t_end) {
   require(std::isfinite(t_end), "t_end", t_end, "a finite time");
+  // A step or output interval lost to rounding at the run's largest time (t + h == t) would loop
+  // forever. (io/run_limits.hpp checks a whole run's step and frame counts before it starts.)
+  const Real largest = std::max(std::abs(state_.t), std::abs(t_end));
+  require(state_.t >= t_end - 0.5 * options_.dt || largest + options_.dt > largest, "integrator.dt",
+          options_.dt, "a step not lost to rounding at t = " + to_text(largest));
+  require(options_.output_interval == 0 || largest + options_.output_interval > largest,
+          "output_interval", options_.output_interval,
+          "an interval not lost to rounding at t = " + to_text(largest));
   const auto start = std::chrono::steady_clock::now();
   const long evaluations_before = force_evaluations_;
   RunReport report;

@@ -41,6 +41,28 @@ TEST(Simulator, RejectsBadTimeStep) {
   EXPECT_THROW(Simulator(m, rest_state(m), make_integrator("rk4"), o), InputError);
 }
 
+// t + dt == t (a far time) would loop forever: refused before the first step.
+TEST(Simulator, RefusesStepsAndOutputIntervalsLostToRounding) {
+  const Model m = build_cube(testing::small_cube(2));
+  State far = rest_state(m);
+  far.t = 1e300;
+  Simulator sim(m, far, make_integrator("rk4"));
+  try {
+    sim.run_until(2e300);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "integrator.dt = 0.001 is invalid: a step not lost to rounding at t = "
+                 "2.0000000000000001e+300");
+  }
+  SimulatorOptions o;
+  o.output_interval = 1e-300;
+  Simulator tiny(m, rest_state(m), make_integrator("rk4"), o);
+  EXPECT_THROW(tiny.run_until(1), InputError);
+  Simulator fine(m, rest_state(m), make_integrator("rk4"));
+  EXPECT_TRUE(fine.run_until(0.01).ok());
+}
+
 TEST(Simulator, ObserversAtTheOutputInterval) {
   const Model m = build_cube(testing::small_cube(2));
   Simulator sim = testing::make_sim(m, rest_state(m), "rk4", 0.001, 0.1);
