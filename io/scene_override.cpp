@@ -69,6 +69,10 @@ std::vector<PathStep> parse_path(const std::string& path, const std::string& ass
       steps.push_back({inside, true, true, std::stoul(inside)});
       pos = close + 1;
     }
+    if (steps.size() > static_cast<std::size_t>(kMaxJsonDepth / 2)) {
+      throw fail("the path '" + path.substr(0, 60) + (path.size() > 60 ? "..." : "") +
+                 "' has more than " + std::to_string(kMaxJsonDepth / 2) + " steps");
+    }
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
@@ -86,7 +90,8 @@ void apply_override(Json& scene, const std::string& assignment) {
   const std::string path = assignment.substr(0, equals);
   const std::string text = assignment.substr(equals + 1);
   Json value;
-  if (!parse_json_if_json(text, set_name(assignment), &value)) {
+  // A path and a value of at most half the nesting each keep the edited scene within it.
+  if (!parse_json_if_json(text, set_name(assignment), &value, kMaxJsonDepth / 2)) {
     value = text;
     try {
       (void)value.dump();

@@ -68,12 +68,17 @@ std::vector<T> read_all(hid_t parent, const std::string& name, hid_t memory_type
                         std::vector<hsize_t>* dims_out) {
   Handle dataset = open_dataset(parent, name);
   const std::vector<hsize_t> dims = dataset_dims(dataset.get());
-  // A file can claim any shape (its chunks need not exist): refuse before allocating.
-  const hsize_t limit = kMaxReadBytes / sizeof(T);
+  // A file can claim any shape (its chunks need not exist): refuse before allocating more than
+  // kMaxReadBytes, or more than its stored bytes could hold (deflate expands at most about
+  // 1032 times; jelly's files store every chunk they claim).
+  const hsize_t stored = H5Dget_storage_size(dataset.get());
+  const hsize_t limit =
+      std::min<hsize_t>(kMaxReadBytes, std::max<hsize_t>(1 << 20, 1100 * stored)) / sizeof(T);
   hsize_t count = 1;
   for (hsize_t d : dims) {
     if (d != 0 && count > limit / d) {
-      throw std::runtime_error("HDF5: dataset " + name + " claims more than " +
+      throw std::runtime_error("HDF5: dataset " + name + " claims more values than it stores (" +
+                               std::to_string(stored) + " bytes) or than " +
                                std::to_string(kMaxReadBytes >> 30) + " GiB");
     }
     count *= d;

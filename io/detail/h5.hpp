@@ -92,10 +92,11 @@ inline void write_dataset(hid_t parent, const std::string& name, const std::vect
 }
 
 std::vector<hsize_t> dataset_dims(hid_t dataset);
-// The readers refuse a dataset larger than this (a damaged file can claim any shape).
+// The readers refuse a dataset larger than this, or than its stored bytes could hold (a damaged
+// file can claim any shape).
 constexpr hsize_t kMaxReadBytes = hsize_t{16} << 30;
 // The whole dataset converted to double / int / long; dims receives its shape. Throws
-// std::runtime_error for a missing dataset or one of more than kMaxReadBytes.
+// std::runtime_error for a missing dataset or one of more than kMaxReadBytes (or than it stores).
 std::vector<double> read_doubles(hid_t parent, const std::string& name,
                                  std::vector<hsize_t>* dims = nullptr);
 std::vector<int> read_ints(hid_t parent, const std::string& name,

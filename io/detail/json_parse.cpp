@@ -19,16 +19,16 @@ namespace {
 // seen in each open object, and the nesting depth.
 class Tracker {
  public:
-  explicit Tracker(std::string source) : source_(std::move(source)) {}
+  Tracker(std::string source, int max_depth) : source_(std::move(source)), max_depth_(max_depth) {}
 
   bool on_event(int depth, Json::parse_event_t event, const Json& parsed) {
     switch (event) {
       case Json::parse_event_t::object_start:
       case Json::parse_event_t::array_start:
-        if (depth >= kMaxJsonDepth) {
+        if (depth >= max_depth_) {
           std::string at = where();
           if (at.size() > 60) at = at.substr(0, 57) + "...";
-          fail("it nests arrays and objects deeper than " + std::to_string(kMaxJsonDepth) +
+          fail("it nests arrays and objects deeper than " + std::to_string(max_depth_) +
                " levels at " + (at.empty() ? std::string("the top") : at) + " (a scene needs 4)");
         }
         frames_.push_back({event == Json::parse_event_t::array_start, 0, {}, {}, where()});
@@ -80,6 +80,7 @@ class Tracker {
   }
 
   std::string source_;
+  int max_depth_;
   std::vector<Frame> frames_;
 };
 
@@ -118,15 +119,16 @@ bool parse(const std::string& text, Tracker& tracker, bool if_json, Json* out) {
 
 }  // namespace
 
-Json parse_json(const std::string& text, const std::string& source) {
-  Tracker tracker(source);
+Json parse_json(const std::string& text, const std::string& source, int max_depth) {
+  Tracker tracker(source, max_depth);
   Json j;
   parse(text, tracker, /*if_json=*/false, &j);
   return j;
 }
 
-bool parse_json_if_json(const std::string& text, const std::string& source, Json* out) {
-  Tracker tracker(source);
+bool parse_json_if_json(const std::string& text, const std::string& source, Json* out,
+                        int max_depth) {
+  Tracker tracker(source, max_depth);
   return parse(text, tracker, /*if_json=*/true, out);
 }
 

@@ -15,12 +15,14 @@ constexpr int kMaxJsonDepth = 64;
 // Parses `text`. Throws InputError "<source> is not valid JSON: ..." for text that is not JSON,
 // a number that overflows a double, a key repeated in one object (naming its JSON path) or
 // nesting deeper than kMaxJsonDepth (naming the path where it happens).
-Json parse_json(const std::string& text, const std::string& source);
+Json parse_json(const std::string& text, const std::string& source, int max_depth = kMaxJsonDepth);
 
 // The same for text that may also be meant as a plain string (a --set value): returns false and
 // leaves `out` unchanged when `text` is not JSON at all; throws InputError as parse_json does
-// when it is JSON that cannot be accepted (too deep, a repeated key, an overflowing number).
-bool parse_json_if_json(const std::string& text, const std::string& source, Json* out);
+// when it is JSON that cannot be accepted (deeper than max_depth, a repeated key, an
+// overflowing number).
+bool parse_json_if_json(const std::string& text, const std::string& source, Json* out,
+                        int max_depth = kMaxJsonDepth);
 
 // The text of a JSON file named by a user (`what`: "scene file"). Throws InputError "cannot read
 // the <what> '<path>': <why>" for a missing or unreadable file, anything but a regular file (a

@@ -78,7 +78,13 @@ TEST(Crashes, DeeplyNestedJsonInASceneOrASetValueExitsTwo) {
   EXPECT_THAT(r.err, HasSubstr("deeper than 64 levels at description[0][0]"));
   r = jelly("run " + kSmallSlope + " --set 'description=" + nested(30000) + "'");
   EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err, HasSubstr("deeper than 64 levels"));
+  EXPECT_THAT(r.err, HasSubstr("deeper than 32 levels"));
+  // A long path created the nesting itself.
+  std::string path;
+  for (int i = 0; i < 30000; ++i) path += "a.";
+  r = jelly("run " + kSmallSlope + " --set '" + path + "a=1'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("' has more than 32 steps"));
 }
 
 TEST(Crashes, DeeplyNestedSceneStoredInARecordingExitsTwo) {

@@ -53,12 +53,20 @@ TEST(JsonParse, DeepSetValuesAndAppliedOverridesAreRefused) {
   // Messages quote a long assignment cut short.
   EXPECT_EQ(error_of(kMinimal, {"description=" + nested(100000)}),
             "--set 'description=" + std::string(65, '[') +
-                "...' is not valid JSON: it nests arrays and objects deeper than 64 levels at "
+                "...' is not valid JSON: it nests arrays and objects deeper than 32 levels at "
                 "[0][0][0][0][0][0][0][0][0][0][0][0][0][0][0][0][0][0][0]... (a scene needs 4)");
   EXPECT_THROW(apply_override(nested(100000), "a=1"), InputError);
+  // A value (32 levels) and a path (32 steps) of half the limit each: the edited scene, written
+  // out by apply_override, reads back.
+  const std::string edited = apply_override(kMinimal, "description.a.b=" + nested(32));
+  EXPECT_NO_THROW(detail::parse_json(edited, "edited"));
+  // A path of 60,000 keys created objects 60,000 deep (a crash when printed).
+  std::string long_path;
+  for (int i = 0; i < 60000; ++i) long_path += "a.";
+  EXPECT_THAT(error_of(kMinimal, {long_path + "a=1"}), HasSubstr("' has more than 32 steps"));
   // Unbalanced brackets are refused as soon as they are too deep, before the end of the text.
   EXPECT_THAT(error_of(kMinimal, {"description=" + std::string(100000, '[')}),
-              HasSubstr("deeper than 64 levels"));
+              HasSubstr("deeper than 32 levels"));
   // Text that is not JSON is a string value, which validation then checks.
   EXPECT_EQ(error_of(kMinimal, {"description=[[[", "duration=[["}),
             "duration = \"[[\" is invalid: a number");

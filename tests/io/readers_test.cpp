@@ -156,7 +156,9 @@ TEST_F(DamagedRecording, DatasetsClaimingMoreThanMemoryAreRefusedBeforeAllocatin
   H5Pclose(properties);
   H5Sclose(space);
   H5Fclose(file);
-  EXPECT_THAT(recording_error(path_), HasSubstr("dataset /particles/jelly/mass claims more than"));
+  EXPECT_THAT(
+      recording_error(path_),
+      HasSubstr("dataset /particles/jelly/mass claims more values than it stores (0 bytes)"));
 }
 
 TEST_F(DamagedRecording, CheckpointSeedContactArraysOfDifferentLengths) {
