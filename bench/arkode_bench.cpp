@@ -8,9 +8,14 @@
 #include <jelly/jelly.hpp>
 
 int main(int argc, char** argv) {
+  const char* const usage =
+      " <slope|elevator> <integrator> <dt> <t_end> [rtol] [atol] [schur|klu]\n";
+  if (argc == 2 && std::string(argv[1]) == "--help") {
+    std::cout << "usage: " << argv[0] << usage;
+    return 0;
+  }
   if (argc < 5) {
-    std::cerr << "usage: " << argv[0]
-              << " <slope|elevator> <integrator> <dt> <t_end> [rtol] [atol] [schur|klu]\n";
+    std::cerr << "error: expected at least 4 arguments\nusage: " << argv[0] << usage;
     return 2;
   }
   try {

@@ -57,6 +57,10 @@ struct Config {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "--help") {
+    std::printf("usage: %s [seconds] [repeats] [directory]\n", argv[0]);
+    return 0;
+  }
   const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
   const std::string dir = argc > 3 ? argv[3] : std::filesystem::temp_directory_path().string();
@@ -85,6 +89,7 @@ int main(int argc, char** argv) {
           jelly::RecorderOptions options;
           options.background_writer = c.background;
           options.compression_level = c.compression;
+          options.overwrite = true;  // its own scratch file, from the configuration before
           recorder = std::make_unique<jelly::H5Recorder>(path, sim, options);
           sim.add_observer(*recorder);
         }

@@ -1,0 +1,29 @@
+#pragma once
+// For the recording and checkpoint fuzz targets: small valid recordings written once per process,
+// and a copy of one altered by a program of HDF5 edits read from the fuzzer's input (datasets
+// replaced by others of any shape, type and values, resized, deleted or swapped; attributes set
+// to scalars, arrays or text; the stored scene edited). The readers must turn whatever results
+// into an InputError or a valid object, never read out of bounds or hang.
+#include <string>
+
+#include <jelly/io/scene.hpp>
+
+#include "fuzz/fuzz_input.hpp"
+
+namespace jelly::fuzz {
+
+// The pristine recordings: 0 = rk4 with seed contact on the slope, 1 = implicit_euler with
+// coulomb contact inside its solve (a checkpoint with integrator state).
+constexpr int kPristineCount = 2;
+const Scene& pristine_scene(int which);
+
+struct Mutated {
+  std::string path;  // a scratch copy, rewritten by the next call
+  int which = 0;     // the pristine recording it started from
+};
+
+// Picks a pristine recording, copies it and applies the edits read from `in`. With
+// `checkpoint_focus` the edits touch /checkpoint and /parameters only.
+Mutated mutated_recording(FuzzInput& in, bool checkpoint_focus);
+
+}  // namespace jelly::fuzz
