@@ -62,10 +62,7 @@ def first_program(words):
 
 
 def is_command(text):
-    try:
-        words = shlex.split(text, comments=False)
-    except ValueError:
-        words = text.split()
+    words = split_words(text)
     if not words:
         return False
     if re.match(r"^[A-Z_][A-Z0-9_]*=\S*$", words[0]) and len(words) == 1:
@@ -128,8 +125,11 @@ def extract(path):
             if " " in span.strip() and is_command(span):
                 kind = "inline"
                 words = span.split()
-                # `jelly run`, `jelly run --restart f.h5`: a subcommand or option named in prose
-                if len(words) <= 2 or (len(words) > 2 and words[2].startswith("-")):
+                # `jelly run`, `jelly run --restart f.h5`, `scripts/animate.py --fps 60`: a
+                # subcommand or an option named in prose, not a command to run
+                first_argument = 2 if re.match(r"^[a-z][a-z-]*$", words[1]) else 1
+                if len(words) <= 2 or (len(words) > first_argument and
+                                       words[first_argument].startswith("-")):
                     kind = "mention"
                 commands.append((i + 1, normalize(span), kind))
         i += 1
@@ -154,9 +154,16 @@ def is_synopsis(text):
     return False
 
 
+def split_words(text):
+    try:
+        return shlex.split(text)
+    except ValueError:
+        return text.split()
+
+
 def help_command(text):
     """`program [subcommand] --help` for a synopsis."""
-    words = text.split()
+    words = split_words(text)
     program_index = 0
     while program_index < len(words) and words[program_index] != first_program(words):
         program_index += 1
@@ -167,8 +174,9 @@ def help_command(text):
 
 
 def load_exceptions(path):
-    """{normalized command: (action, seconds, reason)} from doc_commands.txt."""
-    exceptions = {}
+    """({normalized command: (action, seconds, reason)}, {file: [setup commands]}) from
+    doc_commands.txt."""
+    exceptions, setups = {}, {}
     action = None
     for raw in open(path, encoding="utf-8"):
         line = raw.rstrip("\n")
@@ -176,15 +184,21 @@ def load_exceptions(path):
             continue
         if line.startswith("    "):
             if action is None:
-                sys.exit(f"{path}: a command before any 'skip:' or 'timeout N:' line")
-            exceptions[normalize(line)] = action
+                sys.exit(f"{path}: a command before any 'skip:', 'timeout N:' or 'setup' line")
+            if action[0] == "setup":
+                setups.setdefault(action[2], []).append(normalize(line))
+            else:
+                exceptions[normalize(line)] = action
             continue
-        m = re.match(r"^(skip|timeout (\d+)):\s*(.+)$", line)
+        m = re.match(r"^(skip|timeout (\d+)|setup (\S+)):\s*(.+)$", line)
         if not m:
-            sys.exit(f"{path}: cannot read '{line}' (expected 'skip: reason' or 'timeout N: "
-                     f"reason', then the commands indented by 4 spaces)")
-        action = ("timeout" if m.group(2) else "skip", int(m.group(2) or 0), m.group(3))
-    return exceptions
+            sys.exit(f"{path}: cannot read '{line}' (expected 'skip: reason', 'timeout N: "
+                     f"reason' or 'setup FILE.md: reason', then commands indented by 4 spaces)")
+        if m.group(3):
+            action = ("setup", 0, m.group(3))
+        else:
+            action = ("timeout" if m.group(2) else "skip", int(m.group(2) or 0), m.group(4))
+    return exceptions, setups
 
 
 def make_sandbox(source, build):
@@ -230,7 +244,8 @@ def main():
     files = args.files or (["README.md"] + sorted(
         os.path.join("docs", f) for f in os.listdir(os.path.join(source, "docs"))
         if f.endswith(".md")))
-    exceptions = load_exceptions(os.path.join(source, "tests", "docs", "doc_commands.txt"))
+    exceptions, setups = load_exceptions(
+        os.path.join(source, "tests", "docs", "doc_commands.txt"))
     seen = set()
     failures = []
     if args.check_exceptions:
@@ -255,6 +270,11 @@ def main():
         env["PATH"] = bin_dir + os.pathsep + env.get("PATH", "")
         assignments = []
         try:
+            for text in setups.get(name, []):
+                ok, _, output = run(text, sandbox, env, DEFAULT_TIMEOUT)
+                print(f"{name}: setup {'ok' if ok else 'FAILED'}: {text}")
+                if not ok:
+                    failures.append((f"{name} (setup in doc_commands.txt)", text, output))
             for line, text, kind in commands:
                 seen.add(text)
                 where = f"{name}:{line}"
