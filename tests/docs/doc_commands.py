@@ -15,9 +15,11 @@ Output and formulas in the same blocks do not start with one and are left alone.
   commands of one file run in order in one sandbox, so that `jelly run ... -o run.h5` followed by
   `jelly fit run.h5` works as it does for a reader; assignments (B=...) carry over.
 * tests/docs/doc_commands.txt lists the exceptions, each with its reason: `skip` (a command
-  that installs, needs a program jelly does not depend on, or rebuilds the tree), or
-  `timeout N` (a benchmark that runs for minutes: it must not fail in its first N seconds). An
-  exception that matches no command in the docs is an error too, so the list stays true.
+  that installs or rebuilds the tree), `timeout N` (a benchmark that runs for minutes: it must
+  not fail in its first N seconds), `display N` (a window: run under xvfb-run, the same way),
+  `if-installed PROGRAM` (a program jelly does not depend on, such as ParaView's pvpython), and
+  `setup FILE.md` (commands run first in that file's sandbox, e.g. to make the recording its
+  examples read). An exception that matches no command in the docs is an error too.
 
 Usage: doc_commands.py --source DIR --build DIR [--list | --check-exceptions] [FILE.md ...]
 (ctest runs each markdown file as its own test, and --check-exceptions once.)
@@ -190,14 +192,23 @@ def load_exceptions(path):
             else:
                 exceptions[normalize(line)] = action
             continue
-        m = re.match(r"^(skip|timeout (\d+)|setup (\S+)):\s*(.+)$", line)
+        m = re.match(r"^(skip|timeout (\d+)|display (\d+)|if-installed (\S+)|setup (\S+)):"
+                     r"\s*(.+)$", line)
         if not m:
             sys.exit(f"{path}: cannot read '{line}' (expected 'skip: reason', 'timeout N: "
-                     f"reason' or 'setup FILE.md: reason', then commands indented by 4 spaces)")
-        if m.group(3):
-            action = ("setup", 0, m.group(3))
+                     f"reason', 'display N: reason', 'if-installed PROGRAM: reason' or "
+                     f"'setup FILE.md: reason', then commands indented by 4 spaces)")
+        reason = m.group(6)
+        if m.group(5):
+            action = ("setup", 0, m.group(5))
+        elif m.group(4):
+            action = ("if-installed", DEFAULT_TIMEOUT, reason, m.group(4))
+        elif m.group(3):
+            action = ("display", int(m.group(3)), reason)
+        elif m.group(2):
+            action = ("timeout", int(m.group(2)), reason)
         else:
-            action = ("timeout" if m.group(2) else "skip", int(m.group(2) or 0), m.group(4))
+            action = ("skip", 0, reason)
     return exceptions, setups
 
 
@@ -288,11 +299,20 @@ def main():
                 command = text.rstrip("&").rstrip()
                 if (kind == "mention" or is_synopsis(text)) and not action:
                     command = help_command(text)
+                if action and action[0] == "if-installed" and not shutil.which(action[3]):
+                    print(f"{where}: skipped ({action[3]} is not installed: {action[2]}): {text}")
+                    continue
+                if action and action[0] == "display":
+                    if not shutil.which("xvfb-run"):
+                        print(f"{where}: skipped (needs a display; xvfb-run is not installed): "
+                              f"{text}")
+                        continue
+                    command = "xvfb-run -a " + command
                 seconds = action[1] if action else DEFAULT_TIMEOUT
                 start = time.monotonic()
                 ok, running, output = run("\n".join(assignments + [command]), sandbox, env,
                                           seconds)
-                if running and not action:
+                if running and not (action and action[0] in ("timeout", "display")):
                     ok = False
                     output += f"\n(still running after {seconds} s)"
                 took = time.monotonic() - start
