@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Figures of the Python module jelly (docs/python.md): what calling C++ from Python costs.
 
 1. step: sim.step() called from Python on the seed cube (n = 10 on the 20-degree slope, rk4,
