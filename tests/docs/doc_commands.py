@@ -143,9 +143,9 @@ PIPE_PROGRAMS = {"grep", "head", "tail", "sort", "tee", "wc", "less"}
 
 
 def is_synopsis(text):
-    """Optional parts in [brackets], placeholders (SCENE.json, NAME, PATH=VALUE) or alternatives
-    written a | b: a usage line, not a command."""
-    if re.search(r"(^|\s)[\[<]", text):
+    """Optional parts in [brackets], placeholders (SCENE.json, NAME, PATH=VALUE, out/<scene>.h5)
+    or alternatives written a | b: a usage line, not a command."""
+    if re.search(r"(^|\s)[\[<]", text) or re.search(r"<[A-Za-z_][\w-]*>", text):
         return True
     words = text.split()
     if any(PLACEHOLDER.match(w) for w in words[1:]):
