@@ -118,6 +118,9 @@ int main(int argc, char** argv) {
   speed_cmd->add_option("--dt", speed.dt, "time step (s)")->capture_default_str();
   speed_cmd->add_option("--steps", speed.steps, "timed steps per configuration")
       ->capture_default_str();
+  speed_cmd->add_option("--threads", speed.threads, "thread counts, one row each (0 = all cores)")
+      ->delimiter(',')
+      ->capture_default_str();
 
   SeedOptions seed;
   CLI::App* seed_cmd = app.add_subcommand("seed", "the seed report's stability claims");

@@ -6,6 +6,7 @@
 #include <jelly/bench/memory.hpp>
 #include <jelly/bench/scenes.hpp>
 #include <jelly/bench/stability_region.hpp>
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
@@ -19,6 +20,8 @@ void SpeedOptions::validate() const {
   require(std::isfinite(dt) && dt > 0, "--dt", dt, "a time step > 0 s");
   require(steps >= 1, "--steps", steps, "an integer >= 1");
   require(warmup_steps >= 0, "--warmup-steps", warmup_steps, "an integer >= 0");
+  require(!threads.empty(), "--threads", "(empty)", "at least one thread count");
+  for (int t : threads) require(t >= 0, "--threads", t, "thread counts >= 0 (0 = all cores)");
 }
 
 namespace {
@@ -39,104 +42,110 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
               "cost per step on the seed slope (cube lowered onto the slope, contacts active); "
               "seconds per step; force_seconds = evaluations per step x the mean time of one "
               "evaluation timed between the steps",
-              {"item", "integrator:s", "n", "particles", "springs", "dt", "steps", "status:s",
-               "contacts", "step_seconds", "integrator_seconds", "force_seconds", "contact_seconds",
-               "evaluations_per_step", "springs_per_second", "peak_memory_bytes",
+              {"item", "integrator:s", "n", "threads", "particles", "springs", "dt", "steps",
+               "status:s", "contacts", "step_seconds", "integrator_seconds", "force_seconds",
+               "contact_seconds", "evaluations_per_step", "springs_per_second", "peak_memory_bytes",
                "memory_per_configuration"});
   Table stats("speed_statistics",
               "the integrator's statistics() over the timed steps (and per timed step)",
-              {"item", "integrator:s", "n", "key:s", "value", "per_step"});
+              {"item", "integrator:s", "n", "threads", "key:s", "value", "per_step"});
   long item = 0;
   for (const std::string& integrator : integrators) {
     for (int n : o.sizes) {
-      const long this_item = item++;
-      if (!o.shard.owns(this_item)) continue;
-      std::vector<Cell> head{static_cast<double>(this_item), integrator, static_cast<double>(n)};
-      if (is_adaptive_integrator(integrator)) {
-        std::vector<Cell> row = head;
-        row.insert(row.end(), {NAN, NAN, o.dt, 0.0, std::string("skipped_adaptive"), NAN, NAN, NAN,
-                               NAN, NAN, NAN, NAN, NAN, NAN});
-        speed.add_row(row);
-        continue;
-      }
-      const bool reset = reset_peak_memory();
-      SceneSpec spec;
-      spec.name = "slope";
-      spec.n = n;
-      SceneParts parts = build_scene(spec);
-      // Lower the cube onto the slope: the deepest particle 1 mm below the surface.
-      Real lowest = INFINITY;
-      for (int i = 0; i < parts.model.num_particles(); ++i)
-        lowest = std::min(lowest,
-                          parts.terrains.front()->signed_distance(particle(parts.state.x, i), 0));
-      const Vec3 normal = parts.terrains.front()->normal(Vec3::Zero(), 0);
-      for (int i = 0; i < parts.model.num_particles(); ++i)
-        particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
-      const Model& model = parts.model;
-      State& state = parts.state;
-      auto method = make_integrator(integrator);
-      ContactSolver contacts;
-      const SpringBands bands(model);  // the force loop the Simulator uses
-      const DivergenceGuard guard;
-      State before;
-      double integrator_seconds = 0, contact_seconds = 0, force_probe_seconds = 0;
-      VecX f(model.num_dofs());
-      long evaluations = 0;
-      std::string status = "completed";
-      int timed = 0;
-      Statistics before_timing;
-      for (int k = 0; k < o.warmup_steps + o.steps; ++k) {
-        const bool timing = k >= o.warmup_steps;
-        if (k == o.warmup_steps) before_timing = method->statistics();
-        before.x = state.x;
-        before.v = state.v;
-        const Dynamics dynamics(model, contacts, &parts.terrains, &bands);
-        auto start = Clock::now();
-        const StepResult result = method->step(dynamics, state, o.dt);
-        const double step_time = seconds_since(start);
-        start = Clock::now();
-        if (result.ok)
-          resolve_contact_after_step(*method, contacts, model, parts.terrains, before, state, o.dt);
-        const double contact_time = seconds_since(start);
-        if (timing) {
-          integrator_seconds += step_time;
-          contact_seconds += contact_time;
-          evaluations += dynamics.force_evaluations();
-          ++timed;
-          // One force evaluation (model forces and the seed contact terms), timed between the
-          // steps so that it sees the same load and caches as the steps around it.
+      for (int requested_threads : o.threads) {
+        const long this_item = item++;
+        if (!o.shard.owns(this_item)) continue;
+        const int threads = parallel::resolve_threads(requested_threads);
+        std::vector<Cell> head{static_cast<double>(this_item), integrator, static_cast<double>(n),
+                               static_cast<double>(threads)};
+        if (is_adaptive_integrator(integrator)) {
+          std::vector<Cell> row = head;
+          row.insert(row.end(), {NAN, NAN, o.dt, 0.0, std::string("skipped_adaptive"), NAN, NAN,
+                                 NAN, NAN, NAN, NAN, NAN, NAN, NAN});
+          speed.add_row(row);
+          continue;
+        }
+        const bool reset = reset_peak_memory();
+        SceneSpec spec;
+        spec.name = "slope";
+        spec.n = n;
+        SceneParts parts = build_scene(spec);
+        // Lower the cube onto the slope: the deepest particle 1 mm below the surface.
+        Real lowest = INFINITY;
+        for (int i = 0; i < parts.model.num_particles(); ++i)
+          lowest = std::min(lowest,
+                            parts.terrains.front()->signed_distance(particle(parts.state.x, i), 0));
+        const Vec3 normal = parts.terrains.front()->normal(Vec3::Zero(), 0);
+        for (int i = 0; i < parts.model.num_particles(); ++i)
+          particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
+        const Model& model = parts.model;
+        State& state = parts.state;
+        auto method = make_integrator(integrator);
+        ContactSolver contacts;
+        const SpringBands bands(model);  // the force loop the Simulator uses
+        const DivergenceGuard guard;
+        State before;
+        double integrator_seconds = 0, contact_seconds = 0, force_probe_seconds = 0;
+        VecX f(model.num_dofs());
+        long evaluations = 0;
+        std::string status = "completed";
+        int timed = 0;
+        Statistics before_timing;
+        for (int k = 0; k < o.warmup_steps + o.steps; ++k) {
+          const bool timing = k >= o.warmup_steps;
+          if (k == o.warmup_steps) before_timing = method->statistics();
+          before.x = state.x;
+          before.v = state.v;
+          const Dynamics dynamics(model, contacts, &parts.terrains, &bands, nullptr, threads);
+          auto start = Clock::now();
+          const StepResult result = method->step(dynamics, state, o.dt);
+          const double step_time = seconds_since(start);
           start = Clock::now();
-          bands.compute_forces(model, state.x, state.v, f);
-          contacts.add_forces(state.v, f);
-          force_probe_seconds += seconds_since(start);
+          if (result.ok)
+            resolve_contact_after_step(*method, contacts, model, parts.terrains, before, state,
+                                       o.dt, threads);
+          const double contact_time = seconds_since(start);
+          if (timing) {
+            integrator_seconds += step_time;
+            contact_seconds += contact_time;
+            evaluations += dynamics.force_evaluations();
+            ++timed;
+            // One force evaluation (model forces and the seed contact terms), timed between the
+            // steps so that it sees the same load and caches as the steps around it.
+            start = Clock::now();
+            bands.compute_forces(model, state.x, state.v, f, threads);
+            contacts.add_forces(state.v, f);
+            force_probe_seconds += seconds_since(start);
+          }
+          if (!result.ok) {
+            status = "solver_failed";
+            break;
+          }
+          if (guard.check(model, state)) {
+            status = "diverged";
+            break;
+          }
         }
-        if (!result.ok) {
-          status = "solver_failed";
-          break;
+        const double force_eval = timed > 0 ? force_probe_seconds / timed : NAN;
+        const double per_step = timed > 0 ? 1.0 / timed : NAN;
+        const double evals_per_step = evaluations * per_step;
+        std::vector<Cell> row = head;
+        row.insert(
+            row.end(),
+            {static_cast<double>(model.num_particles()), static_cast<double>(model.springs.size()),
+             o.dt, static_cast<double>(timed), status,
+             static_cast<double>(contacts.contact_count()),
+             (integrator_seconds + contact_seconds) * per_step, integrator_seconds * per_step,
+             evals_per_step * force_eval, contact_seconds * per_step, evals_per_step,
+             model.springs.size() / force_eval, peak_memory_bytes(), reset ? 1.0 : 0.0});
+        speed.add_row(row);
+        // Counters over the timed steps only (the warm-up subtracted).
+        for (const auto& [key, value] : method->statistics()) {
+          const auto it = before_timing.find(key);
+          const double timed_value = value - (it == before_timing.end() ? 0.0 : it->second);
+          stats.add_row({static_cast<double>(this_item), integrator, static_cast<double>(n),
+                         static_cast<double>(threads), key, timed_value, timed_value * per_step});
         }
-        if (guard.check(model, state)) {
-          status = "diverged";
-          break;
-        }
-      }
-      const double force_eval = timed > 0 ? force_probe_seconds / timed : NAN;
-      const double per_step = timed > 0 ? 1.0 / timed : NAN;
-      const double evals_per_step = evaluations * per_step;
-      std::vector<Cell> row = head;
-      row.insert(
-          row.end(),
-          {static_cast<double>(model.num_particles()), static_cast<double>(model.springs.size()),
-           o.dt, static_cast<double>(timed), status, static_cast<double>(contacts.contact_count()),
-           (integrator_seconds + contact_seconds) * per_step, integrator_seconds * per_step,
-           evals_per_step * force_eval, contact_seconds * per_step, evals_per_step,
-           model.springs.size() / force_eval, peak_memory_bytes(), reset ? 1.0 : 0.0});
-      speed.add_row(row);
-      // Counters over the timed steps only (the warm-up subtracted).
-      for (const auto& [key, value] : method->statistics()) {
-        const auto it = before_timing.find(key);
-        const double timed_value = value - (it == before_timing.end() ? 0.0 : it->second);
-        stats.add_row({static_cast<double>(this_item), integrator, static_cast<double>(n), key,
-                       timed_value, timed_value * per_step});
       }
     }
   }

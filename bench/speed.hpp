@@ -15,6 +15,8 @@ namespace jelly::bench {
 struct SpeedOptions {
   std::vector<std::string> integrators;  // empty: every registered integrator
   std::vector<int> sizes{5, 10, 20, 30};
+  // Thread counts, each a row (the scaling table); 0 = all cores.
+  std::vector<int> threads{0};
   Real dt = 1e-3;
   int warmup_steps = 20;
   int steps = 200;

@@ -69,6 +69,11 @@ int main(int argc, char** argv) {
                   "Start from the last checkpoint of this HDF5 file (same scene)")
       ->check(kNonEmpty);
   run->add_flag("-q,--quiet", run_args.quiet, "No progress bar");
+  run->add_option("--threads", run_args.threads,
+                  "Threads for the force loop, the solves and contact (default: all cores; the "
+                  "results are the same for any number)")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber);
 
   std::string info_path;
   CLI::App* info = app.add_subcommand("info", "Describe an HDF5 file written by `jelly run -o`");

@@ -123,6 +123,7 @@ int run_command(const RunArgs& args) {
                    args.restart);
 
   Simulator sim = make_simulator(scene);
+  if (args.threads >= 0) sim.set_threads(args.threads);
   if (checkpoint) restore_from(sim, *checkpoint, args.restart);
 
   std::unique_ptr<Observer> recorder;

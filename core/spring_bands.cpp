@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/forces.hpp>
 
 // One copy of the band loops per instruction set, chosen when the library is loaded (GCC's
@@ -60,22 +61,31 @@ int band_forces(int n, BandEnds e, const Real* __restrict rest, const Real* __re
   return collapsed;
 }
 
-// a[j] += f[j] and a[j + offset] -= f[j] for the three coordinates.
+// a[j] += f[j] (sign > 0) or a[j] -= f[j] for the three coordinates.
 JELLY_VECTOR_CLONES
-void scatter_band(int n, int offset, const Real* __restrict fx, const Real* __restrict fy,
-                  const Real* __restrict fz, Real* __restrict ax, Real* __restrict ay,
-                  Real* __restrict az) {
+void add_band(int n, const Real* __restrict fx, const Real* __restrict fy,
+              const Real* __restrict fz, Real* __restrict ax, Real* __restrict ay,
+              Real* __restrict az) {
   for (int j = 0; j < n; ++j) {
     ax[j] += fx[j];
     ay[j] += fy[j];
     az[j] += fz[j];
   }
+}
+
+JELLY_VECTOR_CLONES
+void subtract_band(int n, const Real* __restrict fx, const Real* __restrict fy,
+                   const Real* __restrict fz, Real* __restrict ax, Real* __restrict ay,
+                   Real* __restrict az) {
   for (int j = 0; j < n; ++j) {
-    ax[j + offset] -= fx[j];
-    ay[j + offset] -= fy[j];
-    az[j + offset] -= fz[j];
+    ax[j] -= fx[j];
+    ay[j] -= fy[j];
+    az[j] -= fz[j];
   }
 }
+
+// Springs per thread below which another thread costs more than it saves.
+constexpr long kMinSpringsPerThread = 8192;
 
 // A band is worth its empty slots when springs fill at least this fraction of them, and bands
 // are worth their loop overhead when they hold this many springs on average.
@@ -91,7 +101,6 @@ SpringBands::SpringBands(const Model& model)
   for (int k = 0; k < s.size(); ++k) by_offset[std::abs(s.b[k] - s.a[k])].push_back(k);
   dense_ = springs_ > 0 && by_offset.count(0) == 0 &&
            springs_ >= kMinimumSpringsPerBand * static_cast<int>(by_offset.size());
-  size_t max_slots = 0;
   for (const auto& [offset, springs] : by_offset) {
     if (!dense_) break;
     int lo = particles_, hi = -1;
@@ -110,7 +119,7 @@ SpringBands::SpringBands(const Model& model)
       if (slot >= 0) dense_ = false;  // two springs on one pair
       slot = k;
     }
-    max_slots = std::max(max_slots, static_cast<size_t>(slots));
+    max_offset_ = std::max(max_offset_, offset);
     bands_.push_back(std::move(band));
   }
   if (!dense_) {
@@ -119,7 +128,6 @@ SpringBands::SpringBands(const Model& model)
   }
   copy_coefficients(model);
   scratch_.assign(9 * static_cast<size_t>(particles_), 0.0);
-  band_force_.assign(3 * max_slots, 0.0);
 }
 
 bool SpringBands::fits(const Model& model) const {
@@ -143,12 +151,20 @@ void SpringBands::copy_coefficients(const Model& model) {
   }
 }
 
-void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f) const {
+void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f,
+                                 int threads) const {
   if (!dense_ || !fits(model)) {
     ::jelly::compute_forces(model, x, v, f);
     return;
   }
   const int n = particles_;
+  const int team = parallel::team_size(threads, springs_, kMinSpringsPerThread);
+  // Per thread: the slots of its particles' springs, at most n + max_offset_ (one thread).
+  const size_t stride = 3 * (static_cast<size_t>(n) + static_cast<size_t>(max_offset_));
+  if (band_force_.size() < static_cast<size_t>(team) * stride) {
+    band_force_.assign(static_cast<size_t>(team) * stride, 0.0);
+    collapsed_.assign(team, 0);
+  }
   Real* px = scratch_.data();
   Real* py = px + n;
   Real* pz = py + n;
@@ -160,38 +176,61 @@ void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& 
   Real* az = ay + n;
   const Real* m = model.mass.data();
   const Vec3 g = model.gravity;
-  for (int i = 0; i < n; ++i) {
-    px[i] = x[3 * i];
-    py[i] = x[3 * i + 1];
-    pz[i] = x[3 * i + 2];
-    pu[i] = v[3 * i];
-    pv[i] = v[3 * i + 1];
-    pw[i] = v[3 * i + 2];
-    ax[i] = m[i] * g.x();
-    ay[i] = m[i] * g.y();
-    az[i] = m[i] * g.z();
-  }
-  const size_t max_slots = band_force_.size() / 3;
-  Real* fx = band_force_.data();
-  Real* fy = fx + max_slots;
-  Real* fz = fy + max_slots;
-  for (const Band& band : bands_) {
-    const int a = band.first, b = band.first + band.offset;
-    const int slots = static_cast<int>(band.spring.size());
-    const BandEnds ends{px + a, py + a, pz + a, pu + a, pv + a, pw + a,
-                        px + b, py + b, pz + b, pu + b, pv + b, pw + b};
-    if (band_forces(slots, ends, band.rest.data(), band.ks.data(), band.kd.data(), fx, fy, fz) >
-        0) {
-      ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: its rest direction
-      return;
+  bool any_collapsed = false;
+  parallel::run(team, [&](int part, int parts) {
+    const parallel::Range range = parallel::split(n, part, parts);
+    const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
+    for (int i = p0; i < p1; ++i) {
+      px[i] = x[3 * i];
+      py[i] = x[3 * i + 1];
+      pz[i] = x[3 * i + 2];
+      pu[i] = v[3 * i];
+      pv[i] = v[3 * i + 1];
+      pw[i] = v[3 * i + 2];
+      ax[i] = m[i] * g.x();
+      ay[i] = m[i] * g.y();
+      az[i] = m[i] * g.z();
     }
-    scatter_band(slots, band.offset, fx, fy, fz, ax + a, ay + a, az + a);
-  }
-  for (int i = 0; i < n; ++i) {
-    f[3 * i] = ax[i];
-    f[3 * i + 1] = ay[i];
-    f[3 * i + 2] = az[i];
-  }
+#pragma omp barrier
+    Real* fx = band_force_.data() + static_cast<size_t>(part) * stride;
+    Real* fy = fx + stride / 3;
+    Real* fz = fy + stride / 3;
+    int collapsed = 0;
+    for (const Band& band : bands_) {
+      const int o = band.offset, first = band.first, slots = band.slots();
+      // Slots whose a (first + slot) or b (a + o) is one of this thread's particles.
+      const int lo = std::max(0, p0 - o - first), hi = std::min(slots, p1 - first);
+      if (lo >= hi) continue;
+      const int a = first + lo, b = a + o;
+      const BandEnds ends{px + a, py + a, pz + a, pu + a, pv + a, pw + a,
+                          px + b, py + b, pz + b, pu + b, pv + b, pw + b};
+      collapsed += band_forces(hi - lo, ends, band.rest.data() + lo, band.ks.data() + lo,
+                               band.kd.data() + lo, fx, fy, fz);
+      // As the serial loop: + on particle a of every slot, then - on particle b.
+      const int a0 = std::max(p0, first + lo), a1 = std::min(p1, first + hi);
+      if (a0 < a1) {
+        const int k = a0 - first - lo;
+        add_band(a1 - a0, fx + k, fy + k, fz + k, ax + a0, ay + a0, az + a0);
+      }
+      const int b0 = std::max(p0, first + o + lo), b1 = std::min(p1, first + o + hi);
+      if (b0 < b1) {
+        const int k = b0 - o - first - lo;
+        subtract_band(b1 - b0, fx + k, fy + k, fz + k, ax + b0, ay + b0, az + b0);
+      }
+    }
+    collapsed_[part] = collapsed;
+#pragma omp barrier
+#pragma omp single
+    for (int t = 0; t < parts; ++t) any_collapsed = any_collapsed || collapsed_[t] > 0;
+    // (the implicit barrier of single: every thread sees any_collapsed)
+    if (any_collapsed) return;
+    for (int i = p0; i < p1; ++i) {
+      f[3 * i] = ax[i];
+      f[3 * i + 1] = ay[i];
+      f[3 * i + 2] = az[i];
+    }
+  });
+  if (any_collapsed) ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: rest direction
 }
 
 }  // namespace jelly

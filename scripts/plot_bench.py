@@ -118,17 +118,23 @@ def plot_work_precision(rows, meta, out):
 
 def plot_speed(rows, meta, out):
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    names = sorted({r["integrator"] for r in rows})
-    for i, name in enumerate(names):
-        sel = sorted((r for r in rows if r["integrator"] == name and r["status"] == "completed"),
-                     key=lambda r: r["springs"])
+    # One line per integrator, and per thread count when the run has several (--threads 1,2).
+    counts = sorted({r.get("threads", 1) for r in rows})
+    keys = sorted({(r["integrator"], r.get("threads", 1)) for r in rows})
+    names = sorted({k[0] for k in keys})
+    for name, threads in keys:
+        i = names.index(name)
+        sel = sorted((r for r in rows if r["integrator"] == name and r.get("threads", 1) == threads
+                      and r["status"] == "completed"), key=lambda r: r["springs"])
         if not sel:
             continue
+        label = name if len(counts) == 1 else "%s, %d threads" % (name, threads)
+        style = "o-" if threads == counts[0] else "s--"
         springs = [r["springs"] for r in sel]
-        axes[0].loglog(springs, [r["step_seconds"] for r in sel], "o-", color="C%d" % i,
-                       label=name)
-        axes[1].semilogx(springs, [r["springs_per_second"] / 1e6 for r in sel], "o-",
-                         color="C%d" % i, label=name)
+        axes[0].loglog(springs, [r["step_seconds"] for r in sel], style, color="C%d" % i,
+                       label=label)
+        axes[1].semilogx(springs, [r["springs_per_second"] / 1e6 for r in sel], style,
+                         color="C%d" % i, label=label)
     axes[0].set_ylabel("seconds per step (indicative: shared CPU)")
     axes[1].set_ylabel("force kernel: million springs per second")
     for ax in axes:

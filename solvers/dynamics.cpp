@@ -1,5 +1,6 @@
 #include <jelly/solvers/dynamics.hpp>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/forces.hpp>
 
@@ -8,7 +9,7 @@ namespace jelly {
 void Dynamics::forces(Real t, const VecX& x, const VecX& v, VecX& f) const {
   ++evaluations_;
   if (bands_)
-    bands_->compute_forces(*model_, x, v, f);
+    bands_->compute_forces(*model_, x, v, f, threads_);
   else
     compute_forces(*model_, x, v, f);
   if (anchors_) add_anchor_forces(*anchors_, x, v, f);
@@ -22,12 +23,14 @@ void Dynamics::acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const
   forces(t, x, v, a);
   const Real* m = model_->mass.data();
   Real* pa = a.data();
-  for (int i = 0; i < model_->num_particles(); ++i) {
-    const Real inv = 1.0 / m[i];
-    pa[3 * i] *= inv;
-    pa[3 * i + 1] *= inv;
-    pa[3 * i + 2] *= inv;
-  }
+  parallel::for_ranges(threads_, model_->num_particles(), [&](long begin, long end) {
+    for (long i = begin; i < end; ++i) {
+      const Real inv = 1.0 / m[i];
+      pa[3 * i] *= inv;
+      pa[3 * i + 1] *= inv;
+      pa[3 * i + 2] *= inv;
+    }
+  });
   if (!model_->pins.empty()) model_->pins.apply_acceleration(t, a);
 }
 

@@ -15,14 +15,17 @@ class Dynamics {
  public:
   // `terrains` (may be null) is for integrators that resolve contact inside their step;
   // `bands` (may be null), built for `model`, evaluates the spring forces faster; `anchors`
-  // (may be null) are added to the forces, and implicit integrators add their Jacobian.
+  // (may be null) are added to the forces, and implicit integrators add their Jacobian;
+  // `threads` (>= 1) is how many threads the force loop and the integrators' own loops may use.
   Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains = nullptr,
-           const SpringBands* bands = nullptr, const AnchorSprings* anchors = nullptr)
+           const SpringBands* bands = nullptr, const AnchorSprings* anchors = nullptr,
+           int threads = 1)
       : model_(&model),
         contacts_(&contacts),
         terrains_(terrains),
         bands_(bands),
-        anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr) {}
+        anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr),
+        threads_(threads > 1 ? threads : 1) {}
 
   // f(t, x, v): size 3N, no allocation. Pinned particles get the forces as if free (an
   // implicit method constrains them itself).
@@ -37,6 +40,8 @@ class Dynamics {
   // The anchor springs, or null when there are none.
   const AnchorSprings* anchors() const { return anchors_; }
   long force_evaluations() const { return evaluations_; }
+  // Threads the integrator may use for its own loops (results do not depend on it).
+  int threads() const { return threads_; }
 
  private:
   const Model* model_;
@@ -44,6 +49,7 @@ class Dynamics {
   const Terrains* terrains_;
   const SpringBands* bands_;
   const AnchorSprings* anchors_;
+  int threads_;
   mutable long evaluations_ = 0;
 };
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
 
@@ -13,6 +14,7 @@ void SimulatorOptions::validate() const {
   require(std::isfinite(dt) && dt > 0, "integrator.dt", dt, "a finite time step > 0 s");
   require(std::isfinite(output_interval) && output_interval >= 0, "output_interval",
           output_interval, "a finite interval >= 0 s (0 = every step)");
+  require(threads >= 0, "threads", threads, "an integer >= 0 (0 = all cores)");
   divergence.validate();
 }
 
@@ -46,6 +48,11 @@ void Simulator::set_body_contact(const BodyContactParams& params) {
 }
 
 void Simulator::check_no_overlap() { body_contact_.check_no_overlap(model_, state_.x); }
+
+void Simulator::set_threads(int threads) {
+  require(threads >= 0, "threads", threads, "an integer >= 0 (0 = all cores)");
+  options_.threads = threads;
+}
 
 void Simulator::add_observer(Observer& observer) { observers_.push_back(&observer); }
 
@@ -105,7 +112,8 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
 }
 
 StepResult Simulator::step() {
-  const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_);
+  const int threads = parallel::resolve_threads(options_.threads);
+  const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_, threads);
   before_.x = state_.x;
   before_.v = state_.v;
   StepResult result = integrator_->step(dynamics, state_, options_.dt);
@@ -114,7 +122,7 @@ StepResult Simulator::step() {
   // Bodies first, then the terrains: a terrain has the last word on where a particle may be.
   if (body_contact_.active(model_)) body_contact_.resolve(model_, before_, state_, options_.dt);
   resolve_contact_after_step(*integrator_, contacts_, model_, terrains_, before_, state_,
-                             options_.dt);
+                             options_.dt, threads);
   if (!model_.pins.empty()) model_.pins.apply(state_.t, state_.x, state_.v);
   ++total_steps_;
   return result;

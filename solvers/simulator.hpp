@@ -30,6 +30,9 @@ struct SimulatorOptions {
   Real dt = 0.001;           // s, > 0
   Real output_interval = 0;  // s between observer frames; 0 = every step
   DivergenceGuard divergence;
+  // Threads for the force loop, the integrators' solves and the contact after a step; 0 = all
+  // cores this process may run on. Results are the same bit for bit for any value.
+  int threads = 0;
   void validate() const;
 };
 
@@ -99,6 +102,8 @@ class Simulator {
   const Integrator& integrator() const { return *integrator_; }
   Integrator& integrator() { return *integrator_; }
   const SimulatorOptions& options() const { return options_; }
+  // Sets options().threads (0 = all cores). Throws InputError for a negative count.
+  void set_threads(int threads);
   const ContactSolver& contacts() const { return contacts_; }
   const BodyContact& body_contact() const { return body_contact_; }
   long total_steps() const { return total_steps_; }

@@ -9,7 +9,9 @@
 //
 // Same forces as compute_forces up to rounding (another summation order). A model whose springs
 // do not fill their bands densely, or a state with a degenerate (collapsed) spring, is evaluated
-// by compute_forces instead.
+// by compute_forces instead. With threads, each thread owns a range of particles; it computes
+// the forces of the slots that touch its particles (the slots at the boundary of two ranges are
+// computed by both) and adds them in the serial loop's order (docs/threads.md).
 #include <vector>
 
 #include <jelly/core/model.hpp>
@@ -18,6 +20,15 @@ namespace jelly {
 
 class SpringBands {
  public:
+  // Springs (a, b = a + offset) with a = first + slot, for slot in [0, spring.size()).
+  struct Band {
+    int offset = 0;                  // b - a
+    int first = 0;                   // first particle a of slot 0
+    std::vector<int> spring;         // [slots]: spring index, or -1
+    std::vector<Real> rest, ks, kd;  // [slots]: 0 where no spring
+    int slots() const { return static_cast<int>(spring.size()); }
+  };
+
   SpringBands() = default;
   // Groups the springs of `model` (allocates; once per model).
   explicit SpringBands(const Model& model);
@@ -26,28 +37,30 @@ class SpringBands {
   bool dense() const { return dense_; }
   // True when built for a model with these particle and spring counts.
   bool fits(const Model& model) const;
+  const std::vector<Band>& bands() const { return bands_; }
+  int max_offset() const { return max_offset_; }
 
-  // f = m g + spring and damper forces at (x, v), as compute_forces. No allocation. Not for
-  // concurrent calls on one object (it keeps its scratch arrays).
-  void compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f) const;
+  // f = m g + spring and damper forces at (x, v), as compute_forces, on up to `threads`
+  // threads; the same bits for any thread count (each thread owns a range of particles and
+  // adds their terms in the one order of the serial loop). No allocation once called with
+  // this thread count. Not for concurrent calls on one object (it keeps its scratch arrays).
+  void compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f,
+                      int threads = 1) const;
 
  private:
   // Copies rest lengths, ks and kd from the model into the bands.
   void copy_coefficients(const Model& model);
 
-  struct Band {
-    int offset = 0;                  // b - a
-    int first = 0;                   // first particle a of slot 0
-    std::vector<int> spring;         // [slots]: spring index, or -1
-    std::vector<Real> rest, ks, kd;  // [slots]: 0 where no spring
-  };
   std::vector<Band> bands_;
   int particles_ = 0;
   int springs_ = 0;
+  int max_offset_ = 0;
   bool dense_ = false;
-  // Scratch: x, y, z, u, v, w, force x, y, z per particle; band force x, y, z per slot.
+  // Scratch: x, y, z, u, v, w, force x, y, z per particle; per thread, the band force x, y, z
+  // of its particles' slots; per thread, its count of collapsed springs.
   mutable std::vector<Real> scratch_;
   mutable std::vector<Real> band_force_;
+  mutable std::vector<int> collapsed_;
 };
 
 }  // namespace jelly

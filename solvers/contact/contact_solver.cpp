@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <jelly/core/detail/parallel.hpp>
+
 namespace jelly {
 
 namespace {
@@ -63,28 +65,50 @@ bool resolve_seed(const Terrain& terrain, const ContactParams& c, Real m1, Real 
   return true;
 }
 
+// Particles per thread below which another thread costs more than it saves.
+constexpr long kMinParticlesPerThread = 1024;
+
 }  // namespace
 
 void ContactSolver::resolve(const Model& model, const Terrains& terrains, const State& before,
-                            State& state, Real h, Scope scope) {
+                            State& state, Real h, Scope scope, int threads) {
   seed_contacts_.clear();
   contact_count_ = 0;
+  const int np = model.num_particles();
+  const int team = parallel::team_size(threads, np, kMinParticlesPerThread);
+  if (static_cast<int>(part_count_.size()) < team) {
+    part_seed_.resize(team);
+    part_count_.resize(team);
+  }
   for (const auto& terrain : terrains) {
     const ContactParams& c = terrain->contact();
     if (scope == Scope::kSeedOnly && c.model == ContactModel::kCoulomb) continue;
-    for (int i = 0; i < model.num_particles(); ++i) {
-      auto x = particle(state.x, i);
-      auto v = particle(state.v, i);
-      if (c.model == ContactModel::kCoulomb) {
-        contact_count_ += resolve_coulomb(*terrain, c, state.t, h, particle(before.x, i),
-                                          particle(before.v, i), x, v);
-      } else {
-        Vec3 n;
-        if (resolve_seed(*terrain, c, model.mass[i], state.t, x, v, n)) {
-          ++contact_count_;
-          seed_contacts_.push_back({i, n, c.friction});
+    int parts_used = 1;
+    parallel::run(team, [&](int part, int parts) {
+      if (part == 0) parts_used = parts;
+      const parallel::Range r = parallel::split(np, part, parts);
+      std::vector<SeedContact>& seed = part_seed_[part];
+      int count = 0;
+      seed.clear();
+      for (int i = static_cast<int>(r.begin); i < static_cast<int>(r.end); ++i) {
+        auto x = particle(state.x, i);
+        auto v = particle(state.v, i);
+        if (c.model == ContactModel::kCoulomb) {
+          count += resolve_coulomb(*terrain, c, state.t, h, particle(before.x, i),
+                                   particle(before.v, i), x, v);
+        } else {
+          Vec3 n;
+          if (resolve_seed(*terrain, c, model.mass[i], state.t, x, v, n)) {
+            ++count;
+            seed.push_back({i, n, c.friction});
+          }
         }
       }
+      part_count_[part] = count;
+    });
+    for (int part = 0; part < parts_used; ++part) {
+      contact_count_ += part_count_[part];
+      seed_contacts_.insert(seed_contacts_.end(), part_seed_[part].begin(), part_seed_[part].end());
     }
   }
 }

@@ -32,9 +32,10 @@ class ContactSolver {
   enum class Scope { kAll, kSeedOnly };
 
   // Applies every terrain's contact response to `state` (time state.t) after a step of size h
-  // from the state `before`.
+  // from the state `before`, on up to `threads` threads (each particle's response is its own;
+  // the seed contacts are listed in particle order for any thread count).
   void resolve(const Model& model, const Terrains& terrains, const State& before, State& state,
-               Real h, Scope scope = Scope::kAll);
+               Real h, Scope scope = Scope::kAll, int threads = 1);
   // Adds contacts resolved elsewhere (inside an implicit step) to contact_count().
   void add_resolved(int count) { contact_count_ += count; }
   // Seed model: for each particle that collided at the last resolve() and whose force f pushes
@@ -53,6 +54,9 @@ class ContactSolver {
  private:
   std::vector<SeedContact> seed_contacts_;
   int contact_count_ = 0;
+  // Per thread of resolve(): its contacts and seed contacts, merged in range order.
+  std::vector<std::vector<SeedContact>> part_seed_;
+  std::vector<int> part_count_;
 };
 
 }  // namespace jelly

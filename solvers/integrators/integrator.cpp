@@ -26,12 +26,12 @@ Statistics Integrator::statistics() const { return {{"steps", static_cast<double
 
 void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,
                                 const Model& model, const Terrains& terrains, const State& before,
-                                State& state, Real h) {
+                                State& state, Real h, int threads) {
   if (!integrator.resolves_contact()) {
-    contacts.resolve(model, terrains, before, state, h);
+    contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kAll, threads);
     return;
   }
-  contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kSeedOnly);
+  contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kSeedOnly, threads);
   contacts.add_resolved(integrator.contacts_resolved());
 }
 

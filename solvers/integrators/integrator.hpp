@@ -65,7 +65,7 @@ class Integrator {
 // the seed model's, with the integrator's contacts added to the count.
 void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,
                                 const Model& model, const Terrains& terrains, const State& before,
-                                State& state, Real h);
+                                State& state, Real h, int threads = 1);
 
 // Resizes v to n entries only when its size differs (no allocation in steady state).
 inline void ensure_size(VecX& v, Eigen::Index n) {

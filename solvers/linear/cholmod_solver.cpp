@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include <jelly/core/detail/parallel.hpp>
+
 namespace jelly {
 
 const std::vector<EnumName<CholmodOrdering>>& cholmod_orderings() {
@@ -141,7 +143,10 @@ LinearResult CholmodSolver::analyze(const SparseMatrix& a) {
   impl_->common.status = CHOLMOD_OK;
   impl_->common.supernodal =
       a.rows() >= impl_->options.supernodal_min_rows ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
-  impl_->factor = cholmod_analyze(&impl_->view, &impl_->common);
+  {
+    const parallel::SerialLibraries serial;
+    impl_->factor = cholmod_analyze(&impl_->view, &impl_->common);
+  }
   ++counters_.analyses;
   if (impl_->factor == nullptr) {
     LinearResult r = from_status(impl_->common.status, "analyze");
@@ -165,7 +170,11 @@ LinearResult CholmodSolver::factorize(const SparseMatrix& a) {
   m.wrap(a);
   m.factorized = false;
   m.common.status = CHOLMOD_OK;
-  const int ok = cholmod_factorize(&m.view, m.factor, &m.common);
+  int ok = 0;
+  {
+    const parallel::SerialLibraries serial;
+    ok = cholmod_factorize(&m.view, m.factor, &m.common);
+  }
   ++counters_.factorizations;
   const int status = m.common.status;
   if (status == CHOLMOD_NOT_POSDEF || m.factor->minor < m.factor->n) {
@@ -197,8 +206,11 @@ LinearResult CholmodSolver::solve(const VecX& b, VecX& x) {
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
   m.common.status = CHOLMOD_OK;
-  const int ok =
-      cholmod_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.x, nullptr, &m.y, &m.e, &m.common);
+  int ok = 0;
+  {
+    const parallel::SerialLibraries serial;
+    ok = cholmod_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.x, nullptr, &m.y, &m.e, &m.common);
+  }
   ++counters_.solves;
   LinearResult r = from_status(m.common.status, "solve");
   if (r.ok() && !ok) r = LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: solve failed");

@@ -1,0 +1,106 @@
+#pragma once
+// Threads for the hot loops (docs/threads.md): OpenMP teams of a size given per call, a static
+// split of index ranges, and sums whose value does not depend on the number of threads (fixed
+// chunks whose partial sums are added in chunk order). Results of every loop built on these
+// are the same bit for bit for any thread count.
+#include <algorithm>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include <jelly/core/types.hpp>
+
+namespace jelly::parallel {
+
+// The cores this process may run on (its CPU affinity mask), at least 1.
+int available_cores();
+// `requested` threads, or all available cores for 0 (the default of the `threads` options).
+int resolve_threads(int requested);
+
+// Below this many items a loop is not worth waking a second thread for.
+constexpr long kMinItemsPerThread = 4096;
+
+// The number of threads to use for n items: at most `threads`, at least 1, and no more than
+// one per kMinItemsPerThread items (`min_items`).
+inline int team_size(int threads, long n, long min_items = kMinItemsPerThread) {
+  const long useful = std::max<long>(1, n / std::max<long>(1, min_items));
+  return static_cast<int>(std::max<long>(1, std::min<long>(threads, useful)));
+}
+
+// Part `part` of `parts` of [0, n): contiguous, in order, sizes differing by at most `align`
+// (boundaries are multiples of `align`).
+struct Range {
+  long begin, end;
+};
+inline Range split(long n, int part, int parts, long align = 1) {
+  const long units = (n + align - 1) / align;
+  const long b = units * part / parts * align, e = units * (part + 1) / parts * align;
+  return {std::min(b, n), std::min(e, n)};
+}
+
+// Runs body(part, parts) on a team of `threads` threads (inline when threads <= 1); `parts` is
+// the size of the team OpenMP gave (it may give fewer threads than asked). `#pragma omp
+// barrier` inside body synchronises the team.
+template <class Body>
+void run(int threads, Body&& body) {
+#ifdef _OPENMP
+  if (threads > 1) {
+#pragma omp parallel num_threads(threads)
+    body(omp_get_thread_num(), omp_get_num_threads());
+    return;
+  }
+#endif
+  body(0, 1);
+}
+
+// body(begin, end) over a static split of [0, n) between up to `threads` threads.
+template <class Body>
+void for_ranges(int threads, long n, Body&& body, long min_items = kMinItemsPerThread) {
+  run(team_size(threads, n, min_items), [&](int part, int parts) {
+    const Range r = split(n, part, parts);
+    if (r.begin < r.end) body(r.begin, r.end);
+  });
+}
+
+// Sums of a fixed partition of [0, n) into chunks of kSumChunk items (one chunk when n is
+// smaller), added in chunk order: the same value for any number of threads.
+constexpr long kSumChunk = 8192;
+inline long sum_chunks(long n) { return std::max<long>(1, (n + kSumChunk - 1) / kSumChunk); }
+
+// The sum over chunks of chunk_sum(begin, end), with `partials` as workspace (resized to the
+// number of chunks; no allocation once it has that size).
+template <class ChunkSum>
+Real ordered_sum(int threads, long n, std::vector<Real>& partials, ChunkSum&& chunk_sum) {
+  const long chunks = sum_chunks(n);
+  if (static_cast<long>(partials.size()) != chunks) partials.assign(chunks, 0.0);
+  run(team_size(threads, chunks, 1), [&](int part, int parts) {
+    const Range r = split(chunks, part, parts);
+    for (long c = r.begin; c < r.end; ++c)
+      partials[c] = chunk_sum(c * kSumChunk, std::min(n, (c + 1) * kSumChunk));
+  });
+  Real total = 0;
+  for (long c = 0; c < chunks; ++c) total += partials[c];
+  return total;
+}
+
+// Keeps libraries that start their own threads (OpenMP regions inside CHOLMOD, which asks for
+// a fixed team of 4; OpenBLAS's thread pool) on the calling thread while alive: their threads
+// spin after each call and did not shorten the wall time (docs/threads.md).
+class SerialLibraries {
+ public:
+  SerialLibraries();
+  ~SerialLibraries();
+  SerialLibraries(const SerialLibraries&) = delete;
+  SerialLibraries& operator=(const SerialLibraries&) = delete;
+
+ private:
+  int saved_levels_ = -1;
+  int saved_blas_ = 0;
+};
+
+// Sets OpenBLAS's thread count when libjelly runs with OpenBLAS (no effect otherwise).
+void set_blas_threads(int threads);
+
+}  // namespace jelly::parallel

@@ -1,0 +1,74 @@
+#include <jelly/core/detail/parallel.hpp>
+
+#include <dlfcn.h>
+#include <sched.h>
+
+#include <thread>
+
+namespace jelly::parallel {
+
+int available_cores() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0) {
+    const int count = CPU_COUNT(&set);
+    if (count > 0) return count;
+  }
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+int resolve_threads(int requested) { return requested > 0 ? requested : available_cores(); }
+
+namespace {
+
+// OpenBLAS's thread-count functions, when libjelly runs with OpenBLAS (looked up, not linked:
+// the BLAS is whichever libblas.so.3 the system provides).
+struct OpenBlas {
+  void (*set)(int) = nullptr;
+  int (*get)() = nullptr;
+  OpenBlas() {
+    void* handle = RTLD_DEFAULT;
+    set = reinterpret_cast<void (*)(int)>(dlsym(handle, "openblas_set_num_threads"));
+    get = reinterpret_cast<int (*)()>(dlsym(handle, "openblas_get_num_threads"));
+    for (const char* name : {"libopenblas.so.0", "libblas.so.3"}) {
+      if (set != nullptr && get != nullptr) break;
+      handle = dlopen(name, RTLD_NOW | RTLD_NOLOAD);  // only if already loaded
+      if (handle == nullptr) continue;
+      set = reinterpret_cast<void (*)(int)>(dlsym(handle, "openblas_set_num_threads"));
+      get = reinterpret_cast<int (*)()>(dlsym(handle, "openblas_get_num_threads"));
+    }
+    if (set == nullptr || get == nullptr) set = nullptr, get = nullptr;
+  }
+};
+
+const OpenBlas& openblas() {
+  static const OpenBlas blas;
+  return blas;
+}
+
+}  // namespace
+
+void set_blas_threads(int threads) {
+  if (openblas().set) openblas().set(std::max(1, threads));
+}
+
+SerialLibraries::SerialLibraries() {
+  if (openblas().get) {
+    saved_blas_ = openblas().get();
+    if (saved_blas_ != 1) openblas().set(1);
+  }
+#ifdef _OPENMP
+  // A region started while max-active-levels is 0 gets a team of one: no thread is woken.
+  saved_levels_ = omp_get_max_active_levels();
+  omp_set_max_active_levels(0);
+#endif
+}
+
+SerialLibraries::~SerialLibraries() {
+  if (saved_blas_ > 1) openblas().set(saved_blas_);
+#ifdef _OPENMP
+  omp_set_max_active_levels(saved_levels_);
+#endif
+}
+
+}  // namespace jelly::parallel
