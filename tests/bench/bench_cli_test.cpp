@@ -84,12 +84,13 @@ TEST_F(BenchCli, GarbageCsvExitsTwoWithError) {
 }
 
 TEST_F(BenchCli, QuickKeepsOptionsGivenExplicitly) {
-  const Result r = bench("speed --quick --sizes 3 --steps 7 --integrators rk4 --out '" +
+  const Result r = bench("speed --quick --sizes 3 --steps 7 --threads 1 --integrators rk4 --out '" +
                          (dir_ / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string csv = read_file(dir_ / "out" / "speed.csv");
-  // The row of the one configuration: item 0, rk4, n = 3, ..., steps = 7 (not --quick's 20).
-  EXPECT_THAT(csv, HasSubstr("\n0,rk4,3,27,185,0.001,7,completed,"));
+  // The row of the one configuration: item 0, rk4, n = 3, 1 thread, ..., steps = 7 (not
+  // --quick's 20).
+  EXPECT_THAT(csv, HasSubstr("\n0,rk4,3,1,27,185,0.001,7,completed,"));
 }
 
 }  // namespace
