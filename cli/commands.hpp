@@ -18,7 +18,7 @@ struct RunArgs {
   std::string restart;            // --restart: checkpoint file
   bool quiet = false;             // --quiet: no progress bar
   bool overwrite = false;         // --overwrite: replace an existing -o file once complete
-  int threads = -1;               // --threads: -1 = the scene's (all cores), 0 = all cores
+  int threads = -1;               // --threads: -1 = the scene's `threads`, 0 = all cores
 };
 
 // jelly run: load the scene with its overrides, simulate, record, summarise.

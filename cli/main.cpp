@@ -70,8 +70,8 @@ int main(int argc, char** argv) {
       ->check(kNonEmpty);
   run->add_flag("-q,--quiet", run_args.quiet, "No progress bar");
   run->add_option("--threads", run_args.threads,
-                  "Threads for the force loop, the solves and contact (default: all cores; the "
-                  "results are the same for any number)")
+                  "Threads for the force loop, the solves and contact (default: the scene's "
+                  "`threads`, 0 = all cores; the results are the same for any number)")
       ->type_name("N")
       ->check(CLI::NonNegativeNumber);
 

@@ -19,6 +19,7 @@ SimulatorOptions simulator_options(const Scene& scene) {
   options.dt = scene.integrator.dt;
   options.output_interval = scene.output_interval;
   options.divergence = scene.divergence;
+  options.threads = scene.threads;
   return options;
 }
 

@@ -41,6 +41,9 @@ struct Scene {
   // Most particles the bodies may have together (a guard against a spacing or n that would
   // exhaust memory).
   long max_particles = 2'000'000;
+  // Threads for the force loop, the solves and contact (0 = all cores); the results are the
+  // same bit for bit for any number (docs/threads.md). `jelly run --threads` overrides it.
+  int threads = 0;
 
   // Throws InputError naming the JSON path of the first invalid field (e.g.
   // "terrains[0].contact.restitution"), its value and what is allowed.

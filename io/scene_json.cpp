@@ -99,6 +99,7 @@ Scene scene_from_json(const Json& j) {
     s.divergence.max_distance = f.number_or("max_distance", s.divergence.max_distance);
     f.reject_unknown();
   }
+  s.threads = root.integer_or("threads", s.threads);
   root.reject_unknown();
   s.validate();
   return s;
@@ -130,6 +131,7 @@ std::string scene_to_json(const Scene& s) {
   j["output_interval"] = s.output_interval;
   j["divergence"] = {{"max_speed", s.divergence.max_speed},
                      {"max_distance", s.divergence.max_distance}};
+  j["threads"] = s.threads;
   return j.dump(2) + "\n";
 }
 

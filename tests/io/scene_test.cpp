@@ -166,11 +166,13 @@ TEST(Scenes, RoundTripKeepsEveryNonDefaultField) {
   s.body_contact.self_contact = true;
   s.body_contact.friction = 0.2;
   s.body_contact.iterations = 7;
+  s.threads = 3;
   const Scene back = parse_scene(scene_to_json(s));
   expect_same_scene(s, back);
   EXPECT_EQ(back.cube().n, 3);
   EXPECT_EQ(back.gravity, Vec3(0, 0, -1));
   EXPECT_EQ(back.terrains[2].as<PlaneSpec>().normal, Vec3(0.1, 1, 0));
+  EXPECT_EQ(back.threads, 3);
 }
 
 TEST(Scenes, MissingFieldsTakeTheSeedDefaults) {
@@ -265,6 +267,9 @@ TEST(BadScenes, OutOfRangeValuesSayWhatIsAllowed) {
             "output_interval = -1 is invalid: a finite interval >= 0 s (0 = every step)");
   EXPECT_EQ(error_of(kGood, {"divergence.max_speed=0"}),
             "divergence.max_speed = 0 is invalid: a speed > 0 m/s");
+  EXPECT_EQ(error_of(kGood, {"threads=-1"}),
+            "threads = -1 is invalid: an integer >= 0 (0 = all cores)");
+  EXPECT_EQ(error_of(kGood, {"threads=1.5"}), "threads = 1.5 is invalid: an integer");
   const std::string unknown = error_of(kGood, {"integrator.name=rk5"});
   EXPECT_THAT(unknown, StartsWith("integrator.name = \"rk5\" is invalid: one of "));
   for (const std::string& name : integrator_names()) {
@@ -341,6 +346,10 @@ TEST(MakeSimulator, BuildsTheSceneAndRunsIt) {
   EXPECT_EQ(sim.integrator().name(), "symplectic_euler");
   EXPECT_EQ(sim.options().dt, 0.002);
   EXPECT_EQ(sim.options().output_interval, 1.0 / 60);
+  EXPECT_EQ(sim.options().threads, 0);  // all cores
+  EXPECT_EQ(
+      make_simulator(load_scene(scene_path("seed_slope.json"), {"threads=2"})).options().threads,
+      2);
   ASSERT_EQ(sim.terrains().size(), 1u);
   EXPECT_EQ(sim.terrains()[0]->contact().model, ContactModel::kSeed);
   const RunReport report = sim.run_until(0.2);

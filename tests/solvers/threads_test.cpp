@@ -2,9 +2,10 @@
 // (docs/threads.md): fixed partitions, sums in a fixed order.
 #include <gtest/gtest.h>
 
-#include <jelly/core/cube.hpp>
+#include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/measures.hpp>
+#include <jelly/geometry/body_spec.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/plane.hpp>
@@ -16,44 +17,109 @@ namespace {
 
 class EveryIntegratorThreads : public ::testing::TestWithParam<std::string> {};
 
-// A jelly big enough for every threaded loop to split (about 37,000 springs, 8,232 unknowns:
-// two sum chunks), dropped spinning and squeezed onto a 20-degree coulomb slope.
+// Two bodies: a jelly big enough for every threaded loop to split (about 37,000 springs, 8,232
+// unknowns: two sum chunks), dropped spinning and squeezed onto a 20-degree coulomb slope; and a
+// small cube above the slope, pinned by its top face to a path that moves it, in a gusty wind
+// and pushed up by a constant force. The force loop, the pins and the external forces all take
+// part.
 struct Outcome {
   State state;
   Statistics statistics;
   int contacts = 0;
 };
 
-Outcome run(const std::string& integrator, int threads) {
+Model two_bodies() {
+  Model model;
   const int n = 14;
-  const Model model = build_cube(testing::small_cube(n, (n - 1) * 4.0 / 9));
-  State s = testing::cube_on_slope(model, 20);
-  const Vec3 centre = center_of_mass(model, s);
-  for (int i = 0; i < model.num_particles(); ++i) {
-    const Vec3 r = particle(s.x, i) - centre;
-    particle(s.x, i) = centre + Vec3(1.02 * r.x(), 0.97 * r.y(), r.z());
-    particle(s.v, i) = Vec3(0.5, -1.0, 0.2) + Vec3(0, 0, 1.5).cross(r);
+  const CubeSpec spec = testing::small_cube(n, (n - 1) * 4.0 / 9);
+  BodySpec jelly;
+  jelly.shape = spec.shape();
+  jelly.material = spec.material();
+  add_body(model, jelly, "bodies[0].");
+  BodySpec hanging;
+  hanging.name = "hanging";
+  CubeShape shape;
+  shape.n = 6;
+  shape.edge_length = 0.5;
+  shape.origin = Vec3(-3, 4, 0);
+  hanging.shape = shape;
+  hanging.material.particle_mass = 0.2;
+  PinSpec top;
+  top.select.has_region = true;
+  top.select.region = Eigen::AlignedBox3d(Vec3(-3.1, 4.45, -0.1), Vec3(-2.4, 4.55, 0.6));
+  top.path = Path::oscillation(Vec3(0.02, 0.05, 0), 2.0);
+  hanging.pins = {top};
+  ExternalForceSpec wind;
+  wind.kind = ExternalForceKind::kWind;
+  wind.vector = Vec3(4, 0, 1);
+  wind.drag = 0.3;
+  wind.gust = 0.5;
+  wind.gust_frequency = 5;
+  ExternalForceSpec push;
+  push.vector = Vec3(0, 20, 0);
+  hanging.forces = {wind, push};
+  add_body(model, hanging, "bodies[1].");
+  model.gravity = spec.gravity;
+  return model;
+}
+
+Outcome run(const Model& model, const std::string& integrator, int threads) {
+  const Body& jelly = model.bodies.at(0);
+  State s = rest_state(model);
+  {
+    // The jelly lies flat on the slope (corner at the origin, 1 mm above it), squeezed and
+    // spinning.
+    const Vec3 corner = particle(s.x, jelly.first_particle);
+    const Eigen::Matrix3d r =
+        Eigen::AngleAxisd(-20 * M_PI / 180.0, Vec3::UnitZ()).toRotationMatrix();
+    Vec3 centre = Vec3::Zero();
+    const int begin = jelly.first_particle, end = begin + jelly.num_particles;
+    for (int i = begin; i < end; ++i) {
+      particle(s.x, i) = r * (particle(s.x, i) - corner + Vec3(0, 1e-3, 0));
+      centre += particle(s.x, i);
+    }
+    centre /= jelly.num_particles;
+    for (int i = begin; i < end; ++i) {
+      const Vec3 d = particle(s.x, i) - centre;
+      particle(s.x, i) = centre + Vec3(1.02 * d.x(), 0.99 * d.y(), d.z());
+      particle(s.v, i) = Vec3(0.5, -1.0, 0.2) + Vec3(0, 0, 1.5).cross(d);
+    }
   }
   const auto method = make_integrator(integrator);
   const bool implicit = method->is_implicit(), adaptive = method->is_adaptive();
   SimulatorOptions o;
-  // Long enough for contacts and several linear solves; adaptive methods take their own steps.
+  // Long enough for contacts and several linear solves; adaptive methods take their own steps
+  // (arkode_dirk's Newton iterations, whose Jacobian knows neither the pins nor the wind's drag,
+  // are the costly part: two steps).
   o.dt = adaptive ? 1e-3 : implicit ? 1.0 / 100 : 5e-4;
   o.threads = threads;
   Simulator sim(model, s, make_integrator(integrator), o);
   ContactParams coulomb;
   coulomb.model = ContactModel::kCoulomb;
   sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), coulomb)));
-  const RunReport report = sim.run_until(adaptive ? 5e-3 : implicit ? 0.05 : 0.02);
+  const RunReport report = sim.run_until(adaptive ? 2e-3 : implicit ? 0.05 : 0.02);
   EXPECT_TRUE(report.ok()) << integrator << " on " << threads << " threads: " << report.reason;
   return {sim.state(), report.statistics, sim.contacts().contact_count()};
 }
 
 TEST_P(EveryIntegratorThreads, SameTrajectoryOnOneTwoAndThreeThreads) {
-  const Outcome one = run(GetParam(), 1);
+  const Model model = two_bodies();
+  ASSERT_EQ(model.bodies.size(), 2u);
+  ASSERT_EQ(model.pins.size(), 36);
+  ASSERT_EQ(model.external_forces.size(), 2u);
+  // The threaded band loop takes the forces of both bodies.
+  ASSERT_TRUE(SpringBands(model).dense());
+  const Outcome one = run(model, GetParam(), 1);
   EXPECT_GT(one.contacts, 0) << "the test should touch the slope";
+  // The pinned body moved with its path and the wind (the pins and forces were applied).
+  const Body& hanging = model.bodies.at(1);
+  EXPECT_GT((one.state.x - rest_state(model).x)
+                .segment(3 * hanging.first_particle, 3 * hanging.num_particles)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-4);
   for (int threads : {2, 3}) {
-    const Outcome other = run(GetParam(), threads);
+    const Outcome other = run(model, GetParam(), threads);
     EXPECT_TRUE(other.state.x == one.state.x) << threads << " threads";
     EXPECT_TRUE(other.state.v == one.state.v) << threads << " threads";
     EXPECT_EQ(other.contacts, one.contacts);
