@@ -1,5 +1,5 @@
 // jelly-bench: which integrator to use for which jelly, and why. Subcommands stability, accuracy,
-// speed, seed and merge; see docs/benchmarks.md.
+// speed, seed, budget and merge; see docs/benchmarks.md.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <jelly/bench/accuracy.hpp>
+#include <jelly/bench/budget.hpp>
 #include <jelly/bench/output.hpp>
 #include <jelly/bench/run_info.hpp>
 #include <jelly/bench/seed_table.hpp>
@@ -129,6 +130,33 @@ int main(int argc, char** argv) {
   seed_cmd->add_option("--horizon", seed.horizon, "simulated time per run (s)")
       ->capture_default_str();
 
+  BudgetOptions budget;
+  CLI::App* budget_cmd =
+      app.add_subcommand("budget", "which integrator for a 1/60 s frame budget (seed slope)");
+  add_common(budget_cmd, common);
+  budget_cmd->add_option("--sizes", budget.sizes, "cube sizes n")
+      ->delimiter(',')
+      ->capture_default_str();
+  budget_cmd->add_option("--setups", budget.labels, "only these setups (labels, comma-separated)")
+      ->delimiter(',');
+  budget_cmd->add_option("--horizon", budget.horizon, "simulated time measured (s)")
+      ->capture_default_str();
+  budget_cmd
+      ->add_option("--search-horizon", budget.search_horizon,
+                   "simulated time of each stability run of the searches (s)")
+      ->capture_default_str();
+  budget_cmd->add_option("--ks-ladder", budget.ks_ladder, "stiffnesses tried (kd proportional)")
+      ->delimiter(',')
+      ->capture_default_str();
+  budget_cmd
+      ->add_option("--ks-search-max-n", budget.ks_search_max_n,
+                   "sizes above this skip the ks ladder")
+      ->capture_default_str();
+  budget_cmd
+      ->add_option("--reference-steps", budget.reference_steps_per_frame,
+                   "RK4 reference steps per frame")
+      ->capture_default_str();
+
   std::vector<std::string> merge_inputs;
   std::string merge_out = "out/bench";
   CLI::App* merge_cmd = app.add_subcommand("merge", "merge the CSV files of shards");
@@ -209,6 +237,28 @@ int main(int argc, char** argv) {
       speed.integrators = common.integrators;
       speed.shard = shard;
       tables = run_speed(speed);
+    } else if (budget_cmd->parsed()) {
+      command = "budget";
+      if (common.quick) {
+        if (budget_cmd->count("--sizes") == 0) budget.sizes = {4};
+        budget.horizon = 0.5;
+        budget.search_horizon = 0.5;
+        budget.lowered = true;
+        if (budget_cmd->count("--ks-ladder") == 0) budget.ks_ladder = {1400, 22400};
+        budget.steps_ladder = {1, 2, 4, 8, 16};
+        budget.sample_every = 3;
+      }
+      if (!common.integrators.empty()) {
+        for (const BudgetSetup& s : default_budget_setups())
+          if (std::find(common.integrators.begin(), common.integrators.end(), s.integrator) !=
+              common.integrators.end())
+            budget.setups.push_back(s);
+        require(!budget.setups.empty(), "--integrators", "(none with a budget setup)",
+                "integrators among the budget setups");
+      }
+      budget.shard = shard;
+      budget.progress = &std::cerr;
+      tables = {run_budget(budget)};
     } else if (seed_cmd->parsed()) {
       command = "seed";
       if (common.quick) {

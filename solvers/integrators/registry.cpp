@@ -11,8 +11,10 @@
 #include <jelly/solvers/integrators/explicit_euler.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/midpoint.hpp>
+#include <jelly/solvers/integrators/projective_dynamics.hpp>
 #include <jelly/solvers/integrators/rk4.hpp>
 #include <jelly/solvers/integrators/symplectic_euler.hpp>
+#include <jelly/solvers/integrators/xpbd.hpp>
 
 namespace jelly {
 
@@ -34,6 +36,8 @@ IntegratorOptionsIo options_io() {
 }
 constexpr auto kImplicit = &IntegratorOptions::implicit;
 constexpr auto kArkode = &IntegratorOptions::arkode;
+constexpr auto kPd = &IntegratorOptions::pd;
+constexpr auto kXpbd = &IntegratorOptions::xpbd;
 
 struct Entry {
   IntegratorInfo info;
@@ -65,10 +69,17 @@ const std::vector<Entry>& table() {
          [](const IntegratorOptions& o) { return std::make_unique<ImplicitEuler>(o.implicit); }},
         {{"midpoint", "explicit midpoint (the report's midpoint Euler), order 2", kNoOptions},
          plain<Midpoint>()},
+        {{"projective_dynamics",
+          "local/global backward Euler on one prefactored matrix (Liu 2013), order 1, implicit",
+          options_io<kPd>()},
+         [](const IntegratorOptions& o) { return std::make_unique<ProjectiveDynamics>(o.pd); }},
         {{"rk4", "classical Runge-Kutta, order 4, explicit", kNoOptions}, plain<RungeKutta4>()},
         {{"symplectic_euler",
           "semi-implicit Euler, order 1 (what the report called implicit Euler)", kNoOptions},
          plain<SymplecticEuler>()},
+        {{"xpbd", "extended position-based dynamics with substeps (Macklin 2016, 2019), order 1",
+          options_io<kXpbd>()},
+         [](const IntegratorOptions& o) { return std::make_unique<Xpbd>(o.xpbd); }},
     };
     std::sort(e.begin(), e.end(),
               [](const Entry& a, const Entry& b) { return a.info.name < b.info.name; });

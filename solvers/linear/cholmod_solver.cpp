@@ -2,6 +2,8 @@
 
 #include <cholmod.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <jelly/core/detail/parallel.hpp>
@@ -67,7 +69,10 @@ struct CholmodSolver::Impl {
   cholmod_dense* x = nullptr;  // solve2 workspaces, reused
   cholmod_dense* y = nullptr;
   cholmod_dense* e = nullptr;
-  cholmod_sparse view{};  // the caller's matrix, not owned
+  cholmod_sparse view{};             // the caller's matrix, not owned
+  cholmod_sparse* update = nullptr;  // columns of a diagonal update, capacity rows
+  std::vector<int> inverse_perm;     // row i of A is row inverse_perm[i] of the factor
+  long rank_updates = 0;
   bool factorized = false;
   int rows = 0;
   long nnz = 0;
@@ -106,6 +111,8 @@ struct CholmodSolver::Impl {
     if (x) cholmod_free_dense(&x, &common);
     if (y) cholmod_free_dense(&y, &common);
     if (e) cholmod_free_dense(&e, &common);
+    if (update) cholmod_free_sparse(&update, &common);
+    inverse_perm.clear();
     factorized = false;
   }
   // A view of the lower triangle of `a` (stype -1: CHOLMOD ignores the upper triangle).
@@ -131,6 +138,59 @@ CholmodSolver::CholmodSolver(CholmodOptions options) : impl_(std::make_unique<Im
 CholmodSolver::~CholmodSolver() = default;
 
 bool CholmodSolver::factorized() const { return impl_->factorized; }
+long CholmodSolver::rank_updates() const { return impl_->rank_updates; }
+
+LinearResult CholmodSolver::update_diagonal(const std::vector<int>& rows,
+                                            const std::vector<Real>& d, bool add) {
+  Impl& m = *impl_;
+  if (!m.factorized)
+    return LinearResult::failure(LinearStatus::kInvalidInput,
+                                 "CHOLMOD: update without a successful factorization");
+  if (rows.size() != d.size())
+    return LinearResult::failure(LinearStatus::kInvalidInput, "CHOLMOD: update: size mismatch");
+  if (rows.empty()) return {};
+  const int n = m.rows;
+  if (m.update == nullptr) {
+    m.update = cholmod_allocate_sparse(n, n, n, 1, 1, 0, CHOLMOD_REAL, &m.common);
+    if (m.update == nullptr)
+      return LinearResult::failure(LinearStatus::kOutOfMemory, "CHOLMOD: update: out of memory");
+    const int* perm = static_cast<const int*>(m.factor->Perm);
+    m.inverse_perm.assign(n, 0);
+    for (int k = 0; k < n; ++k) m.inverse_perm[perm ? perm[k] : k] = k;
+  }
+  // Columns sqrt(d_k) e_(p(row_k)), in the factor's permuted order; CHOLMOD updates up to eight
+  // at a time, so they are passed in one call.
+  int* p = static_cast<int*>(m.update->p);
+  int* i = static_cast<int*>(m.update->i);
+  Real* x = static_cast<Real*>(m.update->x);
+  size_t done = 0;
+  while (done < rows.size()) {
+    const size_t count = std::min(rows.size() - done, static_cast<size_t>(n));
+    p[0] = 0;
+    for (size_t k = 0; k < count; ++k) {
+      const int row = rows[done + k];
+      if (row < 0 || row >= n || !(d[done + k] >= 0))
+        return LinearResult::failure(LinearStatus::kInvalidInput,
+                                     "CHOLMOD: update: bad row or negative value");
+      i[k] = m.inverse_perm[row];
+      x[k] = std::sqrt(d[done + k]);
+      p[k + 1] = static_cast<int>(k + 1);
+    }
+    m.update->ncol = count;
+    m.common.status = CHOLMOD_OK;
+    const int ok = cholmod_updown(add ? 1 : 0, m.update, m.factor, &m.common);
+    m.rank_updates += static_cast<long>(count);
+    LinearResult r = from_status(m.common.status, add ? "update" : "downdate");
+    if (r.ok() && !ok) r = LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: update failed");
+    if (!r.ok()) {
+      m.factorized = false;
+      return r;
+    }
+    done += count;
+  }
+  m.update->ncol = static_cast<size_t>(n);
+  return {};
+}
 double CholmodSolver::factor_non_zeros() const { return impl_->common.lnz; }
 double CholmodSolver::factor_flops() const { return impl_->common.fl; }
 
@@ -190,18 +250,28 @@ LinearResult CholmodSolver::factorize(const SparseMatrix& a) {
 }
 
 LinearResult CholmodSolver::solve(const VecX& b, VecX& x) {
+  if (b.size() != impl_->rows || x.size() != impl_->rows)
+    return LinearResult::failure(LinearStatus::kInvalidInput, "CHOLMOD: solve: wrong vector size");
+  return solve_raw(b.data(), x.data(), 1);
+}
+
+LinearResult CholmodSolver::solve_columns(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
+  if (b.rows() != impl_->rows || x.rows() != b.rows() || x.cols() != b.cols() || b.cols() < 1)
+    return LinearResult::failure(LinearStatus::kInvalidInput, "CHOLMOD: solve: wrong matrix size");
+  return solve_raw(b.data(), x.data(), static_cast<int>(b.cols()));
+}
+
+LinearResult CholmodSolver::solve_raw(const Real* b, Real* x, int columns) {
   Impl& m = *impl_;
   if (!m.factorized)
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CHOLMOD: solve without a successful factorization");
-  if (b.size() != m.rows || x.size() != m.rows)
-    return LinearResult::failure(LinearStatus::kInvalidInput, "CHOLMOD: solve: wrong vector size");
   cholmod_dense rhs{};
   rhs.nrow = static_cast<size_t>(m.rows);
-  rhs.ncol = 1;
-  rhs.nzmax = static_cast<size_t>(m.rows);
+  rhs.ncol = static_cast<size_t>(columns);
+  rhs.nzmax = static_cast<size_t>(m.rows) * columns;
   rhs.d = static_cast<size_t>(m.rows);
-  rhs.x = const_cast<Real*>(b.data());
+  rhs.x = const_cast<Real*>(b);
   rhs.z = nullptr;
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
@@ -216,7 +286,7 @@ LinearResult CholmodSolver::solve(const VecX& b, VecX& x) {
   if (r.ok() && !ok) r = LinearResult::failure(LinearStatus::kFailure, "CHOLMOD: solve failed");
   if (!r.ok()) return r;
   const Real* out = static_cast<const Real*>(m.x->x);
-  std::copy(out, out + m.rows, x.data());
+  std::copy(out, out + static_cast<size_t>(m.rows) * columns, x);
   return r;
 }
 

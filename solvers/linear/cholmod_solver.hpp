@@ -42,6 +42,16 @@ class CholmodSolver final : public LinearSolver {
   LinearResult analyze(const SparseMatrix& a) override;
   LinearResult factorize(const SparseMatrix& a) override;
   LinearResult solve(const VecX& b, VecX& x) override;
+  // Solves A X = B for all columns of B at once (one pass over the factor; projective dynamics
+  // solves x, y and z together). X must have B's size.
+  LinearResult solve_columns(const Eigen::MatrixXd& b, Eigen::MatrixXd& x);
+
+  // Adds (add = true) or subtracts d[k] >= 0 to the diagonal entry rows[k] of the factorized
+  // matrix by a multiple-rank update or downdate of the factor (CHOLMOD Modify: the factor
+  // becomes simplicial LDL'; no new analysis or factorization). No allocation after the first.
+  LinearResult update_diagonal(const std::vector<int>& rows, const std::vector<Real>& d, bool add);
+  // Rank-1 updates and downdates applied since construction.
+  long rank_updates() const;
 
   bool factorized() const;
   // Non-zeros of the factor L (after analyze) and the flop count of the last factorization.
@@ -49,6 +59,8 @@ class CholmodSolver final : public LinearSolver {
   double factor_flops() const;
 
  private:
+  LinearResult solve_raw(const Real* b, Real* x, int columns);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

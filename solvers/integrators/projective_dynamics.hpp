@@ -1,0 +1,94 @@
+#pragma once
+// Projective dynamics (Liu et al. 2013, Bouaziz et al. 2014) for springs with dampers: the
+// backward-Euler step solved by local/global iterations on one prefactored N x N matrix, shared
+// by x, y and z,
+//   A = M / h^2 + L_ks + L_kd / h       (L_w: the spring Laplacian weighted by w),
+// factorized by CHOLMOD once per model and time step. Each iteration is
+//   x <- x + A^-1 r(x),   r(x) = f(x, v) - M (v - v0) / h,   v = (x - x0) / h,
+// which for springs alone is exactly Liu's local step (each spring's rest-length projection)
+// followed by the global solve. The dampers' backward-Euler force is in r and their isotropic
+// bound kd / h in A, so the fixed point is the nonlinear backward-Euler step with the dampers
+// (what implicit_euler's Newton converges to). Optional Chebyshev acceleration (Wang 2015);
+// coulomb terrains by projection inside the iterations (position_contact.hpp); docs/realtime.md.
+#include <memory>
+#include <vector>
+
+#include <jelly/core/jacobian.hpp>
+#include <jelly/solvers/contact/position_contact.hpp>
+#include <jelly/solvers/integrators/integrator.hpp>
+#include <jelly/solvers/integrators/projective_dynamics_options.hpp>
+
+namespace jelly {
+
+class CholmodSolver;
+
+class ProjectiveDynamics final : public Integrator {
+ public:
+  // Throws InputError for invalid options.
+  explicit ProjectiveDynamics(ProjectiveDynamicsOptions options = {});
+  ~ProjectiveDynamics() override;
+
+  std::string_view name() const override { return "projective_dynamics"; }
+  int order() const override { return 1; }
+  bool is_implicit() const override { return true; }
+  bool resolves_contact() const override {
+    return options_.contact == "projection" && terrains_seen_;
+  }
+  int contacts_resolved() const override { return contact_active_ ? contact_.count() : 0; }
+  // steps, symbolic_analyses, factorizations (once per model and dt), iterations (global
+  // solves), not_converged (steps that ended above the tolerance), chebyshev_rho,
+  // factorization_seconds, solve_seconds, contact_restitution_limited.
+  Statistics statistics() const override;
+  // The measured Chebyshev spectral radius (empty when none was measured).
+  std::vector<Real> internal_state() const override;
+  void restore_internal_state(const std::vector<Real>& data) override;
+
+  const ProjectiveDynamicsOptions& options() const { return options_; }
+  // |r| at each iterate of the last step (the first is the inertial prediction's).
+  const std::vector<Real>& last_residuals() const { return residuals_; }
+  // The spectral radius the acceleration uses (the option, or the measured one; 0 before).
+  Real chebyshev_rho() const { return rho_; }
+
+ protected:
+  StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;
+
+ private:
+  // (Re)builds and factorizes A when the model or h changed.
+  StepResult prepare(const Model& model, Real h);
+  // r_ at the iterate x_ (v_ = (x_ - x0) / h), with the contact forces taken out.
+  void residual(const Dynamics& dynamics, const State& s0, Real h);
+  // When every contact slides, the uniform translation of the model along the surfaces
+  // (which the contact penalties in the factor resist) is solved exactly and taken out of r_:
+  // shift_ = h^2 (sum of r_ along the surfaces) / total mass, r_ -= M shift_ / h^2.
+  void slide_correction(const Model& model, Real h);
+  // delta_ = P^-1 r_, P = A + the contact penalties in the factor.
+  StepResult solve();
+  // Brings the contact penalties in the factor in line with the contacts' modes.
+  StepResult sync_penalties();
+
+  ProjectiveDynamicsOptions options_;
+  std::unique_ptr<CholmodSolver> solver_;
+  SparseMatrix a_;
+  Real h_ = 0;
+  // What A was built from: a changed model rebuilds it.
+  VecX mass_;
+  std::vector<Real> ks_, kd_;
+  std::vector<int> spring_a_, spring_b_;
+  Eigen::MatrixXd rhs_, solution_;  // N x 3
+  VecX x_, x_prev_, v_, f_, r_, delta_;
+  VecX diagonal_;              // A's diagonal
+  Vec3 shift_ = Vec3::Zero();  // slide_correction's translation
+  std::vector<Real> penalty_;  // [N]: the contact penalty in the factor
+  std::vector<int> penalized_list_, rows_;
+  std::vector<Real> values_;
+  PositionContact contact_;
+  bool contact_active_ = false;
+  bool terrains_seen_ = true;
+  Real rho_ = 0;  // Chebyshev spectral radius in use
+  std::vector<Real> residuals_, step_norms_;
+  long analyses_ = 0, factorizations_ = 0, iterations_ = 0, not_converged_ = 0;
+  long rank_updates_ = 0;
+  double factorization_seconds_ = 0, solve_seconds_ = 0;
+};
+
+}  // namespace jelly

@@ -1,0 +1,132 @@
+#include <jelly/solvers/integrators/xpbd.hpp>
+
+#include <cmath>
+
+#include <jelly/core/forces.hpp>
+
+namespace jelly {
+
+Xpbd::Xpbd(XpbdOptions options) : options_(std::move(options)) { options_.validate(); }
+
+Statistics Xpbd::statistics() const {
+  Statistics s = Integrator::statistics();
+  s["substeps"] = static_cast<double>(substeps_);
+  s["sweeps"] = static_cast<double>(sweeps_);
+  if (resolves_contact())
+    s["contact_restitution_limited"] = static_cast<double>(contact_.counters().restitution_limited);
+  return s;
+}
+
+void Xpbd::prepare(const Model& model, Real hs) {
+  const Springs& s = model.springs;
+  const bool same_model = mass_.size() == model.mass.size() && mass_ == model.mass && ks_ == s.ks &&
+                          kd_ == s.kd && rest_ == s.rest_length && spring_a_ == s.a &&
+                          spring_b_ == s.b;
+  if (same_model && hs == hs_) return;
+  if (!same_model) {  // once per model (allocates)
+    mass_ = model.mass;
+    ks_ = s.ks;
+    kd_ = s.kd;
+    rest_ = s.rest_length;
+    spring_a_ = s.a;
+    spring_b_ = s.b;
+    rest_position_ = model.rest_position;
+    inverse_mass_ = model.mass.cwiseInverse();
+    constraints_.resize(s.size());
+    const int n = model.num_dofs();
+    x_start_.setZero(n);
+    f_.setZero(n);
+    lambda_.setZero(s.size());
+  }
+  hs_ = hs;
+  for (int k = 0; k < s.size(); ++k) {
+    Constraint& c = constraints_[k];
+    c.a = s.a[k];
+    c.b = s.b[k];
+    c.rest = s.rest_length[k];
+    c.stiffness = s.ks[k] * hs * hs;
+    c.damping = s.kd[k] * hs;
+    const Real w = inverse_mass_[c.a] + inverse_mass_[c.b];
+    c.inverse_denominator = 1.0 / ((c.stiffness + c.damping) * w + 1);
+  }
+}
+
+void Xpbd::sweep(VecX& x) {
+  Real* px = x.data();
+  const Real* p0 = x_start_.data();
+  const Real* w = inverse_mass_.data();
+  Real* lambda = lambda_.data();
+  const int m = static_cast<int>(constraints_.size());
+  for (int k = 0; k < m; ++k) {
+    const Constraint& c = constraints_[k];
+    Real* xa = px + 3 * c.a;
+    Real* xb = px + 3 * c.b;
+    const Real d[3] = {xa[0] - xb[0], xa[1] - xb[1], xa[2] - xb[2]};
+    const Real length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    Real n[3];
+    if (length >= kDegenerateLength * c.rest && length > 0) {
+      const Real inv = 1.0 / length;
+      for (int q = 0; q < 3; ++q) n[q] = d[q] * inv;
+    } else {  // collapsed: the direction at rest
+      const Real* ra = rest_position_.data() + 3 * c.a;
+      const Real* rb = rest_position_.data() + 3 * c.b;
+      for (int q = 0; q < 3; ++q) n[q] = ra[q] - rb[q];
+      const Real r = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (!(r > 0)) continue;
+      for (int q = 0; q < 3; ++q) n[q] /= r;
+    }
+    const Real* a0 = p0 + 3 * c.a;
+    const Real* b0 = p0 + 3 * c.b;
+    // grad C . (x - x_start): the change of the spring's length rate over the substep.
+    Real moved = 0;
+    for (int q = 0; q < 3; ++q) moved += n[q] * ((xa[q] - a0[q]) - (xb[q] - b0[q]));
+    const Real dl =
+        (-c.stiffness * (length - c.rest) - lambda[k] - c.damping * moved) * c.inverse_denominator;
+    lambda[k] += dl;
+    const Real sa = w[c.a] * dl, sb = w[c.b] * dl;
+    for (int q = 0; q < 3; ++q) {
+      xa[q] += sa * n[q];
+      xb[q] -= sb * n[q];
+    }
+  }
+}
+
+StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
+  const Model& model = dynamics.model();
+  const int substeps = options_.substeps;
+  const Real hs = h / substeps;
+  prepare(model, hs);
+  const int n = model.num_particles();
+  const Terrains* terrains = dynamics.terrains();
+  terrains_seen_ = terrains != nullptr;
+  const Real t_end = s.t + h;
+  for (int sub = 0; sub < substeps; ++sub) {
+    // External forces: gravity and the seed model's contact forces.
+    for (int i = 0; i < n; ++i) particle(f_, i) = model.mass[i] * model.gravity;
+    dynamics.contacts().add_forces(s.v, f_);
+    contact_active_ = resolves_contact() && contact_.begin(model, *terrains, s, hs);
+    x_start_ = s.x;
+    for (int i = 0; i < n; ++i) {
+      particle(s.v, i) += (hs * inverse_mass_[i]) * particle(f_, i);
+      particle(s.x, i) += hs * particle(s.v, i);
+    }
+    lambda_.setZero();
+    // Contacts before each sweep, so that the springs carry their correction up the jelly
+    // within the sweep, and after the last, so that the substep ends on the surfaces.
+    for (int it = 0; it < options_.iterations; ++it) {
+      if (contact_active_) contact_.project_with_friction(s.x);
+      sweep(s.x);
+      ++sweeps_;
+    }
+    if (contact_active_) contact_.project_with_friction(s.x);
+    s.v = (s.x - x_start_) / hs;
+    s.t = sub + 1 == substeps ? t_end : s.t + hs;
+    if (contact_active_) contact_.finish(model, s);
+    ++substeps_;
+  }
+  if (!s.x.allFinite() || !s.v.allFinite())
+    return StepResult::failure("xpbd: a position or velocity is not finite");
+  return StepResult::success();
+}
+
+}  // namespace jelly

@@ -1,0 +1,37 @@
+#include <jelly/solvers/integrators/xpbd_options.hpp>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+void XpbdOptions::validate(const std::string& prefix) const {
+  require(substeps >= 1 && substeps <= 100000, prefix + "substeps", substeps,
+          "an integer in [1, 100000]");
+  require(iterations >= 1 && iterations <= 10000, prefix + "iterations", iterations,
+          "an integer in [1, 10000]");
+  require(contact == "projection" || contact == "after_step", prefix + "contact",
+          "\"" + contact + "\"", "\"projection\" or \"after_step\"");
+}
+
+}  // namespace jelly
+
+namespace jelly {
+
+XpbdOptions XpbdOptions::read(JsonFields& f) {
+  XpbdOptions o;
+  o.substeps = f.integer_or("substeps", o.substeps);
+  o.iterations = f.integer_or("iterations", o.iterations);
+  o.contact = f.string_or("contact", o.contact);
+  o.validate(f.prefix());
+  return o;
+}
+
+Json XpbdOptions::to_json() const {
+  Json out = Json::object();
+  out["substeps"] = substeps;
+  out["iterations"] = iterations;
+  out["contact"] = contact;
+  return out;
+}
+
+}  // namespace jelly

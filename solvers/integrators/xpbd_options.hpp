@@ -1,0 +1,31 @@
+#pragma once
+// Options of the XPBD integrator (docs/realtime.md).
+#include <string>
+
+#include <jelly/core/json.hpp>
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+struct XpbdOptions {
+  // Substeps per step (Macklin et al. 2019: many small steps of one iteration each beat few
+  // steps of many iterations).
+  int substeps = 1;
+  // Gauss-Seidel sweeps over the springs (and contacts) per substep. One sweep per substep is
+  // too soft at frame-sized substeps: the seed jelly landing at 11 m/s at 1/60 s is crushed
+  // (inverted springs, +87 % energy); two hold it (docs/realtime.md).
+  int iterations = 2;
+  // How coulomb terrains enter the step: "projection" (position constraints with friction in
+  // every sweep, restitution after each substep) or "after_step" (the explicit integrators'
+  // resolve after the step).
+  std::string contact = "projection";
+
+  // Throws InputError "<prefix><field> = <value> is invalid: <allowed>" for the first invalid
+  // field (prefix e.g. "integrator.options.").
+  void validate(const std::string& prefix = "integrator.options.") const;
+  // The scene's integrator.options of xpbd; validated with the fields' JSON path.
+  static XpbdOptions read(JsonFields& fields);
+  Json to_json() const;
+};
+
+}  // namespace jelly

@@ -1,0 +1,54 @@
+// Scene files carry the options of projective_dynamics and xpbd (docs/scenes.md).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/io/scene.hpp>
+
+namespace jelly {
+namespace {
+
+const char* const kScene = R"({
+  "terrains": [{"kind": "slope"}],
+  "integrator": {"name": "rk4"},
+  "duration": 1
+})";
+
+TEST(SceneRealtimeOptions, RoundTrip) {
+  const Scene pd =
+      parse_scene(kScene, {"integrator.name=projective_dynamics", "integrator.options.iterations=7",
+                           "integrator.options.chebyshev=true", "integrator.options.tolerance=1e-6",
+                           "integrator.options.ordering=\"amd\""});
+  EXPECT_EQ(pd.integrator.options.pd.iterations, 7);
+  EXPECT_TRUE(pd.integrator.options.pd.chebyshev);
+  const Scene pd_again = parse_scene(scene_to_json(pd));
+  EXPECT_EQ(pd_again.integrator.options.pd.iterations, 7);
+  EXPECT_EQ(pd_again.integrator.options.pd.tolerance, 1e-6);
+  EXPECT_EQ(pd_again.integrator.options.pd.ordering, "amd");
+  EXPECT_NO_THROW(make_simulator(pd));
+
+  const Scene xpbd = parse_scene(
+      kScene, {"integrator.name=xpbd", "integrator.options.substeps=8",
+               "integrator.options.iterations=1", "integrator.options.contact=\"after_step\""});
+  const Scene xpbd_again = parse_scene(scene_to_json(xpbd));
+  EXPECT_EQ(xpbd_again.integrator.options.xpbd.substeps, 8);
+  EXPECT_EQ(xpbd_again.integrator.options.xpbd.iterations, 1);
+  EXPECT_EQ(xpbd_again.integrator.options.xpbd.contact, "after_step");
+  EXPECT_NO_THROW(make_simulator(xpbd));
+}
+
+TEST(SceneRealtimeOptions, BadOptionsNameTheirPath) {
+  try {
+    parse_scene(kScene, {"integrator.name=xpbd", "integrator.options.substeps=0"});
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::StartsWith("integrator.options.substeps = 0 is invalid"));
+  }
+  // substeps belongs to xpbd, not to projective_dynamics.
+  EXPECT_THROW(
+      parse_scene(kScene, {"integrator.name=projective_dynamics", "integrator.options.substeps=2"}),
+      InputError);
+}
+
+}  // namespace
+}  // namespace jelly
