@@ -1,4 +1,4 @@
-#include <jelly/solvers/contact/position_contact.hpp>
+#include <jelly/solvers/contact/detail/position_contact.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/contact/detail/position_contact.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>
 
 namespace jelly {
@@ -59,7 +60,7 @@ SparseMatrix global_matrix(const Model& model, Real h) {
 }  // namespace
 
 ProjectiveDynamics::ProjectiveDynamics(ProjectiveDynamicsOptions options)
-    : options_(std::move(options)) {
+    : options_(std::move(options)), contact_(std::make_unique<PositionContact>()) {
   options_.validate();
   rho_ = options_.chebyshev_rho;
   residuals_.reserve(options_.iterations + 2);
@@ -67,6 +68,10 @@ ProjectiveDynamics::ProjectiveDynamics(ProjectiveDynamicsOptions options)
 }
 
 ProjectiveDynamics::~ProjectiveDynamics() = default;
+
+int ProjectiveDynamics::contacts_resolved() const {
+  return contact_active_ ? contact_->count() : 0;
+}
 
 Statistics ProjectiveDynamics::statistics() const {
   Statistics s = Integrator::statistics();
@@ -80,7 +85,8 @@ Statistics ProjectiveDynamics::statistics() const {
   s["solve_seconds"] = solve_seconds_;
   if (options_.chebyshev) s["chebyshev_rho"] = rho_;
   if (resolves_contact())
-    s["contact_restitution_limited"] = static_cast<double>(contact_.counters().restitution_limited);
+    s["contact_restitution_limited"] =
+        static_cast<double>(contact_->counters().restitution_limited);
   return s;
 }
 
@@ -133,6 +139,10 @@ StepResult ProjectiveDynamics::prepare(const Model& model, Real h) {
   h_ = h;
   diagonal_ = a_.diagonal();
   penalty_.assign(model.num_particles(), 0.0);  // the new factor holds no penalties
+  if (anchor_weight_.size() != static_cast<size_t>(model.num_particles())) {
+    anchor_weight_.assign(model.num_particles(), 0.0);
+    anchored_.clear();
+  }
   penalized_list_.clear();
   return StepResult::success();
 }
@@ -149,40 +159,54 @@ void ProjectiveDynamics::residual(const Dynamics& dynamics, const State& s0, Rea
     for (int c = 0; c < 3; ++c)
       r_[3 * i + c] = f_[3 * i + c] - m * (v_[3 * i + c] - s0.v[3 * i + c]);
   }
-  if (contact_active_) contact_.constrain_residual(x_, r_);
+  if (contact_active_) contact_->constrain_residual(x_, r_);
+}
+
+void ProjectiveDynamics::set_anchor_weights(const AnchorSprings* anchors, Real h) {
+  for (int i : anchored_) anchor_weight_[i] = 0;
+  anchored_.clear();
+  if (anchors == nullptr) return;
+  for (const AnchorSpring& a : *anchors) {
+    if (anchor_weight_[a.particle] == 0) anchored_.push_back(a.particle);
+    anchor_weight_[a.particle] += a.stiffness + a.damping / h;
+  }
 }
 
 StepResult ProjectiveDynamics::sync_penalties() {
-  // The penalty each particle should have in the factor: a sticking contact is held (both
-  // along and across the surface); a sliding one must move along the surface, which the
-  // isotropic penalty resists, but without any it lets the iterations diverge at stiff contacts,
-  // so it gets a moderate one (docs/realtime.md); a free particle none.
+  // What each particle should have in the factor beyond A: its anchor springs' k + c / h (their
+  // Jacobian, as implicit_euler takes it), and a contact penalty: a sticking contact is held
+  // (both along and across the surface); a sliding one must move along the surface, which the
+  // isotropic penalty resists, but without any it lets the iterations diverge at stiff
+  // contacts, so it gets a moderate one (docs/realtime.md); a free particle none.
   const auto wanted = [&](int i) {
-    if (!contact_active_) return 0.0;
-    switch (contact_.mode(i)) {
+    Real w = anchor_weight_[i];
+    if (!contact_active_) return w;
+    switch (contact_->mode(i)) {
       case PositionContact::Mode::kStick:
       case PositionContact::Mode::kNew:
-        return kStickPenalty * diagonal_[i];
+        return w + kStickPenalty * diagonal_[i];
       case PositionContact::Mode::kSlide:
-        return kSlidePenalty * diagonal_[i];
+        return w + kSlidePenalty * diagonal_[i];
       default:
-        return 0.0;
+        return w;
     }
+  };
+  const auto raise = [&](int i) {
+    const Real change = wanted(i) - penalty_[i];
+    if (change <= 0) return;
+    if (penalty_[i] == 0) penalized_list_.push_back(i);
+    rows_.push_back(i);
+    values_.push_back(change);
+    penalty_[i] += change;
   };
   for (int pass = 0; pass < 2; ++pass) {
     const bool add = pass == 1;
     rows_.clear();
     values_.clear();
     if (add) {
-      if (!contact_active_) break;
-      for (int i : contact_.active()) {
-        const Real change = wanted(i) - penalty_[i];
-        if (change <= 0) continue;
-        if (penalty_[i] == 0) penalized_list_.push_back(i);
-        rows_.push_back(i);
-        values_.push_back(change);
-        penalty_[i] += change;
-      }
+      if (contact_active_)
+        for (int i : contact_->active()) raise(i);
+      for (int i : anchored_) raise(i);
     } else {  // downdates first, so that no particle is ever held twice
       size_t kept = 0;
       for (int i : penalized_list_) {
@@ -208,13 +232,13 @@ StepResult ProjectiveDynamics::sync_penalties() {
 
 void ProjectiveDynamics::slide_correction(const Model& model, Real h) {
   shift_.setZero();
-  if (!contact_active_ || contact_.active().empty()) return;
+  if (!contact_active_ || contact_->active().empty()) return;
   Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();
-  for (int i : contact_.active()) {
-    const PositionContact::Mode m = contact_.mode(i);
+  for (int i : contact_->active()) {
+    const PositionContact::Mode m = contact_->mode(i);
     if (m == PositionContact::Mode::kStick || m == PositionContact::Mode::kNew) return;
     if (m == PositionContact::Mode::kSlide)
-      normals += contact_.normal(i) * contact_.normal(i).transpose();
+      normals += contact_->normal(i) * contact_->normal(i).transpose();
   }
   // The directions no contact constrains: the null space of sum n n^T.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normals);
@@ -257,8 +281,9 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
     particle(x_, i) = particle(s.x, i) + h * particle(s.v, i) + (h * h) * model.gravity;
   const Terrains* terrains = dynamics.terrains();
   terrains_seen_ = terrains != nullptr;
-  contact_active_ = resolves_contact() && contact_.begin(model, *terrains, s, h, true);
-  if (contact_active_) contact_.project(x_);
+  contact_active_ = resolves_contact() && contact_->begin(model, *terrains, s, h, true);
+  if (contact_active_) contact_->project(x_);
+  set_anchor_weights(dynamics.anchors(), h);
   if (StepResult r = sync_penalties(); !r.ok) return r;
 
   const bool measure_rho = options_.chebyshev && rho_ == 0;
@@ -274,7 +299,7 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
     if (last && options_.tolerance == 0) break;
     // The contact set settles in the first half of the iterations; the second half converges
     // for it (docs/realtime.md).
-    if (contact_active_) contact_.freeze(2 * k >= budget);
+    if (contact_active_) contact_->freeze(2 * k >= budget);
     residual(dynamics, s, h);
     const Real norm = r_.norm();
     if (!std::isfinite(norm))
@@ -307,7 +332,7 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
       x_prev_ = x_;
       x_ += delta_;
     }
-    if (contact_active_) contact_.project(x_);
+    if (contact_active_) contact_->project(x_);
   }
   // (A first step whose prediction is already the answer, free fall, has nothing to measure.)
   if (measure_rho && first > 1e-9 * model.mass.sum() * model.gravity.norm()) {
@@ -322,7 +347,7 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
   s.v = (x_ - s.x) / h;
   s.x = x_;
   s.t += h;
-  if (contact_active_) contact_.finish(model, s);
+  if (contact_active_) contact_->finish(model, s);
   return StepResult::success();
 }
 

@@ -13,12 +13,13 @@
 #include <memory>
 #include <vector>
 
-#include <jelly/core/jacobian.hpp>
-#include <jelly/solvers/contact/position_contact.hpp>
+#include <jelly/core/sparse_matrix.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/integrators/projective_dynamics_options.hpp>
 
 namespace jelly {
+
+class PositionContact;
 
 class CholmodSolver;
 
@@ -34,7 +35,7 @@ class ProjectiveDynamics final : public Integrator {
   bool resolves_contact() const override {
     return options_.contact == "projection" && terrains_seen_;
   }
-  int contacts_resolved() const override { return contact_active_ ? contact_.count() : 0; }
+  int contacts_resolved() const override;
   // steps, symbolic_analyses, factorizations (once per model and dt), iterations (global
   // solves), not_converged (steps that ended above the tolerance), chebyshev_rho,
   // factorization_seconds, solve_seconds, contact_restitution_limited.
@@ -63,7 +64,10 @@ class ProjectiveDynamics final : public Integrator {
   void slide_correction(const Model& model, Real h);
   // delta_ = P^-1 r_, P = A + the contact penalties in the factor.
   StepResult solve();
-  // Brings the contact penalties in the factor in line with the contacts' modes.
+  // anchor_weight_ = k + c / h of the anchor springs, per particle.
+  void set_anchor_weights(const AnchorSprings* anchors, Real h);
+  // Brings the diagonal additions in the factor in line with the anchors and the contacts'
+  // modes (rank updates of the factor, no factorization).
   StepResult sync_penalties();
 
   ProjectiveDynamicsOptions options_;
@@ -76,12 +80,14 @@ class ProjectiveDynamics final : public Integrator {
   std::vector<int> spring_a_, spring_b_;
   Eigen::MatrixXd rhs_, solution_;  // N x 3
   VecX x_, x_prev_, v_, f_, r_, delta_;
-  VecX diagonal_;              // A's diagonal
-  Vec3 shift_ = Vec3::Zero();  // slide_correction's translation
-  std::vector<Real> penalty_;  // [N]: the contact penalty in the factor
+  VecX diagonal_;                    // A's diagonal
+  Vec3 shift_ = Vec3::Zero();        // slide_correction's translation
+  std::vector<Real> penalty_;        // [N]: what the factor holds beyond A (anchors, contacts)
+  std::vector<Real> anchor_weight_;  // [N]: k + c / h of the anchor springs
+  std::vector<int> anchored_;
   std::vector<int> penalized_list_, rows_;
   std::vector<Real> values_;
-  PositionContact contact_;
+  std::unique_ptr<PositionContact> contact_;  // detail/position_contact.hpp
   bool contact_active_ = false;
   bool terrains_seen_ = true;
   Real rho_ = 0;  // Chebyshev spectral radius in use

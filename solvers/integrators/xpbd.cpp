@@ -3,17 +3,26 @@
 #include <cmath>
 
 #include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/detail/position_contact.hpp>
 
 namespace jelly {
 
-Xpbd::Xpbd(XpbdOptions options) : options_(std::move(options)) { options_.validate(); }
+Xpbd::Xpbd(XpbdOptions options)
+    : options_(std::move(options)), contact_(std::make_unique<PositionContact>()) {
+  options_.validate();
+}
+
+Xpbd::~Xpbd() = default;
+
+int Xpbd::contacts_resolved() const { return contact_active_ ? contact_->count() : 0; }
 
 Statistics Xpbd::statistics() const {
   Statistics s = Integrator::statistics();
   s["substeps"] = static_cast<double>(substeps_);
   s["sweeps"] = static_cast<double>(sweeps_);
   if (resolves_contact())
-    s["contact_restitution_limited"] = static_cast<double>(contact_.counters().restitution_limited);
+    s["contact_restitution_limited"] =
+        static_cast<double>(contact_->counters().restitution_limited);
   return s;
 }
 
@@ -91,6 +100,23 @@ void Xpbd::sweep(VecX& x) {
   }
 }
 
+void Xpbd::sweep_anchors(const AnchorSprings& anchors, Real hs, VecX& x) {
+  // Each anchor spring is the vector constraint C = x_p - target with compliance 1 / k and
+  // damping c on the particle's own motion: the same update as a spring's, per coordinate.
+  for (size_t k = 0; k < anchors.size(); ++k) {
+    const AnchorSpring& a = anchors[k];
+    const Real w = inverse_mass_[a.particle];
+    const Real stiffness = a.stiffness * hs * hs, damping = a.damping * hs;
+    const Real inverse_denominator = 1.0 / ((stiffness + damping) * w + 1);
+    auto xp = particle(x, a.particle);
+    const Vec3 dl = (-stiffness * (Vec3(xp) - a.target) - anchor_lambda_[k] -
+                     damping * (Vec3(xp) - particle(x_start_, a.particle))) *
+                    inverse_denominator;
+    anchor_lambda_[k] += dl;
+    xp += w * dl;
+  }
+}
+
 StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
   const Model& model = dynamics.model();
   const int substeps = options_.substeps;
@@ -104,24 +130,27 @@ StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
     // External forces: gravity and the seed model's contact forces.
     for (int i = 0; i < n; ++i) particle(f_, i) = model.mass[i] * model.gravity;
     dynamics.contacts().add_forces(s.v, f_);
-    contact_active_ = resolves_contact() && contact_.begin(model, *terrains, s, hs);
+    contact_active_ = resolves_contact() && contact_->begin(model, *terrains, s, hs);
     x_start_ = s.x;
     for (int i = 0; i < n; ++i) {
       particle(s.v, i) += (hs * inverse_mass_[i]) * particle(f_, i);
       particle(s.x, i) += hs * particle(s.v, i);
     }
     lambda_.setZero();
+    const AnchorSprings* anchors = dynamics.anchors();
+    if (anchors) anchor_lambda_.assign(anchors->size(), Vec3::Zero());
     // Contacts before each sweep, so that the springs carry their correction up the jelly
     // within the sweep, and after the last, so that the substep ends on the surfaces.
     for (int it = 0; it < options_.iterations; ++it) {
-      if (contact_active_) contact_.project_with_friction(s.x);
+      if (contact_active_) contact_->project_with_friction(s.x);
       sweep(s.x);
+      if (anchors) sweep_anchors(*anchors, hs, s.x);
       ++sweeps_;
     }
-    if (contact_active_) contact_.project_with_friction(s.x);
+    if (contact_active_) contact_->project_with_friction(s.x);
     s.v = (s.x - x_start_) / hs;
     s.t = sub + 1 == substeps ? t_end : s.t + hs;
-    if (contact_active_) contact_.finish(model, s);
+    if (contact_active_) contact_->finish(model, s);
     ++substeps_;
   }
   if (!s.x.allFinite() || !s.v.allFinite())

@@ -7,21 +7,25 @@
 //   dlambda = (-ks hs^2 C - lambda - kd hs grad C . (x - x_start)) / ((ks hs^2 + kd hs) w + 1),
 //   xa += wa dlambda n, xb -= wb dlambda n       (w = wa + wb inverse masses, n = grad_a C),
 // which is Macklin 2016's update (alpha~ = alpha / hs^2, gamma = alpha~ beta~ / hs, beta = kd)
-// multiplied through by ks hs^2, so that ks = 0 (a pure damper) is allowed. Coulomb terrains are
+// multiplied through by ks hs^2, so that ks = 0 (a pure damper) is allowed; anchor springs are
+// constraints of the same kind to their target. Coulomb terrains are
 // position constraints with position-based friction in each sweep, and restitution after each
 // substep (position_contact.hpp); docs/realtime.md.
+#include <memory>
 #include <vector>
 
-#include <jelly/solvers/contact/position_contact.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/integrators/xpbd_options.hpp>
 
 namespace jelly {
 
+class PositionContact;
+
 class Xpbd final : public Integrator {
  public:
   // Throws InputError for invalid options.
   explicit Xpbd(XpbdOptions options = {});
+  ~Xpbd() override;
 
   std::string_view name() const override { return "xpbd"; }
   int order() const override { return 1; }
@@ -30,7 +34,7 @@ class Xpbd final : public Integrator {
   bool resolves_contact() const override {
     return options_.contact == "projection" && terrains_seen_;
   }
-  int contacts_resolved() const override { return contact_active_ ? contact_.count() : 0; }
+  int contacts_resolved() const override;
   // steps, substeps, sweeps, contact_restitution_limited.
   Statistics statistics() const override;
 
@@ -50,6 +54,7 @@ class Xpbd final : public Integrator {
   };
   void prepare(const Model& model, Real hs);
   void sweep(VecX& x);
+  void sweep_anchors(const AnchorSprings& anchors, Real hs, VecX& x);
 
   XpbdOptions options_;
   std::vector<Constraint> constraints_;
@@ -61,7 +66,8 @@ class Xpbd final : public Integrator {
   std::vector<int> spring_a_, spring_b_;
   VecX rest_position_;
   VecX x_start_, lambda_, f_;
-  PositionContact contact_;
+  std::vector<Vec3> anchor_lambda_;
+  std::unique_ptr<PositionContact> contact_;  // detail/position_contact.hpp
   bool contact_active_ = false;
   bool terrains_seen_ = true;
   long substeps_ = 0, sweeps_ = 0;

@@ -313,5 +313,20 @@ TEST_P(RealtimeIntegrators, JellyRestsOnTheSlope) {
   EXPECT_LT((center_of_mass(m, sim.state()) - settled).norm(), 0.01);
 }
 
+// A stiff pull (the viewer's mouse drag, k = 1e6) at dt = 1/60: the jelly hangs from it without
+// diverging (projective dynamics takes the anchor's k + c / h into its factor by a rank update,
+// xpbd makes it a constraint), the pulled particle within 1 mm of its target.
+TEST_P(RealtimeIntegrators, StiffAnchorAtDt1_60) {
+  const Model m = build_cube(testing::small_cube(4));
+  Simulator sim(m, rest_state(m), make_integrator(GetParam()), SimulatorOptions{1.0 / 60});
+  const Vec3 target = particle(sim.state().x, 63) + Vec3(0, 0.5, 0);
+  sim.set_anchors({AnchorSpring{63, target, 1e6, 100}});
+  ASSERT_TRUE(sim.run_until(3.0).ok());
+  EXPECT_LT((Vec3(particle(sim.state().x, 63)) - target).norm(), 1e-3);
+  EXPECT_LT(center_of_mass(m, sim.state()).y(), target.y());
+  if (GetParam() == "projective_dynamics")
+    EXPECT_EQ(sim.integrator().statistics().at("factorizations"), 1);
+}
+
 }  // namespace
 }  // namespace jelly

@@ -1,8 +1,8 @@
 #pragma once
-// Coulomb contact for the position-based integrators (projective_dynamics, xpbd; docs/realtime.md):
-// particles are kept on the coulomb terrains' surfaces by projection at the end of the (sub)step
-// t1, with Coulomb friction, and bounce after it with restitution, within the energy the step
-// lost. Two ways to use it:
+// Internal (not installed). Coulomb contact for the position-based integrators
+// (projective_dynamics, xpbd; docs/realtime.md): particles are kept on the coulomb terrains'
+// surfaces by projection at the end of the (sub)step t1, with Coulomb friction, and bounce after it
+// with restitution, within the energy the step lost. Two ways to use it:
 //  * projective dynamics (constrain_residual + project, per iteration): the inward normal part of
 //    a contact's residual r = f - M (v1 - v0) / h is the contact force (it is removed before the
 //    global solve, so the fixed point balances every force exactly); a sticking contact's whole
