@@ -22,8 +22,8 @@ Eigen::Matrix2d amplification_matrix(const std::string& integrator, Real h, Real
 Real amplification(const std::string& integrator, Real h, Real w2, Real c);
 
 // The largest h (relative precision 1e-4) such that every mode with w^2 in [0, rho] (sampled
-// geometrically from 1e-4 rho, 400 samples) has amplification <= 1 + 1e-9 + 1e-12 / h (the
-// second term: the rounding of position-based velocities): the first boundary
+// geometrically from 1e-4 rho, 400 samples) has amplification <= 1 + 1e-9 (+ 1e-12 / h for
+// implicit methods: the rounding of position-based velocities): the first boundary
 // met when h grows from h_min. Returns h_cap when no instability is found below it, and 0 when
 // h_min is already unstable.
 Real predicted_max_dt(const std::string& integrator, Real rho, Real c, Real h_cap,
