@@ -142,6 +142,8 @@ StepResult ProjectiveDynamics::prepare(const Model& model, Real h) {
   if (anchor_weight_.size() != static_cast<size_t>(model.num_particles())) {
     anchor_weight_.assign(model.num_particles(), 0.0);
     anchored_.clear();
+    pinned_.assign(model.num_particles(), 0);
+    pinned_list_.clear();
   }
   penalized_list_.clear();
   return StepResult::success();
@@ -152,7 +154,7 @@ void ProjectiveDynamics::residual(const Dynamics& dynamics, const State& s0, Rea
   const int n = model.num_particles();
   const Real inv_h = 1.0 / h;
   v_ = (x_ - s0.x) * inv_h;
-  dynamics.forces(x_, v_, f_);
+  dynamics.forces(s0.t + h, x_, v_, f_);
   // r = f - M (v - v0) / h
   for (int i = 0; i < n; ++i) {
     const Real m = model.mass[i] * inv_h;
@@ -160,6 +162,18 @@ void ProjectiveDynamics::residual(const Dynamics& dynamics, const State& s0, Rea
       r_[3 * i + c] = f_[3 * i + c] - m * (v_[3 * i + c] - s0.v[3 * i + c]);
   }
   if (contact_active_) contact_->constrain_residual(x_, r_);
+  for (int i : model.pins.particles) particle(r_, i).setZero();  // the pin takes it
+}
+
+void ProjectiveDynamics::place_pins(const Model& model, Real t) {
+  const Pins& pins = model.pins;
+  for (int k = 0; k < pins.size(); ++k) particle(x_, pins.particles[k]) = pins.position(k, t);
+}
+
+void ProjectiveDynamics::set_pins(const Pins& pins) {
+  for (int i : pinned_list_) pinned_[i] = 0;
+  pinned_list_ = pins.particles;  // (no allocation once the pins are the same)
+  for (int i : pinned_list_) pinned_[i] = 1;
 }
 
 void ProjectiveDynamics::set_anchor_weights(const AnchorSprings* anchors, Real h) {
@@ -180,6 +194,7 @@ StepResult ProjectiveDynamics::sync_penalties() {
   // contacts, so it gets a moderate one (docs/realtime.md); a free particle none.
   const auto wanted = [&](int i) {
     Real w = anchor_weight_[i];
+    if (pinned_[i]) return w + kStickPenalty * diagonal_[i];
     if (!contact_active_) return w;
     switch (contact_->mode(i)) {
       case PositionContact::Mode::kStick:
@@ -207,6 +222,7 @@ StepResult ProjectiveDynamics::sync_penalties() {
       if (contact_active_)
         for (int i : contact_->active()) raise(i);
       for (int i : anchored_) raise(i);
+      for (int i : pinned_list_) raise(i);
     } else {  // downdates first, so that no particle is ever held twice
       size_t kept = 0;
       for (int i : penalized_list_) {
@@ -232,7 +248,7 @@ StepResult ProjectiveDynamics::sync_penalties() {
 
 void ProjectiveDynamics::slide_correction(const Model& model, Real h) {
   shift_.setZero();
-  if (!contact_active_ || contact_->active().empty()) return;
+  if (!contact_active_ || contact_->active().empty() || !model.pins.empty()) return;
   Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();
   for (int i : contact_->active()) {
     const PositionContact::Mode m = contact_->mode(i);
@@ -283,6 +299,8 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
   terrains_seen_ = terrains != nullptr;
   contact_active_ = resolves_contact() && contact_->begin(model, *terrains, s, h, true);
   if (contact_active_) contact_->project(x_);
+  place_pins(model, s.t + h);
+  set_pins(model.pins);
   set_anchor_weights(dynamics.anchors(), h);
   if (StepResult r = sync_penalties(); !r.ok) return r;
 
@@ -333,6 +351,7 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
       x_ += delta_;
     }
     if (contact_active_) contact_->project(x_);
+    place_pins(model, s.t + h);
   }
   // (A first step whose prediction is already the answer, free fall, has nothing to measure.)
   if (measure_rho && first > 1e-9 * model.mass.sum() * model.gravity.norm()) {

@@ -64,6 +64,11 @@ class ProjectiveDynamics final : public Integrator {
   void slide_correction(const Model& model, Real h);
   // delta_ = P^-1 r_, P = A + the contact penalties in the factor.
   StepResult solve();
+  // Pinned particles at their paths' positions at time t (in x_).
+  void place_pins(const Model& model, Real t);
+  // pinned_ from the model's pins (each is held in the factor like a sticking contact, and its
+  // residual is the pin's).
+  void set_pins(const Pins& pins);
   // anchor_weight_ = k + c / h of the anchor springs, per particle.
   void set_anchor_weights(const AnchorSprings* anchors, Real h);
   // Brings the diagonal additions in the factor in line with the anchors and the contacts'
@@ -85,6 +90,8 @@ class ProjectiveDynamics final : public Integrator {
   std::vector<Real> penalty_;        // [N]: what the factor holds beyond A (anchors, contacts)
   std::vector<Real> anchor_weight_;  // [N]: k + c / h of the anchor springs
   std::vector<int> anchored_;
+  std::vector<char> pinned_;  // [N]
+  std::vector<int> pinned_list_;
   std::vector<int> penalized_list_, rows_;
   std::vector<Real> values_;
   std::unique_ptr<PositionContact> contact_;  // detail/position_contact.hpp

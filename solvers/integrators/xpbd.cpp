@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/contact/detail/position_contact.hpp>
 
@@ -30,7 +31,7 @@ void Xpbd::prepare(const Model& model, Real hs) {
   const Springs& s = model.springs;
   const bool same_model = mass_.size() == model.mass.size() && mass_ == model.mass && ks_ == s.ks &&
                           kd_ == s.kd && rest_ == s.rest_length && spring_a_ == s.a &&
-                          spring_b_ == s.b;
+                          spring_b_ == s.b && pinned_ == model.pins.particles;
   if (same_model && hs == hs_) return;
   if (!same_model) {  // once per model (allocates)
     mass_ = model.mass;
@@ -40,7 +41,9 @@ void Xpbd::prepare(const Model& model, Real hs) {
     spring_a_ = s.a;
     spring_b_ = s.b;
     rest_position_ = model.rest_position;
+    pinned_ = model.pins.particles;
     inverse_mass_ = model.mass.cwiseInverse();
+    for (int i : pinned_) inverse_mass_[i] = 0;  // constraints never move a pinned particle
     constraints_.resize(s.size());
     const int n = model.num_dofs();
     x_start_.setZero(n);
@@ -117,6 +120,10 @@ void Xpbd::sweep_anchors(const AnchorSprings& anchors, Real hs, VecX& x) {
   }
 }
 
+void Xpbd::place_pins(const Pins& pins, Real t, VecX& x) const {
+  for (int k = 0; k < pins.size(); ++k) particle(x, pins.particles[k]) = pins.position(k, t);
+}
+
 StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
   const Model& model = dynamics.model();
   const int substeps = options_.substeps;
@@ -127,15 +134,20 @@ StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
   terrains_seen_ = terrains != nullptr;
   const Real t_end = s.t + h;
   for (int sub = 0; sub < substeps; ++sub) {
-    // External forces: gravity and the seed model's contact forces.
+    // External forces: gravity, the model's external forces and the seed model's contact
+    // forces.
     for (int i = 0; i < n; ++i) particle(f_, i) = model.mass[i] * model.gravity;
+    if (!model.external_forces.empty())
+      add_external_forces(model.external_forces, model.mass, s.t, s.v, f_);
     dynamics.contacts().add_forces(s.v, f_);
+    const Real t1 = sub + 1 == substeps ? t_end : s.t + hs;
     contact_active_ = resolves_contact() && contact_->begin(model, *terrains, s, hs);
     x_start_ = s.x;
     for (int i = 0; i < n; ++i) {
       particle(s.v, i) += (hs * inverse_mass_[i]) * particle(f_, i);
       particle(s.x, i) += hs * particle(s.v, i);
     }
+    place_pins(model.pins, t1, s.x);
     lambda_.setZero();
     const AnchorSprings* anchors = dynamics.anchors();
     if (anchors) anchor_lambda_.assign(anchors->size(), Vec3::Zero());
@@ -148,8 +160,9 @@ StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
       ++sweeps_;
     }
     if (contact_active_) contact_->project_with_friction(s.x);
+    place_pins(model.pins, t1, s.x);
     s.v = (s.x - x_start_) / hs;
-    s.t = sub + 1 == substeps ? t_end : s.t + hs;
+    s.t = t1;
     if (contact_active_) contact_->finish(model, s);
     ++substeps_;
   }

@@ -55,6 +55,8 @@ class Xpbd final : public Integrator {
   void prepare(const Model& model, Real hs);
   void sweep(VecX& x);
   void sweep_anchors(const AnchorSprings& anchors, Real hs, VecX& x);
+  // Pinned particles (inverse mass 0 in the sweeps) at their paths' positions at time t.
+  void place_pins(const Pins& pins, Real t, VecX& x) const;
 
   XpbdOptions options_;
   std::vector<Constraint> constraints_;
@@ -63,7 +65,7 @@ class Xpbd final : public Integrator {
   // What the constraints were built from: a changed model rebuilds them.
   VecX mass_;
   std::vector<Real> ks_, kd_, rest_;
-  std::vector<int> spring_a_, spring_b_;
+  std::vector<int> spring_a_, spring_b_, pinned_;
   VecX rest_position_;
   VecX x_start_, lambda_, f_;
   std::vector<Vec3> anchor_lambda_;
