@@ -53,7 +53,7 @@ State backward_euler_step(const Model& model, const State& s0, Real h) {
   ImplicitEulerOptions o;
   o.newton_iterations = 100;
   o.newton_tolerance = 1e-14;
-  o.linear_solver = "cholmod";
+  o.linear_solver = ImplicitLinearSolver::kCholmod;
   ImplicitEuler newton(o);
   const State s = one_step(newton, model, s0, h);
   EXPECT_TRUE(newton.last_converged());
@@ -149,15 +149,16 @@ TEST(RealtimeOptions, InvalidOptionsNameTheField) {
   }
   o = {};
   o.pd.chebyshev_rho = 1;
-  EXPECT_THROW(o.validate(), InputError);
+  EXPECT_THROW(make_integrator("projective_dynamics", o), InputError);
   o = {};
   o.pd.contact = "implicit";
-  EXPECT_THROW(o.validate(), InputError);
+  EXPECT_THROW(make_integrator("projective_dynamics", o), InputError);
   o = {};
   o.xpbd.substeps = 0;
   EXPECT_THROW(make_integrator("xpbd", o), InputError);
   o = {};
-  EXPECT_NO_THROW(o.validate());
+  EXPECT_NO_THROW(make_integrator("projective_dynamics", o));
+  EXPECT_NO_THROW(make_integrator("xpbd", o));
 }
 
 // ---- XPBD -----------------------------------------------------------------------------------
