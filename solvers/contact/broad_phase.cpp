@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace jelly {
 
@@ -23,7 +24,22 @@ void BroadPhase::find_pairs(const VecX& x, const VecX& radius, std::vector<Pair>
   if (n < 2) return;
   // Cells as large as the largest contact distance: a pair in contact lies in neighbouring cells.
   const Real cell = 2 * radius.maxCoeff();
+  if (!(cell > 0)) return;  // no particle reaches another
   const Real inverse = 1 / cell;
+  // A dense grid over the particles' bounding box (one more cell on every side) when it has at
+  // most 8 cells per particle: neighbouring cells along x are neighbours in memory. Else a hash.
+  Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<Real>::infinity());
+  Eigen::Array3d hi = -lo;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Array3d p(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+    lo = lo.min(p);
+    hi = hi.max(p);
+  }
+  const Eigen::Array3d span = ((hi - lo) * inverse).floor() + 3;
+  if (span.allFinite() && span.prod() <= 8.0 * n + 64) {
+    find_pairs_dense(x, radius, lo, inverse, span.cast<int>(), pairs);
+    return;
+  }
   unsigned buckets = 1;
   while (buckets < 2u * static_cast<unsigned>(n)) buckets <<= 1;
   const unsigned mask = buckets - 1;
@@ -61,6 +77,55 @@ void BroadPhase::find_pairs(const VecX& x, const VecX& radius, std::vector<Pair>
             const Real reach = ri + radius[j];
             const Vec3 d(x[3 * j] - xi[0], x[3 * j + 1] - xi[1], x[3 * j + 2] - xi[2]);
             if (d.squaredNorm() < reach * reach) pairs.emplace_back(i, j);
+          }
+        }
+      }
+    }
+  }
+}
+
+void BroadPhase::find_pairs_dense(const VecX& x, const VecX& radius, const Eigen::Array3d& lo,
+                                  Real inverse, const Eigen::Array3i& dims,
+                                  std::vector<Pair>& pairs) {
+  const int n = static_cast<int>(radius.size());
+  const int nx = dims[0], nxy = dims[0] * dims[1];
+  const int cells = nxy * dims[2];
+  start_.assign(cells + 1, 0);
+  sorted_.resize(n);
+  bucket_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    // Cell coordinates from 1 (cell 0 and the last are the padding).
+    int c[3];
+    for (int a = 0; a < 3; ++a)
+      c[a] = 1 + static_cast<int>(std::floor((x[3 * i + a] - lo[a]) * inverse));
+    bucket_[i] = c[0] + nx * c[1] + nxy * c[2];
+    ++start_[bucket_[i] + 1];
+  }
+  for (int b = 0; b < cells; ++b) start_[b + 1] += start_[b];
+  for (int i = 0; i < n; ++i) sorted_[start_[bucket_[i]]++] = i;
+  for (int b = cells; b > 0; --b) start_[b] = start_[b - 1];
+  start_[0] = 0;
+  // Positions and radii in the sorted order, for locality.
+  xs_.resize(3 * n);
+  rs_.resize(n);
+  for (int s = 0; s < n; ++s) {
+    const int i = sorted_[s];
+    for (int a = 0; a < 3; ++a) xs_[3 * s + a] = x[3 * i + a];
+    rs_[s] = radius[i];
+  }
+  for (int s = 0; s < n; ++s) {
+    const int c = bucket_[sorted_[s]];
+    const Real px = xs_[3 * s], py = xs_[3 * s + 1], pz = xs_[3 * s + 2], r = rs_[s];
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        const int row = c + dy * nx + dz * nxy;  // cells row - 1 .. row + 1 are contiguous
+        const int end = start_[row + 2];
+        for (int t = std::max(start_[row - 1], s + 1); t < end; ++t) {
+          const Real ex = xs_[3 * t] - px, ey = xs_[3 * t + 1] - py, ez = xs_[3 * t + 2] - pz;
+          const Real reach = r + rs_[t];
+          if (ex * ex + ey * ey + ez * ez < reach * reach) {
+            const int i = sorted_[s], j = sorted_[t];
+            pairs.emplace_back(std::min(i, j), std::max(i, j));
           }
         }
       }

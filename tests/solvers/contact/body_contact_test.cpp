@@ -56,7 +56,9 @@ TEST(BroadPhase, FindsExactlyThePairsOfABruteForceSearch) {
       EXPECT_TRUE(std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end());
       const Pairs expected = brute_force(x, r);  // sorted by construction
       EXPECT_EQ(sorted, expected) << "n = " << n << ", extent " << extent;
-      if (n == 3000 && extent == 5.0) EXPECT_GT(expected.size(), 100u);
+      if (n == 3000 && extent == 5.0) {
+        EXPECT_GT(expected.size(), 100u);
+      }
     }
   }
 }
@@ -96,7 +98,9 @@ TEST(BodyContact, ResponseConservesMomentum) {
     const Vec3 l0 = angular_momentum(model, before), l1 = angular_momentum(model, s);
     const Real scale = model.mass.sum() * 2;  // total mass times the approach speed
     EXPECT_LT((p1 - p0).norm(), 1e-12 * scale) << mu;
-    if (mu == 0) EXPECT_LT((l1 - l0).norm(), 1e-12 * scale) << mu;
+    if (mu == 0) {
+      EXPECT_LT((l1 - l0).norm(), 1e-12 * scale) << mu;
+    }
     // The overlap is gone (to the iterations' accuracy) and nothing approaches any more.
     Real worst = 0;
     for (const auto& [i, j] : contact.pairs()) {
@@ -134,7 +138,9 @@ TEST_P(BodiesEveryIntegrator, TwoFreeCubesCollideConserveMomentumAndSeparate) {
   EXPECT_GT(touching_steps, 0);
   EXPECT_TRUE(sim.body_contact().pairs().empty());  // apart again
   EXPECT_LT((p1 - p0).norm(), 1e-9 * p0.norm());
-  if (GetParam() == "symplectic_euler") EXPECT_LT((l1 - l0).norm(), 1e-9 * l0.norm());
+  if (GetParam() == "symplectic_euler") {
+    EXPECT_LT((l1 - l0).norm(), 1e-9 * l0.norm());
+  }
   // They bounced: the left cube now moves slower than the centre of mass (0.25 m/s).
   Vec3 left = Vec3::Zero();
   for (int i = 0; i < 64; ++i) left += model.mass[i] * particle(sim.state().v, i);

@@ -1,0 +1,83 @@
+// Broad and narrow phase of body-body contact (docs/contact.md, docs/benchmarks.md): two n^3
+// cubes side by side, their facing layers overlapping by 1 % of the contact distance (n^2
+// contact pairs), one BodyContact::resolve per iteration on a fresh copy of the state (the copy
+// is not timed). Counters: particles, pairs, ns per particle, and the broad phase alone.
+// Run on one core: taskset -c 0 build/bench/jelly_contact_benchmark (the manual times and the
+// *_ms counters are wall clock; on a shared machine read the CPU column).
+#include <chrono>
+
+#include <benchmark/benchmark.h>
+
+#include <jelly/jelly.hpp>
+
+namespace {
+
+using namespace jelly;
+
+Model two_cubes(int n) {
+  const Real edge = 4, spacing = edge / (n - 1);
+  Model model;
+  CubeSpec a;
+  a.n = n;
+  a.edge_length = edge;
+  a.origin = Vec3(0, 0, 0);
+  CubeSpec b = a;
+  b.origin = Vec3(edge + 0.99 * spacing, 0, 0);  // facing layers 1 % inside each other
+  model.add_body("a", a.shape().build(a.material(), "a."));
+  model.add_body("b", b.shape().build(b.material(), "b."));
+  return model;
+}
+
+void BM_BodyContactResolve(benchmark::State& bench) {
+  const Model model = two_cubes(static_cast<int>(bench.range(0)));
+  const State start = rest_state(model);
+  BodyContact contact;
+  State s = start;
+  size_t pairs = 0;
+  for (auto _ : bench) {
+    s.x = start.x;
+    s.v = start.v;
+    const auto t0 = std::chrono::steady_clock::now();
+    contact.resolve(model, start, s, 1e-3);
+    const auto t1 = std::chrono::steady_clock::now();
+    pairs = contact.pairs().size();
+    bench.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+  }
+  const double steps = static_cast<double>(contact.stats().steps);
+  bench.counters["particles"] = model.num_particles();
+  bench.counters["pairs"] = static_cast<double>(pairs);
+  bench.counters["broad_ms"] = 1e3 * contact.stats().broad_seconds / steps;
+  bench.counters["narrow_ms"] = 1e3 * contact.stats().narrow_seconds / steps;
+  bench.counters["ns_per_particle"] =
+      1e9 * (contact.stats().broad_seconds + contact.stats().narrow_seconds) / steps /
+      model.num_particles();
+}
+BENCHMARK(BM_BodyContactResolve)
+    ->Arg(10)
+    ->Arg(20)
+    ->Arg(30)
+    ->Arg(40)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+
+// The broad phase alone on one n^3 cube (n = 40: 64,000 particles).
+void BM_BroadPhaseOneCube(benchmark::State& bench) {
+  CubeSpec spec;
+  spec.n = static_cast<int>(bench.range(0));
+  const Model model = build_cube(spec);
+  const State s = rest_state(model);
+  const VecX radius = VecX::Constant(model.num_particles(), 0.5 * 4.0 / (spec.n - 1));
+  BroadPhase broad;
+  std::vector<BroadPhase::Pair> pairs;
+  for (auto _ : bench) {
+    broad.find_pairs(s.x, radius, pairs);
+    benchmark::DoNotOptimize(pairs.data());
+  }
+  bench.counters["particles"] = model.num_particles();
+  bench.counters["pairs"] = static_cast<double>(pairs.size());
+}
+BENCHMARK(BM_BroadPhaseOneCube)->Arg(10)->Arg(20)->Arg(40)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
