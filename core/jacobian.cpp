@@ -70,6 +70,21 @@ inline void spring_blocks(const Real* px, const Real* pv, const Real* pr, int ia
 
 }  // namespace
 
+void spring_jacobian_blocks(const Model& model, const VecX& x, const VecX& v,
+                            const JacobianOptions& options, std::vector<Real>& k_blocks,
+                            std::vector<Real>& d_blocks) {
+  const Springs& s = model.springs;
+  k_blocks.resize(9 * static_cast<size_t>(s.size()));
+  d_blocks.resize(k_blocks.size());
+  SpringBlocks blocks;
+  for (int sp = 0; sp < s.size(); ++sp) {
+    spring_blocks(x.data(), v.data(), model.rest_position.data(), 3 * s.a[sp], 3 * s.b[sp],
+                  s.rest_length[sp], s.ks[sp], s.kd[sp], options, blocks);
+    std::copy(blocks.k, blocks.k + 9, &k_blocks[9 * static_cast<size_t>(sp)]);
+    std::copy(blocks.d, blocks.d + 9, &d_blocks[9 * static_cast<size_t>(sp)]);
+  }
+}
+
 SpringJacobian::SpringJacobian(const Model& model) : num_particles_(model.num_particles()) {
   const Springs& s = model.springs;
   const int n = num_particles_;

@@ -17,6 +17,14 @@ struct JacobianOptions {
   bool exact_damper = false;
 };
 
+// Per spring k = (a, b) its 3x3 blocks df_a/dxa of K and df_a/dva of D at (x, v), row-major, 9
+// values per spring (spring k at [9k, 9k + 9)), as assemble() computes them; the spring's other
+// blocks are df_a/dxb = df_b/dxa = -df_a/dxa and df_b/dxb = df_a/dxa. For matrix-free products:
+// (K p)_a += K_k (p_a - p_b), (K p)_b -= K_k (p_a - p_b). Resizes the vectors to 9M.
+void spring_jacobian_blocks(const Model& model, const VecX& x, const VecX& v,
+                            const JacobianOptions& options, std::vector<Real>& k_blocks,
+                            std::vector<Real>& d_blocks);
+
 class SpringJacobian {
  public:
   // Builds the pattern of the 3N x 3N matrices for the springs of `model`: one dense 3x3 block

@@ -6,9 +6,11 @@
 #include <arkode/arkode_arkstep.h>
 #include <arkode/arkode_butcher_dirk.h>
 #include <sunlinsol/sunlinsol_klu.h>
+#include <sunlinsol/sunlinsol_spgmr.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/arkode/detail/arkode_iterative.hpp>
 #include <jelly/solvers/arkode/detail/arkode_schur.hpp>
 #include <jelly/solvers/arkode/detail/arkode_support.hpp>
 
@@ -18,13 +20,22 @@ namespace {
 
 constexpr Real kDeltaGammaMax = 1e-2;
 constexpr int kMaximumOrderPredictor = 1;
+constexpr int kGmresMaxKrylov = 10;
+constexpr int kInterpolantDegree = 3;
+
+// "auto": the matrix-free Schur CG, the fastest in every measurement of docs/arkode.md
+// ("Iterative Newton solves").
+std::string resolve_linear_solver(const std::string& name) { return name == "auto" ? "cg" : name; }
 
 class DirkDriver final : public arkode::Driver {
  public:
-  DirkDriver(const ArkodeOptions& options, std::string method)
-      : Driver("arkode_dirk", arkode::kArkStepApi, options), method_(std::move(method)) {
+  DirkDriver(const ArkodeOptions& options, std::string method, std::string linear_solver)
+      : Driver("arkode_dirk", arkode::kArkStepApi, options),
+        method_(std::move(method)),
+        linear_solver_kind_(std::move(linear_solver)) {
     data_.owner = this;
   }
+  const std::string& linear_solver_kind() const { return linear_solver_kind_; }
   // ARKODE's memory refers to the linear solver and matrix: free it first.
   ~DirkDriver() override { memory_.reset(); }
 
@@ -39,7 +50,21 @@ class DirkDriver final : public arkode::Driver {
     int flag = ARKStepSetErrHandlerFn(m, arkode::keep_error, &data_);
     if (flag >= 0) flag = ARKStepSetTableName(m, method_.c_str(), "ARKODE_ERK_NONE");
     if (flag < 0) return flag;
-    if (options_.linear_solver == "klu") {
+    if (linear_solver_kind_ == "gmres") {
+      linear_solver_.reset(SUNLinSol_SPGMR(y0, SUN_PREC_RIGHT, kGmresMaxKrylov, context_.get()));
+      if (!linear_solver_) return ARK_MEM_FAIL;
+      flag = ARKStepSetLinearSolver(m, linear_solver_.get(), nullptr);
+      if (flag >= 0)
+        flag = ARKStepSetPreconditioner(m, &DirkDriver::preconditioner_setup,
+                                        &DirkDriver::preconditioner_solve);
+    } else if (linear_solver_kind_ == "jacobi" || linear_solver_kind_ == "cg") {
+      linear_solver_ = arkode::make_iterative_solver(context_.get(), m, &data_,
+                                                     linear_solver_kind_ == "cg"
+                                                         ? arkode::IterativeMode::kCg
+                                                         : arkode::IterativeMode::kJacobi);
+      if (!linear_solver_) return ARK_MEM_FAIL;
+      flag = arkode::attach_schur_solver(m, linear_solver_.get());
+    } else if (linear_solver_kind_ == "klu") {
       const sunindextype n = N_VGetLength(y0) / 2;
       const Model& model = data_.dynamics->model();
       schur_ = std::make_unique<arkode::SchurSystem>(model);  // K, D on their fixed pattern
@@ -63,18 +88,27 @@ class DirkDriver final : public arkode::Driver {
     // them after one iteration: on the damped oscillator the global error then stayed near
     // 1e-5 for every rtol from 1e-4 to 1e-8 (docs/arkode.md). The Schur solver refines its
     // solution to the current gamma instead; for KLU a 1% bound restores the accuracy.
-    if (flag >= 0 && options_.linear_solver == "klu")
+    if (flag >= 0 && linear_solver_kind_ == "klu")
       flag = ARKStepSetDeltaGammaMax(m, kDeltaGammaMax);
     // Newton starts from the interpolant of the last step (ARKODE's "maximum order" predictor)
     // rather than from y_n: on a spinning cube of stiff springs the trivial predictor made 86%
     // of the steps fail Newton's convergence test and took 9 times as many steps
     // (docs/arkode.md). After a restart ARKODE falls back to y_n.
     if (flag >= 0) flag = ARKStepSetPredictorMethod(m, kMaximumOrderPredictor);
+    // ARKODE's default Hermite interpolant for this order-5 method has degree 5, which costs
+    // extra right-hand sides per step (8 of the 23 per step in free fall on the seed cube) and
+    // makes every prediction a long linear combination; degree 3 uses only the step's end
+    // values (docs/arkode.md).
+    if (flag >= 0) flag = ARKStepSetInterpolantDegree(m, kInterpolantDegree);
     return flag;
   }
 
+  // A DIRK step is expensive: the driver steps past the interval end and interpolates there
+  // (docs/arkode.md, "Contact"), so that contact-free intervals cost no step of their own.
+  bool interpolates() const override { return true; }
+
   std::string failure_detail() const override {
-    if (options_.linear_solver == "klu" || !linear_solver_) return {};
+    if (linear_solver_kind_ != "schur" || !linear_solver_) return {};
     const std::string& why = arkode::schur_error(linear_solver_.get());
     return why.empty() ? why : "Schur solve: " + why;
   }
@@ -87,7 +121,12 @@ class DirkDriver final : public arkode::Driver {
     ARKStepGetNumNonlinSolvIters(m, &c.newton_iterations);
     ARKStepGetNumNonlinSolvConvFails(m, &c.newton_failures);
     ARKStepGetNumLinSolvSetups(m, &c.linear_setups);
-    if (options_.linear_solver == "klu") ARKStepGetNumJacEvals(m, &c.jacobian_evaluations);
+    if (linear_solver_kind_ == "klu") ARKStepGetNumJacEvals(m, &c.jacobian_evaluations);
+    if (linear_solver_kind_ == "gmres") {
+      ARKStepGetNumLinIters(m, &c.linear_iterations);
+      ARKStepGetNumLinConvFails(m, &c.linear_failures);
+      ARKStepGetNumLinRhsEvals(m, &c.linear_rhs_evaluations);
+    }
     return c;
   }
 
@@ -95,8 +134,22 @@ class DirkDriver final : public arkode::Driver {
     s["newton_iterations"] = static_cast<double>(total().newton_iterations);
     s["newton_convergence_failures"] = static_cast<double>(total().newton_failures);
     s["linear_setups"] = static_cast<double>(total().linear_setups);
-    if (options_.linear_solver == "klu") {
+    if (linear_solver_kind_ == "klu") {
       s["jacobian_evaluations"] = static_cast<double>(total().jacobian_evaluations);
+    } else if (linear_solver_kind_ == "gmres") {
+      s["krylov_iterations"] = static_cast<double>(total().linear_iterations);
+      s["krylov_failures"] = static_cast<double>(total().linear_failures);
+      s["jv_rhs_evaluations"] = static_cast<double>(total().linear_rhs_evaluations);
+      s["preconditioner_setups"] = static_cast<double>(preconditioner_.linearizations());
+    } else if (linear_solver_kind_ == "jacobi" || linear_solver_kind_ == "cg") {
+      if (linear_solver_) {
+        const arkode::IterativeStatistics& i = arkode::iterative_statistics(linear_solver_.get());
+        s["linearizations"] = static_cast<double>(i.setups);
+        if (linear_solver_kind_ == "cg") {
+          s["cg_iterations"] = static_cast<double>(i.iterations);
+          s["cg_failures"] = static_cast<double>(i.failures);
+        }
+      }
     } else if (linear_solver_) {
       const arkode::SchurStatistics& schur = arkode::schur_statistics(linear_solver_.get());
       s["schur_factorizations"] = static_cast<double>(schur.factorizations);
@@ -155,7 +208,42 @@ class DirkDriver final : public arkode::Driver {
     return 0;
   }
 
+  // ARKLsPrecSetupFn ("gmres"): the diagonal blocks of K and D at y, unless ARKODE says the
+  // last ones will do (jok).
+  static int preconditioner_setup(realtype /*t*/, N_Vector y, N_Vector /*fy*/, booleantype jok,
+                                  booleantype* jcur, realtype /*gamma*/, void* user_data) {
+    auto& data = *static_cast<arkode::RhsData*>(user_data);
+    auto& self = *static_cast<DirkDriver*>(data.owner);
+    if (jok && self.preconditioner_.ready()) {
+      *jcur = SUNFALSE;
+      return 0;
+    }
+    const Model& model = data.dynamics->model();
+    const sunindextype n = model.num_dofs();
+    const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
+    data.x = yy.head(n);
+    data.v = yy.tail(n);
+    self.preconditioner_.linearize(model, data.x, data.v);
+    *jcur = SUNTRUE;
+    return 0;
+  }
+
+  // ARKLsPrecSolveFn ("gmres"): z = P^-1 r for ARKODE's current gamma.
+  static int preconditioner_solve(realtype /*t*/, N_Vector /*y*/, N_Vector /*fy*/, N_Vector r,
+                                  N_Vector z, realtype gamma, realtype /*delta*/, int /*lr*/,
+                                  void* user_data) {
+    auto& data = *static_cast<arkode::RhsData*>(user_data);
+    auto& self = *static_cast<DirkDriver*>(data.owner);
+    if (!self.preconditioner_.ready()) return -1;
+    const Model& model = data.dynamics->model();
+    self.preconditioner_.set_gamma(model, gamma);
+    self.preconditioner_.block_jacobi(model, N_VGetArrayPointer(r), N_VGetArrayPointer(z));
+    return 0;
+  }
+
   std::string method_;
+  std::string linear_solver_kind_;  // "schur", "klu", "cg", "gmres", "jacobi" (auto resolved)
+  arkode::SpringOperator preconditioner_;               // gmres: the block Jacobi
   std::unique_ptr<arkode::SchurSystem> schur_;          // klu: the K, D assembly
   std::vector<sunindextype> column_start_, row_index_;  // klu: the pattern of J
   arkode::MatrixPtr jacobian_;
@@ -176,7 +264,8 @@ ArkodeDirk::ArkodeDirk(const ArkodeOptions& options) {
   require(embedded, "integrator.options.method", method,
           "the name of an ARKODE diagonally implicit Runge-Kutta table with an embedding, e.g. "
           "ARKODE_ARK324L2SA_DIRK_4_2_3, ARKODE_SDIRK_5_3_4, ARKODE_KVAERNO_7_4_5");
-  driver_ = std::make_unique<DirkDriver>(options, method);
+  driver_ =
+      std::make_unique<DirkDriver>(options, method, resolve_linear_solver(options.linear_solver));
 }
 
 ArkodeDirk::~ArkodeDirk() = default;

@@ -12,8 +12,10 @@ void ArkodeOptions::validate(const std::string& prefix) const {
   require(std::isfinite(atol) && atol > 0, prefix + "atol", atol, "an absolute tolerance > 0");
   require(std::isfinite(max_step) && max_step >= 0, prefix + "max_step", max_step,
           "a finite step >= 0 s (0 = the contact interval dt)");
-  require(linear_solver == "schur" || linear_solver == "klu", prefix + "linear_solver",
-          "\"" + linear_solver + "\"", "\"schur\" or \"klu\"");
+  require(linear_solver == "auto" || linear_solver == "cg" || linear_solver == "gmres" ||
+              linear_solver == "jacobi" || linear_solver == "schur" || linear_solver == "klu",
+          prefix + "linear_solver", "\"" + linear_solver + "\"",
+          "one of \"auto\", \"cg\", \"gmres\", \"jacobi\", \"schur\", \"klu\"");
   require(max_steps > 0, prefix + "max_steps", max_steps,
           "a number of internal steps per contact interval > 0");
 }

@@ -106,6 +106,9 @@ void Driver::accumulate() {
   total_.newton_failures += now.newton_failures - seen_.newton_failures;
   total_.linear_setups += now.linear_setups - seen_.linear_setups;
   total_.jacobian_evaluations += now.jacobian_evaluations - seen_.jacobian_evaluations;
+  total_.linear_iterations += now.linear_iterations - seen_.linear_iterations;
+  total_.linear_failures += now.linear_failures - seen_.linear_failures;
+  total_.linear_rhs_evaluations += now.linear_rhs_evaluations - seen_.linear_rhs_evaluations;
   seen_ = now;
 }
 
@@ -124,7 +127,10 @@ StepResult Driver::advance(const Dynamics& dynamics, State& state, Real h) {
   const bool restart = fresh || contacts || contacts_last_ || state.t != last_t_ ||
                        state.x != last_x_ || state.v != last_v_;
   contacts_last_ = contacts;
-  const Real max_step = options_.max_step > 0 ? options_.max_step : h;
+  // Interpolating drivers step past the interval end (no limit by default); the others stop
+  // there.
+  const Real max_step = options_.max_step > 0 ? options_.max_step : (interpolates() ? 0.0 : h);
+  const Real first_step = max_step > 0 ? std::min(max_step, interpolates() ? h : max_step) : h;
   if (restart) {
     if (fresh) {
       memory_.reset();
@@ -160,13 +166,13 @@ StepResult Driver::advance(const Dynamics& dynamics, State& state, Real h) {
     // the first call). Measured on a jelly resting on the floor (docs/arkode.md), this costs
     // fewer evaluations than ARKODE's estimate or its controller's proposal, which a contact
     // often rejects.
-    const int f = api_.set_init_step(memory_.get(), std::min(last_h_, max_step));
+    const int f = api_.set_init_step(memory_.get(), std::min(last_h_, first_step));
     if (f < 0) return StepResult::failure(failure("SetInitStep", f));
   }
 
   void* m = memory_.get();
   const Real t_end = state.t + h;
-  int flag = api_.set_stop_time(m, t_end);
+  int flag = interpolates() ? 0 : api_.set_stop_time(m, t_end);
   if (flag >= 0) flag = api_.set_max_step(m, max_step);
   if (flag < 0) return StepResult::failure(failure("setting the stop time", flag));
   realtype t_reached = state.t;

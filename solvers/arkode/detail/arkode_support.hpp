@@ -92,6 +92,9 @@ extern const StepperApi kArkStepApi;
 struct Counters {
   long steps = 0, attempts = 0, error_test_failures = 0, rhs_evaluations = 0;
   long newton_iterations = 0, newton_failures = 0, linear_setups = 0, jacobian_evaluations = 0;
+  // Krylov solvers: iterations, convergence failures, right-hand sides of J v difference
+  // quotients (not in rhs_evaluations).
+  long linear_iterations = 0, linear_failures = 0, linear_rhs_evaluations = 0;
 };
 
 // Advances the state over one contact interval [t, t + h] with adaptive internal steps.
@@ -115,6 +118,10 @@ class Driver {
   virtual void add_statistics(Statistics& /*stats*/) const {}
   // More about a failure than ARKODE's message (e.g. the linear solver's reason).
   virtual std::string failure_detail() const { return {}; }
+  // True: ARKODE steps past the interval end and advance() returns its interpolant there (no
+  // stop time; internal steps unlimited unless max_step is set; after a restart the first step
+  // is at most the interval). False: every interval ends with an internal step (stop time).
+  virtual bool interpolates() const { return false; }
   // A failure message: what failed, SUNDIALS' flag name and its last message.
   std::string failure(const char* call, int flag) const;
   const Counters& total() const { return total_; }

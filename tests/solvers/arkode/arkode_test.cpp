@@ -2,12 +2,16 @@
 
 #include <cmath>
 #include <iostream>
+#include <random>
+
+#include <Eigen/Dense>
 
 #include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/arkode/arkode_dirk.hpp>
 #include <jelly/solvers/arkode/arkode_erk.hpp>
+#include <jelly/solvers/arkode/detail/arkode_iterative.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
@@ -163,6 +167,96 @@ TEST(Arkode, KluAndSchurAgree) {
   EXPECT_NEAR(schur.stats.at("arkode_steps"), klu.stats.at("arkode_steps"),
               0.1 * schur.stats.at("arkode_steps"));
   EXPECT_GT(klu.stats.at("jacobian_evaluations"), 0);
+}
+
+// Every linear solver of arkode_dirk (the iterative ones included) solves the same Newton
+// systems: the same error and nearly the same steps as the direct Schur solve.
+TEST(Arkode, EveryLinearSolverAgreesWithSchur) {
+  const ArkodeRun schur = oscillator_run("arkode_dirk", 1e-7, "schur");
+  for (const std::string solver : {"cg", "gmres", "jacobi", "auto"}) {
+    const ArkodeRun run = oscillator_run("arkode_dirk", 1e-7, solver);
+    EXPECT_LT(run.error, 1e-6) << solver;
+    EXPECT_NEAR(run.stats.at("arkode_steps"), schur.stats.at("arkode_steps"),
+                0.1 * schur.stats.at("arkode_steps"))
+        << solver;
+  }
+  const ArkodeRun cg = oscillator_run("arkode_dirk", 1e-7, "cg");
+  EXPECT_GT(cg.stats.at("cg_iterations"), 0);
+  EXPECT_EQ(cg.stats.count("schur_factorizations"), 0u);
+  const ArkodeRun gmres = oscillator_run("arkode_dirk", 1e-7, "gmres");
+  EXPECT_GT(gmres.stats.at("krylov_iterations"), 0);
+  // "auto" is the matrix-free CG (docs/arkode.md).
+  const ArkodeRun automatic = oscillator_run("arkode_dirk", 1e-7, "auto");
+  EXPECT_EQ(automatic.stats.count("cg_iterations"), 1u);
+}
+
+// The matrix-free operator of the iterative solvers against dense matrices assembled by
+// SpringJacobian: S = M - g D - g^2 K, K p, the filtered operator of a seed contact and the
+// block-Jacobi solves.
+TEST(Arkode, SpringOperatorMatchesDenseMatrices) {
+  using Dense = Eigen::MatrixXd;
+  CubeSpec spec = testing::small_cube(3);
+  spec.particle_mass = 1.5;
+  const Model model = build_cube(spec);
+  State s = rest_state(model);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  for (Eigen::Index i = 0; i < s.x.size(); ++i) {
+    s.x[i] += 0.05 * u(rng);
+    s.v[i] = u(rng);
+  }
+  const int n = model.num_dofs();
+  SpringJacobian jacobian(model);
+  SparseMatrix ks = jacobian.make_matrix(), ds = jacobian.make_matrix();
+  jacobian.assemble(model, s.x, s.v, JacobianOptions{}, ks, ds);
+  const Dense k(ks), d(ds);
+  const Real g = 0.01;
+  Dense m = Dense::Zero(n, n);
+  for (int i = 0; i < n; ++i) m(i, i) = model.mass[i / 3];
+  const Dense full = m - g * d - g * g * k;
+
+  arkode::SpringOperator op;
+  op.linearize(model, s.x, s.v);
+  op.set_gamma(model, g);
+  VecX p(n), out;
+  for (int i = 0; i < n; ++i) p[i] = u(rng);
+  op.multiply_s(model, p, out);
+  EXPECT_LT((out - full * p).norm(), 1e-12 * (full * p).norm());
+  op.multiply_k(model, p.data(), out);
+  EXPECT_LT((out - k * p).norm(), 1e-12 * (k * p).norm());
+
+  // Block Jacobi: each particle's 6x6 block of I - g J solved exactly.
+  VecX r(2 * n), z(2 * n);
+  for (int i = 0; i < 2 * n; ++i) r[i] = u(rng);
+  op.block_jacobi(model, r.data(), z.data());
+  for (int i = 0; i < model.num_particles(); ++i) {
+    Dense block = Dense::Identity(6, 6);
+    block.block(0, 3, 3, 3) = -g * Dense::Identity(3, 3);
+    block.block(3, 0, 3, 3) = -g * k.block(3 * i, 3 * i, 3, 3) / model.mass[i];
+    block.block(3, 3, 3, 3) -= g * d.block(3 * i, 3 * i, 3, 3) / model.mass[i];
+    Eigen::VectorXd ri(6), zi(6);
+    ri << r.segment<3>(3 * i), r.segment<3>(n + 3 * i);
+    zi << z.segment<3>(3 * i), z.segment<3>(n + 3 * i);
+    EXPECT_LT((block * zi - ri).norm(), 1e-12 * ri.norm()) << "particle " << i;
+  }
+
+  // A seed contact on particle 4 with normal nn and friction damping c: (P (S + G) P + I - P).
+  const Vec3 nn = Vec3(1, 2, 2) / 3;
+  const Real c = 20;
+  op.set_constraints({{4, nn, c}});
+  op.set_gamma(model, g);
+  Dense filter = Dense::Identity(n, n), friction = Dense::Zero(n, n);
+  filter.block(12, 12, 3, 3) -= nn * nn.transpose();
+  friction.block(12, 12, 3, 3) = g * c * (Eigen::Matrix3d::Identity() - nn * nn.transpose());
+  const Dense filtered = filter * (full + friction) * filter + (Dense::Identity(n, n) - filter);
+  op.multiply_filtered(model, p, out);
+  EXPECT_LT((out - filtered * p).norm(), 1e-12 * (filtered * p).norm());
+  // Its preconditioner inverts the filtered operator's diagonal blocks.
+  op.precondition(p, out);
+  for (int i = 0; i < model.num_particles(); ++i) {
+    const Eigen::Vector3d back = filtered.block(3 * i, 3 * i, 3, 3) * out.segment<3>(3 * i);
+    EXPECT_LT((back - p.segment<3>(3 * i)).norm(), 1e-12 * p.segment<3>(3 * i).norm());
+  }
 }
 
 void expect_input_error(const std::string& name, const ArkodeOptions& o, const std::string& field) {
