@@ -129,6 +129,13 @@ int main(int argc, char** argv) {
   seed_cmd->add_option("--n", seed.n, "particles per cube edge")->capture_default_str();
   seed_cmd->add_option("--horizon", seed.horizon, "simulated time per run (s)")
       ->capture_default_str();
+  std::vector<std::string> seed_contacts{"seed_framework", "seed"};
+  seed_cmd
+      ->add_option("--contact", seed_contacts,
+                   "placements of the report's contact rules: seed_framework (in every force "
+                   "evaluation, as the course framework), seed (after each step)")
+      ->delimiter(',')
+      ->capture_default_str();
 
   BudgetOptions budget;
   CLI::App* budget_cmd =
@@ -266,6 +273,9 @@ int main(int argc, char** argv) {
         if (given(seed_cmd, "--horizon") == 0) seed.horizon = 0.5;
       }
       seed.integrators = common.integrators;
+      seed.contacts.clear();
+      for (const std::string& c : seed_contacts)
+        seed.contacts.push_back(contact_model_from_name(c, "--contact"));
       seed.shard = shard;
       seed.progress = &std::cerr;
       tables = {run_seed(seed)};

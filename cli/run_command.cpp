@@ -12,6 +12,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/io/run_limits.hpp>
 #include <jelly/io/scene.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 
 #include "commands.hpp"
 #include "exit_codes.hpp"
@@ -125,6 +126,9 @@ int run_command(const RunArgs& args) {
   Simulator sim = make_simulator(scene);
   if (args.threads >= 0) sim.set_threads(args.threads);
   if (checkpoint) restore_from(sim, *checkpoint, args.restart);
+  for (const std::string& warning : seed_step_warnings(sim.model(), sim.state(), sim.terrains(),
+                                                       sim.options().dt, scene.duration))
+    std::fprintf(stderr, "warning: %s\n", warning.c_str());
 
   std::unique_ptr<Observer> recorder;
   struct stat output_info {};

@@ -19,11 +19,12 @@ void Dynamics::forces(Real t, const VecX& x, const VecX& v, VecX& f) const {
   contacts_->add_forces(v, f);
 }
 
-void Dynamics::acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const {
-  forces(t, x, v, a);
-  const Real* m = model_->mass.data();
+namespace {
+// a = M^-1 f in place, then the pinned particles' path accelerations.
+void finish_acceleration(const Model& model, int threads, Real t, VecX& a) {
+  const Real* m = model.mass.data();
   Real* pa = a.data();
-  parallel::for_ranges(threads_, model_->num_particles(), [&](long begin, long end) {
+  parallel::for_ranges(threads, model.num_particles(), [&](long begin, long end) {
     for (long i = begin; i < end; ++i) {
       const Real inv = 1.0 / m[i];
       pa[3 * i] *= inv;
@@ -31,7 +32,19 @@ void Dynamics::acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const
       pa[3 * i + 2] *= inv;
     }
   });
-  if (!model_->pins.empty()) model_->pins.apply_acceleration(t, a);
+  if (!model.pins.empty()) model.pins.apply_acceleration(t, a);
+}
+}  // namespace
+
+void Dynamics::acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const {
+  forces(t, x, v, a);
+  finish_acceleration(*model_, threads_, t, a);
+}
+
+void Dynamics::stage_acceleration(Real t, const VecX& x, VecX& v, VecX& a) const {
+  forces(t, x, v, a);
+  if (in_evaluation_contact_) ContactSolver::apply_in_evaluation(*model_, *terrains_, t, x, v, a);
+  finish_acceleration(*model_, threads_, t, a);
 }
 
 }  // namespace jelly

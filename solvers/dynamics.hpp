@@ -2,7 +2,8 @@
 // The right-hand side every integrator sees: the model's forces (gravity, springs, dampers,
 // external forces at time t) plus the contact forces active during the current step and the
 // anchor springs (external pulls), and the accelerations M^-1 f, with pinned particles following
-// their paths.
+// their paths. With a seed_framework terrain, an evaluation also runs the course framework's
+// collision handler on its own state (stage_acceleration()).
 #include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
@@ -25,13 +26,25 @@ class Dynamics {
         terrains_(terrains),
         bands_(bands),
         anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr),
-        threads_(threads > 1 ? threads : 1) {}
+        threads_(threads > 1 ? threads : 1),
+        in_evaluation_contact_(terrains != nullptr &&
+                               ContactSolver::has_in_evaluation_contact(*terrains)) {}
 
   // f(t, x, v): size 3N, no allocation. Pinned particles get the forces as if free (an
   // implicit method constrains them itself).
   void forces(Real t, const VecX& x, const VecX& v, VecX& f) const;
   // a = M^-1 f(t, x, v), except that pinned particles get their path's acceleration.
   void acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const;
+  // The evaluation of an explicit method's stage at time t (docs/contact.md, seed_framework):
+  // a as acceleration(t, x, v, a), with the seed_framework terrains' collision handler run on
+  // (x, v, f) before the division by the masses; it reflects v in place. The integrator uses
+  // that reflected v as the stage's dx/dt, and the first stage's evaluation changes the step's
+  // own velocity, as in the framework. Without seed_framework terrains the same as
+  // acceleration(t, x, v, a), v unchanged.
+  void stage_acceleration(Real t, const VecX& x, VecX& v, VecX& a) const;
+  // True when a terrain uses seed_framework: the integrator must evaluate through
+  // stage_acceleration() (Integrator::supports_in_evaluation_contact()).
+  bool has_in_evaluation_contact() const { return in_evaluation_contact_; }
 
   const Model& model() const { return *model_; }
   const ContactSolver& contacts() const { return *contacts_; }
@@ -50,6 +63,7 @@ class Dynamics {
   const SpringBands* bands_;
   const AnchorSprings* anchors_;
   int threads_;
+  bool in_evaluation_contact_;
   mutable long evaluations_ = 0;
 };
 

@@ -40,6 +40,11 @@ Simulator& Simulator::operator=(Simulator&&) noexcept = default;
 
 void Simulator::add_terrain(std::unique_ptr<Terrain> terrain) {
   require(terrain != nullptr, "terrain", "null", "a terrain");
+  if (terrain->contact().model == ContactModel::kSeedFramework &&
+      !integrator_->supports_in_evaluation_contact()) {
+    throw InputError("terrains[" + std::to_string(terrains_.size()) + "].contact.model",
+                     "\"seed_framework\"", in_evaluation_contact_requirement(integrator_->name()));
+  }
   terrains_.push_back(std::move(terrain));
 }
 

@@ -60,6 +60,7 @@ class Simulator {
   Simulator(Simulator&&) noexcept;
   Simulator& operator=(Simulator&&) noexcept;
 
+  // Throws InputError for a seed_framework terrain when the integrator does not support it.
   void add_terrain(std::unique_ptr<Terrain> terrain);
   // Contact between bodies and within a body (default: between bodies, when there are two or
   // more). Throws InputError for invalid parameters.

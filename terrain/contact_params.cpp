@@ -12,6 +12,9 @@ const std::vector<EnumName<ContactModel>>& contact_models() {
        "projection, restitution above a resting speed, Coulomb friction (default)"},
       {ContactModel::kSeed, "seed",
        "the seed report's rules: reflection within epsilon, friction -mu N v_t"},
+      {ContactModel::kSeedFramework, "seed_framework",
+       "the seed rules inside every force evaluation, as the course framework (explicit "
+       "integrators)"},
   };
   return table;
 }

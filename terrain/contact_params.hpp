@@ -16,13 +16,22 @@ enum class ContactModel {
   kCoulomb,
   // The seed report's rules (sections 1.2 and 1.3): velocity reflection within epsilon, a contact
   // force cancelling the inward force, and friction -mu N v_t proportional to the speed.
+  // Reflection once after each step, the forces during the next one (any integrator).
   kSeed,
+  // The same rules where the course framework applied them: inside every force evaluation, on
+  // that evaluation's own state (each stage of a multi-stage method reflects its own velocity).
+  // The explicit integrators only (docs/contact.md).
+  kSeedFramework,
 };
 // Every contact model with its name and description.
 const std::vector<EnumName<ContactModel>>& contact_models();
 std::string_view contact_model_name(ContactModel model);
 // Throws InputError naming `field` for an unknown name.
 ContactModel contact_model_from_name(std::string_view name, std::string_view field);
+// The seed rules (either placement): reflection within epsilon, no projection.
+inline bool is_seed_model(ContactModel model) {
+  return model == ContactModel::kSeed || model == ContactModel::kSeedFramework;
+}
 
 struct ContactParams {
   ContactModel model = ContactModel::kCoulomb;

@@ -1,6 +1,9 @@
 #include <jelly/solvers/contact/contact_solver.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 
 #include <jelly/core/detail/parallel.hpp>
 
@@ -45,15 +48,23 @@ bool resolve_coulomb(const Terrain& terrain, const ContactParams& c, Real t, Rea
   return true;
 }
 
-// Seed model (report 1.2 / 1.3): within epsilon and approaching, the normal velocity u1 becomes
+// Seed rules' collision test (report 1.2 / 1.3): within epsilon of the surface and moving
+// towards it (relative velocity). Gives the surface's normal and velocity.
+bool seed_touches(const Terrain& terrain, const ContactParams& c, Real t, const Vec3& x,
+                  const Vec3& v, Vec3& n, Vec3& u) {
+  if (terrain.signed_distance(x, t) >= c.epsilon || !terrain.can_contact(x, t)) return false;
+  n = terrain.normal(x, t);
+  u = terrain.surface_velocity(x, t);
+  return (v - u).dot(n) < 0;
+}
+
+// Seed model: within epsilon and approaching, the normal velocity u1 becomes
 // (m1 u1 + m2 u2 + m2 e (u2 - u1)) / (m1 + m2), u2 the surface's; a fixed plane (m2 infinite)
 // gives u2 + e (u2 - u1) = -e u1. The tangential velocity is kept.
 bool resolve_seed(const Terrain& terrain, const ContactParams& c, Real m1, Real t,
                   Eigen::Ref<const Vec3> x, Eigen::Ref<Vec3> v, Vec3& normal) {
-  if (terrain.signed_distance(x, t) >= c.epsilon || !terrain.can_contact(x, t)) return false;
-  const Vec3 n = terrain.normal(x, t);
-  const Vec3 u = terrain.surface_velocity(x, t);
-  if ((v - u).dot(n) >= 0) return false;
+  Vec3 n, u;
+  if (!seed_touches(terrain, c, t, x, v, n, u)) return false;
   const Real u1 = v.dot(n);
   const Real u2 = u.dot(n);
   const Real m2 = terrain.mass();
@@ -93,7 +104,12 @@ void ContactSolver::resolve(const Model& model, const Terrains& terrains, const 
       for (int i = static_cast<int>(r.begin); i < static_cast<int>(r.end); ++i) {
         auto x = particle(state.x, i);
         auto v = particle(state.v, i);
-        if (c.model == ContactModel::kCoulomb) {
+        if (c.model == ContactModel::kSeedFramework) {
+          // Nothing after the step: the next step's first force evaluation handles the
+          // particles counted here (within epsilon and approaching).
+          Vec3 n, u;
+          count += seed_touches(*terrain, c, state.t, x, v, n, u);
+        } else if (c.model == ContactModel::kCoulomb) {
           count += resolve_coulomb(*terrain, c, state.t, h, particle(before.x, i),
                                    particle(before.v, i), x, v);
         } else {
@@ -125,6 +141,31 @@ void ContactSolver::add_forces(const VecX& v, VecX& f) const {
   }
 }
 
+void ContactSolver::apply_in_evaluation(const Model& model, const Terrains& terrains, Real t,
+                                        const VecX& x, VecX& v, VecX& f) {
+  for (const auto& terrain : terrains) {
+    const ContactParams& c = terrain->contact();
+    if (c.model != ContactModel::kSeedFramework) continue;
+    for (int i = 0; i < model.num_particles(); ++i) {
+      auto vi = particle(v, i);
+      Vec3 n;
+      if (!resolve_seed(*terrain, c, model.mass[i], t, particle(x, i), vi, n)) continue;
+      auto fi = particle(f, i);
+      const Real fn = fi.dot(n);
+      if (fn >= 0) continue;
+      // The tangential velocity is the one before the reflection (which keeps it).
+      const Vec3 vt = vi - vi.dot(n) * n;
+      fi += -fn * n + c.friction * fn * vt;
+    }
+  }
+}
+
+bool ContactSolver::has_in_evaluation_contact(const Terrains& terrains) {
+  for (const auto& terrain : terrains)
+    if (terrain->contact().model == ContactModel::kSeedFramework) return true;
+  return false;
+}
+
 void ContactSolver::clear() {
   seed_contacts_.clear();
   contact_count_ = 0;
@@ -133,6 +174,56 @@ void ContactSolver::clear() {
 void ContactSolver::restore(std::vector<SeedContact> seed_contacts, int contact_count) {
   seed_contacts_ = std::move(seed_contacts);
   contact_count_ = contact_count;
+}
+
+std::vector<std::string> seed_step_warnings(const Model& model, const State& state,
+                                            const Terrains& terrains, Real dt, Real t_end) {
+  std::vector<std::string> out;
+  for (size_t k = 0; k < terrains.size(); ++k) {
+    const Terrain& terrain = *terrains[k];
+    const ContactParams& c = terrain.contact();
+    if (!is_seed_model(c.model) || model.num_particles() == 0) continue;
+    // The lowest particle and the fastest approach (relative to the surface, along its normal).
+    Real lowest = std::numeric_limits<Real>::infinity();
+    Vec3 n = Vec3::UnitY();
+    Real approach = 0;
+    for (int i = 0; i < model.num_particles(); ++i) {
+      const Vec3 x = particle(state.x, i);
+      const Vec3 ni = terrain.normal(x, state.t);
+      const Real d = terrain.signed_distance(x, state.t);
+      if (d < lowest) {
+        lowest = d;
+        n = ni;
+      }
+      approach = std::max(approach,
+                          -(particle(state.v, i) - terrain.surface_velocity(x, state.t)).dot(ni));
+    }
+    const Real g = std::max<Real>(0, -model.gravity.dot(n));
+    Real speed = std::sqrt(approach * approach + 2 * g * std::max<Real>(lowest, 0));
+    // The surface's own approach (a rising elevator), sampled every millisecond.
+    const Vec3 at = terrain.position(state.t);
+    Real surface = 0;
+    const long samples = std::min<long>(1000000, static_cast<long>((t_end - state.t) / 1e-3) + 1);
+    for (long s = 0; s < samples; ++s) {
+      const Real t = state.t + static_cast<Real>(s) * 1e-3;
+      surface = std::max(surface, terrain.surface_velocity(at, t).dot(n));
+    }
+    speed += surface;
+    if (!(speed * dt > 2 * c.epsilon)) continue;
+    char text[640];
+    std::snprintf(text, sizeof text,
+                  "terrains[%zu]: the %s contact rules act within epsilon = %g m of the surface, "
+                  "but at dt = %g s a particle arriving at up to %.3g m/s moves %.3g m per step: "
+                  "it can cross that zone within one step and end about %.3g m below the surface "
+                  "before they act. They were made for small steps (the report's dt = 0.001 s); "
+                  "for large steps use the coulomb contact model "
+                  "(terrains[%zu].contact.model = \"coulomb\"), which implicit_euler resolves "
+                  "inside its solve",
+                  k, std::string(contact_model_name(c.model)).c_str(), c.epsilon, dt, speed,
+                  speed * dt, speed * dt - c.epsilon, k);
+    out.emplace_back(text);
+  }
+  return out;
 }
 
 }  // namespace jelly

@@ -6,7 +6,10 @@
 //     implicit integrator may resolve the coulomb terrains inside its solve instead);
 //  2. during the next step, every force evaluation calls add_forces(), which applies the seed
 //     model's contact and friction forces to the particles that collided in step 1.
+// The seed_framework model instead acts inside every force evaluation (apply_in_evaluation(),
+// which the explicit integrators call through Dynamics::stage_acceleration()).
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <jelly/core/model.hpp>
@@ -42,7 +45,19 @@ class ContactSolver {
   // into the surface, cancels the inward normal force N and adds the friction -mu N v_t.
   void add_forces(const VecX& v, VecX& f) const;
 
-  // Particle-terrain contacts found by the last resolve().
+  // seed_framework, the course framework's collision handler inside a force evaluation at time t
+  // on that evaluation's own state (x, v) with its forces f (gravity, springs, dampers): for each
+  // particle within epsilon of a seed_framework terrain and moving towards it, v is reflected in
+  // place (as resolve() does for seed) and, if f then pushes it into the surface, the contact
+  // force -(f.n) n and the friction -mu N v_t (N = -(f.n)) are added to f. Terrains in order,
+  // each seeing the forces the ones before added.
+  static void apply_in_evaluation(const Model& model, const Terrains& terrains, Real t,
+                                  const VecX& x, VecX& v, VecX& f);
+  // True when a terrain uses seed_framework.
+  static bool has_in_evaluation_contact(const Terrains& terrains);
+
+  // Particle-terrain contacts found by the last resolve() (seed_framework: the particles within
+  // epsilon and approaching, which the next step's first evaluation will reflect).
   int contact_count() const { return contact_count_; }
   // Forget the seed contacts (after a restart or a state set from outside).
   void clear();
@@ -58,5 +73,16 @@ class ContactSolver {
   std::vector<std::vector<SeedContact>> part_seed_;
   std::vector<int> part_count_;
 };
+
+// The seed rules (seed, seed_framework) act only within epsilon of a surface and never project:
+// a particle that moves more than epsilon per step can cross that zone within one step and end
+// below the surface before they act (0.23 m into the seed slope at dt = 1/60 s). For each such
+// terrain where this can go deeper than the zone itself (fastest arrival speed x dt > 2 epsilon),
+// one sentence naming the terrain, the speeds and the coulomb model for large steps. The arrival
+// speed is estimated from the state: the fastest approach now, plus the free fall (gravity
+// along the normal) of the lowest particle onto the surface, plus the terrain's own largest
+// approach speed over [state.t, t_end] (sampled every millisecond).
+std::vector<std::string> seed_step_warnings(const Model& model, const State& state,
+                                            const Terrains& terrains, Real dt, Real t_end);
 
 }  // namespace jelly

@@ -11,6 +11,9 @@ StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
   const Eigen::Index n = dynamics.model().num_dofs();
   require(state.x.size() == n && state.v.size() == n, "state.size", state.x.size(),
           "3 x the number of particles (" + std::to_string(n) + ")");
+  if (dynamics.has_in_evaluation_contact() && !supports_in_evaluation_contact())
+    throw InputError("terrains.contact.model", "\"seed_framework\"",
+                     in_evaluation_contact_requirement(name()));
   StepResult result = do_step(dynamics, state, h);
   if (!result.ok) return result;
   // Pinned particles end the step exactly on their paths, whatever the method did with them.
@@ -18,6 +21,13 @@ StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
   if (!pins.empty()) pins.apply(state.t, state.x, state.v);
   ++steps_;
   return result;
+}
+
+std::string in_evaluation_contact_requirement(std::string_view integrator) {
+  return "a contact model other than seed_framework with integrator " + std::string(integrator) +
+         ": seed_framework acts inside every force evaluation, which only the explicit "
+         "integrators (explicit_euler, midpoint, rk4, symplectic_euler) support; use \"seed\" "
+         "(the same rules once per step)";
 }
 
 void Integrator::restore_internal_state(const std::vector<Real>& /*data*/) {}

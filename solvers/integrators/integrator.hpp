@@ -27,7 +27,8 @@ class Integrator {
   virtual ~Integrator() = default;
 
   // Advances state (t, x, v) by h under `dynamics`. Throws InputError unless h is finite and
-  // > 0 and the state's sizes match the model.
+  // > 0 and the state's sizes match the model, or when `dynamics` has seed_framework terrains
+  // and the method does not support them.
   StepResult step(const Dynamics& dynamics, State& state, Real h);
 
   virtual std::string_view name() const = 0;
@@ -36,6 +37,11 @@ class Integrator {
   // True when the method chooses its own internal steps within each step(h) (error control):
   // the h-convergence of fixed-step methods does not apply to it.
   virtual bool is_adaptive() const { return false; }
+  // True when every force evaluation of do_step() goes through Dynamics::stage_acceleration(),
+  // so that seed_framework terrains act inside it (the explicit methods). The others reject
+  // such terrains: a velocity reflection inside an implicit solve's or ARKODE's right-hand side
+  // is not a function of the state they iterate on (docs/contact.md).
+  virtual bool supports_in_evaluation_contact() const { return false; }
   // True when do_step() already applied the contact of the coulomb terrains (inside its solve);
   // the Simulator then applies only the seed model's contact after the step.
   virtual bool resolves_contact() const { return false; }
@@ -66,6 +72,9 @@ class Integrator {
 void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,
                                 const Model& model, const Terrains& terrains, const State& before,
                                 State& state, Real h, int threads = 1);
+
+// What InputError says is allowed when `integrator` meets a seed_framework terrain.
+std::string in_evaluation_contact_requirement(std::string_view integrator);
 
 // Resizes v to n entries only when its size differs (no allocation in steady state).
 inline void ensure_size(VecX& v, Eigen::Index n) {

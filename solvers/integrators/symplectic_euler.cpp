@@ -4,7 +4,7 @@ namespace jelly {
 
 StepResult SymplecticEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
   ensure_size(a_, s.x.size());
-  dynamics.acceleration(s.t, s.x, s.v, a_);
+  dynamics.stage_acceleration(s.t, s.x, s.v, a_);
   s.v += h * a_;
   s.x += h * s.v;
   s.t += h;

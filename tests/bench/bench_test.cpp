@@ -301,7 +301,7 @@ TEST(SeedTable, ClaimsHaveVerdictsForEveryScene) {
   o.horizon = 0.05;
   const Table seed = run_seed(o);
   const Table claims = seed_claims(seed);
-  ASSERT_EQ(claims.rows(), 6);
+  ASSERT_EQ(claims.rows(), 12);  // 3 claims x 2 scenes x 2 placements of the contact rules
   for (int r = 0; r < claims.rows(); ++r) {
     const std::string& v = claims.text(r, "verdict");
     EXPECT_TRUE(v == "confirmed" || v == "refuted") << v;

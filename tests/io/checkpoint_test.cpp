@@ -56,7 +56,8 @@ constexpr Real kEnd = 1.0;
 
 class Restart : public ::testing::TestWithParam<ContactModel> {};
 INSTANTIATE_TEST_SUITE_P(Contact, Restart,
-                         ::testing::Values(ContactModel::kCoulomb, ContactModel::kSeed),
+                         ::testing::Values(ContactModel::kCoulomb, ContactModel::kSeed,
+                                           ContactModel::kSeedFramework),
                          [](const auto& p) { return std::string(contact_model_name(p.param)); });
 
 // A run stopped half way (its recorder writes the final checkpoint) and continued from the file
