@@ -59,18 +59,107 @@ void Simulator::set_threads(int threads) {
   options_.threads = threads;
 }
 
-void Simulator::add_observer(Observer& observer) { observers_.push_back(&observer); }
+
+Observer::~Observer() {
+  // forget() edits lists_ of this observer too: iterate over a copy.
+  const std::vector<ObserverList*> lists = lists_;
+  for (ObserverList* list : lists) list->forget(this);
+}
+
+ObserverList::ObserverList(ObserverList&& other) noexcept
+    : observers_(std::move(other.observers_)), owned_(std::move(other.owned_)) {
+  other.observers_.clear();
+  other.owned_.clear();
+  relink(&other);
+}
+
+ObserverList& ObserverList::operator=(ObserverList&& other) noexcept {
+  if (this == &other) return *this;
+  clear();
+  observers_ = std::move(other.observers_);
+  owned_ = std::move(other.owned_);
+  other.observers_.clear();
+  other.owned_.clear();
+  relink(&other);
+  return *this;
+}
+
+ObserverList::~ObserverList() { clear(); }
+
+void ObserverList::relink(ObserverList* from) {
+  for (Observer* o : observers_) {
+    if (o == nullptr) continue;
+    std::replace(o->lists_.begin(), o->lists_.end(), from, this);
+  }
+}
+
+void ObserverList::clear() {
+  for (Observer* o : observers_) {
+    if (o == nullptr) continue;
+    o->lists_.erase(std::remove(o->lists_.begin(), o->lists_.end(), this), o->lists_.end());
+  }
+  observers_.clear();
+  // Owned observers are released last: their destructors no longer find this list.
+  owned_.clear();
+}
+
+void ObserverList::add(Observer& observer) {
+  if (std::find(observers_.begin(), observers_.end(), &observer) != observers_.end()) return;
+  observers_.push_back(&observer);
+  observer.lists_.push_back(this);
+}
+
+void ObserverList::add(std::shared_ptr<Observer> observer) {
+  add(*observer);
+  if (std::find(owned_.begin(), owned_.end(), observer) == owned_.end())
+    owned_.push_back(std::move(observer));
+}
+
+bool ObserverList::remove(const Observer& observer) {
+  const auto at = std::find(observers_.begin(), observers_.end(), &observer);
+  if (at == observers_.end()) return false;
+  Observer* o = *at;
+  if (iterating_ > 0)
+    *at = nullptr;
+  else
+    observers_.erase(at);
+  o->lists_.erase(std::remove(o->lists_.begin(), o->lists_.end(), this), o->lists_.end());
+  // Released last (this may destroy the observer, whose destructor then finds no list).
+  const auto owned = std::find_if(owned_.begin(), owned_.end(),
+                                  [&](const std::shared_ptr<Observer>& p) { return p.get() == o; });
+  if (owned != owned_.end()) {
+    std::shared_ptr<Observer> keep = std::move(*owned);
+    owned_.erase(owned);
+  }
+  return true;
+}
+
+std::size_t ObserverList::size() const {
+  return static_cast<std::size_t>(std::count_if(observers_.begin(), observers_.end(),
+                                                [](Observer* o) { return o != nullptr; }));
+}
+
+void ObserverList::forget(const Observer* observer) {
+  const auto at = std::find(observers_.begin(), observers_.end(), observer);
+  if (at == observers_.end()) return;
+  if (iterating_ > 0)
+    *at = nullptr;
+  else
+    observers_.erase(at);
+}
+
+void Simulator::add_observer(Observer& observer) { observers_.add(observer); }
+
+void Simulator::add_observer(std::shared_ptr<Observer> observer) {
+  require(observer != nullptr, "observer", "null", "an observer");
+  observers_.add(std::move(observer));
+}
+
+bool Simulator::remove_observer(const Observer& observer) { return observers_.remove(observer); }
 
 void Simulator::set_anchors(AnchorSprings anchors) {
   validate_anchors(anchors, model_.num_particles());
   anchors_ = std::move(anchors);
-}
-
-bool Simulator::remove_observer(const Observer& observer) {
-  const auto end = std::remove(observers_.begin(), observers_.end(), &observer);
-  const bool found = end != observers_.end();
-  observers_.erase(end, observers_.end());
-  return found;
 }
 
 namespace {
@@ -134,7 +223,7 @@ StepResult Simulator::step() {
 }
 
 void Simulator::emit_frame() {
-  for (Observer* o : observers_) o->on_frame(*this);
+  observers_.for_each([this](Observer& o) { o.on_frame(*this); });
   ++frames_;
   if (options_.output_interval > 0) {
     while (next_output_ <= state_.t + 1e-9 * options_.dt) next_output_ += options_.output_interval;
@@ -182,7 +271,7 @@ RunReport Simulator::run_until(Real t_end) {
   }
   report.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (Observer* o : observers_) o->on_finish(*this, report);
+  observers_.for_each([this, &report](Observer& o) { o.on_finish(*this, report); });
   return report;
 }
 

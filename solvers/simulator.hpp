@@ -2,6 +2,8 @@
 // Steps a model among terrains with an integrator: contact after every step (or inside it, for
 // an integrator that resolves contact itself), observers at a chosen output interval, and a
 // divergence guard that stops the run with a report.
+#include <algorithm>
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -17,14 +19,76 @@ namespace jelly {
 
 class Simulator;
 class SpringBands;
+class ObserverList;
 
 // Called with the simulator at the first output time and then every output interval.
+// An observer knows the simulators it was added to and leaves them when it is destroyed, so a
+// simulator never calls a destroyed observer (and a destroyed simulator is forgotten by its
+// observers). Observers and their simulators are used from one thread.
 class Observer {
  public:
-  virtual ~Observer() = default;
+  Observer() = default;
+  // A copy is a new observer: it observes nothing until it is added itself.
+  Observer(const Observer& /*other*/) noexcept {}
+  Observer& operator=(const Observer& /*other*/) noexcept { return *this; }
+  // Removes this observer from every simulator it was added to.
+  virtual ~Observer();
+
   virtual void on_frame(const Simulator& simulator) = 0;
   virtual void on_finish(const Simulator& /*simulator*/, const RunReport& /*report*/) {}
+
+ private:
+  friend class ObserverList;
+  std::vector<ObserverList*> lists_;  // the simulators' lists that hold this observer
 };
+
+// The observers of a simulator (used by Simulator; not for direct use): links that both sides
+// undo on destruction. Observers removed or destroyed during a callback are skipped, never
+// called after their removal.
+class ObserverList {
+ public:
+  ObserverList() = default;
+  ObserverList(ObserverList&& other) noexcept;
+  ObserverList& operator=(ObserverList&& other) noexcept;
+  ObserverList(const ObserverList&) = delete;
+  ObserverList& operator=(const ObserverList&) = delete;
+  ~ObserverList();
+
+  // Adding an observer that is already in the list does nothing.
+  void add(Observer& observer);
+  void add(std::shared_ptr<Observer> observer);  // shared ownership: kept alive while added
+  // False when the observer was not in the list.
+  bool remove(const Observer& observer);
+  std::size_t size() const;
+  // Calls f(observer) for each observer, in the order they were added.
+  template <typename F>
+  void for_each(F f);
+
+ private:
+  friend class Observer;
+  void forget(const Observer* observer);  // the observer is being destroyed
+  void relink(ObserverList* from);        // after a move: the observers now point here
+  void clear();
+  std::vector<Observer*> observers_;  // null: removed while iterating
+  std::vector<std::shared_ptr<Observer>> owned_;
+  int iterating_ = 0;
+};
+
+template <typename F>
+void ObserverList::for_each(F f) {
+  ++iterating_;
+  try {
+    // Index-based: observers added during a callback are called in the same pass.
+    for (std::size_t i = 0; i < observers_.size(); ++i)
+      if (observers_[i] != nullptr) f(*observers_[i]);
+  } catch (...) {
+    --iterating_;
+    throw;
+  }
+  if (--iterating_ == 0) {
+    observers_.erase(std::remove(observers_.begin(), observers_.end(), nullptr), observers_.end());
+  }
+}
 
 struct SimulatorOptions {
   Real dt = 0.001;           // s, > 0
@@ -68,10 +132,16 @@ class Simulator {
   // Throws InputError naming both bodies when two bodies (or, with self-contact, two parts of
   // one body) overlap in the current state.
   void check_no_overlap();
-  // The observer must outlive the runs it observes.
+  // Calls `observer` at every frame of the following runs until it is removed or destroyed (it
+  // then leaves the simulator by itself). Adding it twice adds it once.
   void add_observer(Observer& observer);
-  // Stops calling `observer`; false when it was not added.
+  // The same, and the simulator shares the observer's ownership: it stays alive while added
+  // (for observers nobody else keeps, e.g. a progress bar). Throws InputError for null.
+  void add_observer(std::shared_ptr<Observer> observer);
+  // Stops calling `observer` (and releases the simulator's share of it); false when it was not
+  // added. Allowed inside a callback: the observer is not called again.
   bool remove_observer(const Observer& observer);
+  std::size_t num_observers() const { return observers_.size(); }
 
   // One step of options().dt, then contact. Returns the integrator's failure, if any; does not
   // check divergence (run_until does).
@@ -122,7 +192,7 @@ class Simulator {
   ContactSolver contacts_;
   BodyContact body_contact_;
   State before_;  // the state at the start of the current step
-  std::vector<Observer*> observers_;
+  ObserverList observers_;
   AnchorSprings anchors_;
   long total_steps_ = 0;
   long force_evaluations_ = 0;

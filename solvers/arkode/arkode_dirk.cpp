@@ -223,7 +223,7 @@ class DirkDriver final : public arkode::Driver {
     const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
     data.x = yy.head(n);
     data.v = yy.tail(n);
-    self.preconditioner_.linearize(model, data.x, data.v);
+    self.preconditioner_.linearize(model, data.x, data.v, data.dynamics->anchors());
     *jcur = SUNTRUE;
     return 0;
   }

@@ -5,8 +5,8 @@
 
 #include <arkode/arkode_arkstep.h>
 
+#include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/forces.hpp>
-#include <jelly/core/jacobian.hpp>
 
 namespace jelly::arkode {
 
@@ -27,7 +27,8 @@ inline void pack(const Real* b, Real* out) {
 }
 }  // namespace
 
-void SpringOperator::linearize(const Model& model, const VecX& x, const VecX& v) {
+void SpringOperator::linearize(const Model& model, const VecX& x, const VecX& v,
+                               const AnchorSprings* anchors) {
   spring_jacobian_blocks(model, x, v, JacobianOptions{}, k_blocks_, d_blocks_);
   const Springs& s = model.springs;
   const size_t blocks = 9 * static_cast<size_t>(model.num_particles());
@@ -45,6 +46,16 @@ void SpringOperator::linearize(const Model& model, const VecX& x, const VecX& v)
       for (int e = 0; e < 9; ++e) {
         kp[e] += k[e];
         dp[e] += d[e];
+      }
+    }
+  }
+  anchors_.clear();
+  if (anchors) {
+    anchors_ = *anchors;
+    for (const AnchorSpring& a : anchors_) {
+      for (int c = 0; c < 3; ++c) {
+        k_diagonal_[9 * static_cast<size_t>(a.particle) + 4 * c] -= a.stiffness;
+        d_diagonal_[9 * static_cast<size_t>(a.particle) + 4 * c] -= a.damping;
       }
     }
   }
@@ -127,10 +138,15 @@ void spring_product(const Model& model, const Real* blocks, size_t stride, const
 
 void SpringOperator::multiply_s(const Model& model, const VecX& p, VecX& out) const {
   spring_product(model, s_.data(), 6, p.data(), true, out);
+  for (const AnchorSpring& a : anchors_)
+    out.segment<3>(3 * a.particle) +=
+        (gamma_ * a.damping + gamma_ * gamma_ * a.stiffness) * p.segment<3>(3 * a.particle);
 }
 
 void SpringOperator::multiply_k(const Model& model, const Real* p, VecX& out) const {
   spring_product(model, spring_.data(), 12, p, false, out);
+  for (const AnchorSpring& a : anchors_)
+    for (int c = 0; c < 3; ++c) out[3 * a.particle + c] -= a.stiffness * p[3 * a.particle + c];
 }
 
 void SpringOperator::filter(VecX& r) const {
@@ -237,7 +253,7 @@ int setup(SUNLinearSolver s, SUNMatrix /*unused*/) {
   const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
   c.x = yy.head(n);
   c.v = yy.tail(n);
-  c.op.linearize(model, c.x, c.v);
+  c.op.linearize(model, c.x, c.v, c.data->dynamics->anchors());
   // The seed contacts whose force pushes into the surface at this iterate (see SpringOperator).
   const auto& seed = c.data->dynamics->contacts().seed_contacts();
   if (!seed.empty()) {

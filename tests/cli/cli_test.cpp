@@ -78,7 +78,21 @@ TEST(Cli, ADivergentRunExitsThree) {
   const Result r = jelly("run " + kSmallSlope + " --integrator explicit_euler --dt 0.05 --quiet");
   EXPECT_EQ(r.code, 3) << r.out << r.err;
   EXPECT_THAT(r.out, StartsWith("jelly run: diverged at t = "));
-  EXPECT_THAT(r.err, StartsWith("error: the run stopped early: diverged at t = "));
+  // The seed contact at dt = 0.05 s is warned about first (docs/contact.md).
+  EXPECT_THAT(r.err, StartsWith("warning: terrains[0]: the seed contact rules act within"));
+  EXPECT_THAT(r.err, HasSubstr("\nerror: the run stopped early: diverged at t = "));
+}
+
+// A seed-model terrain at a step that crosses its epsilon zone is warned about at the start,
+// naming the coulomb model; at the report's dt = 1 ms it is not.
+TEST(Cli, SeedContactAtLargeStepsWarns) {
+  Result r = jelly("run '" + scene("seed_slope.json") + "' --dt 0.0166667 --duration 0.02 --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.err, StartsWith("warning: terrains[0]: the seed contact rules act within epsilon"));
+  EXPECT_THAT(r.err, HasSubstr("terrains[0].contact.model = \"coulomb\""));
+  r = jelly("run '" + scene("seed_slope.json") + "' --duration 0.02 --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
 }
 
 TEST(Cli, BadScenesExitTwoNamingTheJsonPath) {

@@ -241,7 +241,8 @@ TEST(BadScenes, OutOfRangeValuesSayWhatIsAllowed) {
             "terrains[2].contact.static_friction = 0.10000000000000001 is invalid: a finite "
             "number >= friction (0.5)");
   EXPECT_EQ(error_of(kGood, {"terrains[0].contact.model=ice"}),
-            "terrains[0].contact.model = \"ice\" is invalid: one of \"coulomb\", \"seed\"");
+            "terrains[0].contact.model = \"ice\" is invalid: one of \"coulomb\", \"seed\", "
+            "\"seed_framework\"");
   EXPECT_EQ(error_of(kGood, {"cube.n=1"}), "cube.n = 1 is invalid: an integer in [2, 400]");
   EXPECT_EQ(error_of(kGood, {"springs.shear.kd=-1"}),
             "springs.shear.kd = -1 is invalid: a finite damping >= 0");

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <memory>
+#include <string>
+#include <vector>
+
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
@@ -145,6 +149,169 @@ TEST(Simulator, StableRunIsNotFlagged) {
   s.v[1] = 1.0;
   Simulator sim = testing::make_sim(m, s, "rk4", 0.001);
   EXPECT_TRUE(sim.run_until(1.0).ok());
+}
+
+}  // namespace
+}  // namespace jelly
+
+namespace jelly {
+namespace {
+
+// Counts its frames and finishes; `log` (optional) records its name per frame.
+struct Counter final : Observer {
+  explicit Counter(std::string name = "", std::vector<std::string>* log = nullptr)
+      : name(std::move(name)), log(log) {}
+  void on_frame(const Simulator& /*sim*/) override {
+    ++frames;
+    if (log) log->push_back(name);
+  }
+  void on_finish(const Simulator& /*sim*/, const RunReport& /*report*/) override { ++finishes; }
+  std::string name;
+  std::vector<std::string>* log;
+  int frames = 0, finishes = 0;
+};
+
+Simulator small_sim() {
+  const Model m = build_cube(testing::small_cube(2, 1.0, Vec3(0, 1, 0)));
+  return testing::make_sim(m, rest_state(m), "rk4", 0.01, 0.01);
+}
+
+// An observer destroyed before the next run leaves the simulator: it is not called (under
+// AddressSanitizer a call would be a use after free).
+TEST(Observers, DestroyedObserverIsNotCalled) {
+  Simulator sim = small_sim();
+  Counter kept;
+  sim.add_observer(kept);
+  {
+    Counter gone;
+    sim.add_observer(gone);
+    ASSERT_TRUE(sim.run_until(0.05).ok());
+    EXPECT_GT(gone.frames, 0);
+    EXPECT_EQ(sim.num_observers(), 2u);
+  }
+  EXPECT_EQ(sim.num_observers(), 1u);
+  ASSERT_TRUE(sim.run_until(0.1).ok());
+  EXPECT_EQ(kept.frames, 11);  // t = 0, 0.01, ..., 0.1
+  EXPECT_EQ(kept.finishes, 2);
+}
+
+// A simulator destroyed first is forgotten by its observers, which may be added elsewhere.
+TEST(Observers, DestroyedSimulatorIsForgotten) {
+  Counter counter;
+  {
+    Simulator first = small_sim();
+    first.add_observer(counter);
+    ASSERT_TRUE(first.run_until(0.02).ok());
+  }
+  Simulator second = small_sim();
+  second.add_observer(counter);
+  ASSERT_TRUE(second.run_until(0.02).ok());
+  EXPECT_EQ(counter.frames, 6);
+}
+
+// remove_observer stops the calls, also from inside a callback, and says whether it removed.
+TEST(Observers, RemoveObserver) {
+  Simulator sim = small_sim();
+  std::vector<std::string> log;
+  Counter a("a", &log), b("b", &log);
+  sim.add_observer(a);
+  sim.add_observer(b);
+  sim.add_observer(a);  // once only
+  EXPECT_EQ(sim.num_observers(), 2u);
+  ASSERT_TRUE(sim.run_until(0.0).ok());
+  EXPECT_EQ(log, (std::vector<std::string>{"a", "b"}));
+  EXPECT_TRUE(sim.remove_observer(a));
+  EXPECT_FALSE(sim.remove_observer(a));
+  ASSERT_TRUE(sim.run_until(0.01).ok());
+  EXPECT_EQ(log, (std::vector<std::string>{"a", "b", "b"}));
+
+  // An observer that removes the next one (and itself) during its first frame.
+  struct Remover final : Observer {
+    Simulator* sim = nullptr;
+    Observer* victim = nullptr;
+    int frames = 0;
+    void on_frame(const Simulator& /*s*/) override {
+      ++frames;
+      sim->remove_observer(*victim);
+      sim->remove_observer(*this);
+    }
+  } remover;
+  remover.sim = &sim;
+  remover.victim = &b;
+  sim.remove_observer(b);
+  sim.add_observer(remover);
+  sim.add_observer(b);
+  const int before = b.frames;
+  ASSERT_TRUE(sim.run_until(0.05).ok());
+  EXPECT_EQ(remover.frames, 1);
+  EXPECT_EQ(b.frames, before);
+  EXPECT_EQ(sim.num_observers(), 0u);
+}
+
+// An observer destroyed by another observer's callback is skipped in that same pass.
+TEST(Observers, DestroyedDuringACallbackIsSkipped) {
+  Simulator sim = small_sim();
+  auto victim = std::make_unique<Counter>();
+  struct Destroyer final : Observer {
+    std::unique_ptr<Counter>* victim = nullptr;
+    void on_frame(const Simulator& /*s*/) override { victim->reset(); }
+  } destroyer;
+  destroyer.victim = &victim;
+  sim.add_observer(destroyer);
+  sim.add_observer(*victim);
+  ASSERT_TRUE(sim.run_until(0.03).ok());
+  EXPECT_EQ(victim, nullptr);
+  EXPECT_EQ(sim.num_observers(), 1u);
+}
+
+// Shared ownership: the simulator keeps an observer alive while it is added, and lets it go
+// when it is removed or when the simulator is destroyed.
+TEST(Observers, SharedOwnership) {
+  std::weak_ptr<Counter> watch;
+  {
+    Simulator sim = small_sim();
+    {
+      auto counter = std::make_shared<Counter>();
+      watch = counter;
+      sim.add_observer(counter);
+    }
+    ASSERT_FALSE(watch.expired());
+    ASSERT_TRUE(sim.run_until(0.02).ok());
+    EXPECT_EQ(watch.lock()->frames, 3);
+    auto other = std::make_shared<Counter>();
+    std::weak_ptr<Counter> other_watch = other;
+    sim.add_observer(other);
+    other.reset();
+    EXPECT_TRUE(sim.remove_observer(*other_watch.lock()));
+    EXPECT_TRUE(other_watch.expired());
+    EXPECT_THROW(sim.add_observer(std::shared_ptr<Observer>()), InputError);
+  }
+  EXPECT_TRUE(watch.expired());
+}
+
+// A moved simulator keeps its observers, which follow it (and leave it when destroyed); a copy
+// of an observer is not added anywhere.
+TEST(Observers, FollowAMovedSimulatorAndCopiesAreNotAdded) {
+  Counter counter;
+  Simulator first = small_sim();
+  first.add_observer(counter);
+  Simulator second = std::move(first);
+  ASSERT_TRUE(second.run_until(0.01).ok());
+  EXPECT_EQ(counter.frames, 2);
+  Counter copy = counter;
+  EXPECT_EQ(second.num_observers(), 1u);
+  {
+    Counter temporary;
+    second.add_observer(temporary);
+    Simulator third = small_sim();
+    third = std::move(second);
+    EXPECT_EQ(third.num_observers(), 2u);
+    second = std::move(third);
+  }
+  EXPECT_EQ(second.num_observers(), 1u);
+  ASSERT_TRUE(second.run_until(0.02).ok());
+  EXPECT_EQ(counter.frames, 3);
+  EXPECT_EQ(copy.frames, 2);
 }
 
 }  // namespace

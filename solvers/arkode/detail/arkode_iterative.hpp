@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/arkode/detail/arkode_support.hpp>
 
@@ -35,7 +36,9 @@ class SpringOperator {
     Vec3 normal;
     Real damping;  // mu N of the friction -mu N v_t (N/(m/s))
   };
-  void linearize(const Model& model, const VecX& x, const VecX& v);
+  // `anchors` (may be null): their diagonal Jacobians -k I, -c I are added.
+  void linearize(const Model& model, const VecX& x, const VecX& v,
+                 const AnchorSprings* anchors = nullptr);
   // The particles whose normal acceleration the seed contact cancels (see above); call after
   // linearize(), before set_gamma().
   void set_constraints(std::vector<Constraint> constraints);
@@ -68,6 +71,7 @@ class SpringOperator {
   std::vector<Real> s_;           // [2M] S's per-spring block alpha u u^T + beta I
   std::vector<Real> s_inverse_;   // [9N] inverses of the filtered diagonal blocks
   std::vector<Constraint> constraints_;
+  AnchorSprings anchors_;                  // copies of the anchors' particle, k and c
   std::vector<int> constraint_of_;         // [N] index into constraints_, or -1
   std::vector<Real> k_blocks_, d_blocks_;  // workspace of linearize()
   VecX filtered_;                          // workspace of multiply_filtered()

@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include <jelly/core/detail/jacobian.hpp>
 #include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
@@ -170,12 +171,17 @@ TEST(Arkode, KluAndSchurAgree) {
 }
 
 // Every linear solver of arkode_dirk (the iterative ones included) solves the same Newton
-// systems: the same error and nearly the same steps as the direct Schur solve.
+// systems: the same error and nearly the same steps as the direct Schur solve (block Jacobi
+// alone is a modified Newton: more Newton failures, more steps).
 TEST(Arkode, EveryLinearSolverAgreesWithSchur) {
   const ArkodeRun schur = oscillator_run("arkode_dirk", 1e-7, "schur");
   for (const std::string solver : {"cg", "gmres", "jacobi", "auto"}) {
     const ArkodeRun run = oscillator_run("arkode_dirk", 1e-7, solver);
     EXPECT_LT(run.error, 1e-6) << solver;
+    if (solver == "jacobi") {
+      EXPECT_LT(run.stats.at("arkode_steps"), 2 * schur.stats.at("arkode_steps"));
+      continue;
+    }
     EXPECT_NEAR(run.stats.at("arkode_steps"), schur.stats.at("arkode_steps"),
                 0.1 * schur.stats.at("arkode_steps"))
         << solver;
