@@ -2,9 +2,9 @@
 // on that evaluation's own state, as in the course framework (docs/contact.md).
 #include <gtest/gtest.h>
 
-#include <jelly/core/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>
 
