@@ -299,7 +299,8 @@ void bind_solvers(py::module_& m) {
           py::arg("spec"),
           "Adds a terrain of any kind from its scene JSON (a dict or JSON text, see "
           "make_terrain).")
-      .def("add_observer", &Simulator::add_observer, py::arg("observer"), py::keep_alive<1, 2>(),
+      .def("add_observer", py::overload_cast<Observer&>(&Simulator::add_observer),
+           py::arg("observer"), py::keep_alive<1, 2>(),
            "Calls observer.on_frame at every output frame of run_until (and on_finish at its end).")
       .def("remove_observer", &Simulator::remove_observer, py::arg("observer"),
            "Stops calling an observer added before; False when it was not added.")
