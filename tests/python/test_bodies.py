@@ -41,7 +41,7 @@ def test_body_kinds_are_listed_and_each_builds_its_body():
         assert (body.kind, body.name) == (kind, "b_" + kind)
         assert body.num_particles == sim.model.num_particles
     assert {"plane", "slope", "elevator", "sphere"} <= set(jelly.terrain_kinds())
-    assert set(jelly.contact_models()) == {"coulomb", "seed"}
+    assert set(jelly.contact_models()) == {"coulomb", "seed", "seed_framework"}
     assert jelly.cube_particle_count(10) == 1000 and jelly.cube_spring_count(10) == 12876
 
 
