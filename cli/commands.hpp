@@ -89,4 +89,13 @@ struct ExportArgs {
 // jelly export FILE.h5 --obj-sequence DIR | --pc2 out.pc2.
 int export_command(const ExportArgs& args);
 
+struct MeshArgs {
+  std::string input;       // closed surface: .obj, .stl or .ply
+  std::string output;      // -o: .msh
+  double size = 0;         // --size: element size (m); 0 = keep the surface's triangles
+  bool overwrite = false;  // --overwrite: replace an existing -o file
+};
+// jelly mesh IN.stl -o OUT.msh [--size h]: tetrahedralize a closed surface with Gmsh.
+int mesh_command(const MeshArgs& args);
+
 }  // namespace jelly::cli

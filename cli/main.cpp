@@ -1,6 +1,6 @@
 // jelly: simulate scenes (run), describe recordings (info), fit coefficients to a recording
 // (fit), list what a scene can name (list), watch scenes and recordings (view), render videos
-// (render), export surfaces for other tools (export).
+// (render), export surfaces for other tools (export), fill surfaces with tetrahedra (mesh).
 #include <cstdio>
 #include <exception>
 #include <new>
@@ -190,6 +190,22 @@ int main(int argc, char** argv) {
   export_cmd->add_flag("--overwrite", export_args.overwrite,
                        "Replace existing files (an existing file is an error otherwise)");
 
+  MeshArgs mesh_args;
+  CLI::App* mesh = app.add_subcommand(
+      "mesh", "Fill a closed surface (.obj, .stl, .ply) with tetrahedra (Gmsh) for a tetmesh body");
+  mesh->add_option("input", mesh_args.input, "Closed surface mesh: .obj, .stl or .ply")
+      ->required()
+      ->check(kNonEmpty);
+  mesh->add_option("-o,--output", mesh_args.output, "Tetrahedral mesh to write (.msh, Gmsh 4.1)")
+      ->required()
+      ->check(kNonEmpty);
+  mesh->add_option("--size", mesh_args.size,
+                   "Element size in the surface's units: the surface is remeshed at this size "
+                   "(default 0: keep its triangles)")
+      ->type_name("H")
+      ->capture_default_str();
+  mesh->add_flag("--overwrite", mesh_args.overwrite, "Replace an existing -o file");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -208,6 +224,7 @@ int main(int argc, char** argv) {
     if (view->parsed()) return view_command(view_args);
     if (render->parsed()) return render_command(render_args);
     if (export_cmd->parsed()) return export_command(export_args);
+    if (mesh->parsed()) return mesh_command(mesh_args);
   } catch (const jelly::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitBadInput;

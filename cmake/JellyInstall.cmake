@@ -23,4 +23,5 @@ write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/jellyConfigVersion.
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/jellyConfig.cmake
               ${CMAKE_CURRENT_BINARY_DIR}/jellyConfigVersion.cmake
               ${CMAKE_CURRENT_SOURCE_DIR}/cmake/FindCHOLMOD.cmake
+              ${CMAKE_CURRENT_SOURCE_DIR}/cmake/FindGmsh.cmake
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/jelly)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 
 #include <jelly/core/errors.hpp>
@@ -130,6 +131,16 @@ std::string JsonFields::string_or(std::string_view key, const std::string& fallb
 Vec3 JsonFields::vec3_or(std::string_view key, const Vec3& fallback) {
   const Json* v = find(key);
   return v == nullptr ? fallback : json_vec3(*v, path(key));
+}
+
+std::string JsonFields::file(std::string_view key) {
+  const std::string name = string(key);
+  if (name.empty()) throw InputError(path(key), "\"\"", "a file name");
+  std::filesystem::path p(name);
+  if (p.is_relative() && !base_directory_.empty()) p = std::filesystem::path(base_directory_) / p;
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(p, ec);
+  return (ec ? p : absolute).lexically_normal().string();
 }
 
 const Json* JsonFields::value(std::string_view key) { return find(key); }

@@ -45,11 +45,18 @@ class JsonFields {
   std::string string(std::string_view key);
   std::string string_or(std::string_view key, const std::string& fallback);
   Vec3 vec3_or(std::string_view key, const Vec3& fallback);
+  // A required file name, resolved against base_directory() when relative and returned as an
+  // absolute, normalised path (the scene file's folder for a mesh named in a scene).
+  std::string file(std::string_view key);
   // A sub-object or array, or nullptr when the key is missing.
   const Json* value(std::string_view key);
 
   // Throws InputError for the first key no getter asked for, listing the allowed keys.
   void reject_unknown() const;
+
+  // The folder file() resolves relative names against; "" = the current directory.
+  void set_base_directory(std::string directory) { base_directory_ = std::move(directory); }
+  const std::string& base_directory() const { return base_directory_; }
 
  private:
   const Json* find(std::string_view key);
@@ -58,6 +65,7 @@ class JsonFields {
   const Json& object_;
   std::string path_;
   std::vector<std::string> known_;
+  std::string base_directory_;
 };
 
 // Typed conversions of a single value at `path`; throw InputError naming path, value and type.

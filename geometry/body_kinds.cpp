@@ -4,6 +4,8 @@
 #include <jelly/geometry/box.hpp>
 #include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/voxelized.hpp>
 
 namespace jelly {
 
@@ -16,6 +18,14 @@ const std::vector<BodyKindInfo>& body_kinds() {
        &ClothShape::read},
       {"cube", "the seed's lattice: n per edge, edge_length, origin (corner particle)",
        &CubeShape::read},
+      {"tetmesh",
+       "springs along a tet mesh's edges: file (.msh, .node/.ele), scale, position, "
+       "rotation_degrees",
+       &TetmeshShape::read},
+      {"voxelized",
+       "a closed mesh filled with the lattice: file (.obj/.stl/.ply), spacing, scale, position, "
+       "rotation_degrees",
+       &VoxelizedShape::read},
   };
   return kinds;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -101,7 +102,8 @@ void Scene::validate() const {
 }
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  return parse_scene(detail::read_json_file(path, "scene file"), overrides, path);
+  return parse_scene(detail::read_json_file(path, "scene file"), overrides, path,
+                     std::filesystem::path(path).parent_path().string());
 }
 
 std::unique_ptr<Terrain> make_terrain(const TerrainSpec& spec) { return spec.make(); }

@@ -64,9 +64,11 @@ BodySpec cube_body(const CubeSpec& cube, const std::string& name = "jelly");
 // apply_override) to the JSON before it is validated. Throws InputError for a file that cannot
 // be read, is not JSON, or holds an invalid scene.
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
-// The same from JSON text; `source` names the text in messages (a file name).
+// The same from JSON text; `source` names the text in messages (a file name). Files the
+// scene names (a body's mesh) are relative to `base_directory` ("" = the current directory;
+// load_scene passes the scene file's folder); the scene holds them as absolute paths.
 Scene parse_scene(const std::string& json_text, const std::vector<std::string>& overrides = {},
-                  const std::string& source = "scene");
+                  const std::string& source = "scene", const std::string& base_directory = "");
 // The scene as pretty-printed JSON with every field written out; parse_scene reads it back to
 // an equal scene.
 std::string scene_to_json(const Scene& scene);

@@ -37,7 +37,7 @@ BodySpec read_legacy_cube(JsonFields& root) {
   return body;
 }
 
-Scene scene_from_json(const Json& j) {
+Scene scene_from_json(const Json& j, const std::string& base_directory) {
   JsonFields root(j, "");
   Scene s;
   s.description = root.string_or("description", s.description);
@@ -54,6 +54,7 @@ Scene scene_from_json(const Json& j) {
     s.bodies.clear();
     for (std::size_t i = 0; i < bodies->size(); ++i) {
       JsonFields f((*bodies)[i], json_element("bodies", i));
+      f.set_base_directory(base_directory);
       s.bodies.push_back(BodySpec::read(f));
     }
   } else {
@@ -108,10 +109,10 @@ Scene scene_from_json(const Json& j) {
 }  // namespace
 
 Scene parse_scene(const std::string& json_text, const std::vector<std::string>& overrides,
-                  const std::string& source) {
+                  const std::string& source, const std::string& base_directory) {
   Json j = detail::parse_json(json_text, source);
   for (const std::string& o : overrides) detail::apply_override(j, o);
-  return scene_from_json(j);
+  return scene_from_json(j, base_directory);
 }
 
 std::string scene_to_json(const Scene& s) {

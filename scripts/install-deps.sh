@@ -10,6 +10,8 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas-dev libsundials-dev libhdf5-dev hdf5-tools
   libceres-dev libgtest-dev libgmock-dev googletest libbenchmark-dev nlohmann-json3-dev libcli11-dev
   python3-h5py python3-matplotlib python3-numpy ffmpeg clang-format ccache
+  # meshes: reading OBJ/STL/PLY (assimp), tetrahedral meshes and `jelly mesh` (Gmsh)
+  libassimp-dev libgmsh-dev
   # the viewer (jelly view / render): OpenGL through GLVND, Mesa's EGL and software drivers
   # (llvmpipe), GLFW, Dear ImGui with its backends, stb for PNG; Xvfb for its tests (and for the
   # test jelly_paraview's screenshot)

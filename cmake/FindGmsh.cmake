@@ -1,0 +1,23 @@
+# FindGmsh: the Gmsh library and its C++ API (Debian's libgmsh-dev ships no CMake config).
+#
+# Defines the imported target Gmsh::Gmsh and the variables Gmsh_FOUND, GMSH_INCLUDE_DIR,
+# GMSH_LIBRARY and Gmsh_VERSION (the API version of gmsh.h).
+include(FindPackageHandleStandardArgs)
+
+find_path(GMSH_INCLUDE_DIR NAMES gmsh.h)
+find_library(GMSH_LIBRARY NAMES gmsh)
+
+if(GMSH_INCLUDE_DIR AND EXISTS "${GMSH_INCLUDE_DIR}/gmsh.h")
+  file(STRINGS "${GMSH_INCLUDE_DIR}/gmsh.h" _gmsh_version_line
+       REGEX "#define GMSH_API_VERSION \"[0-9.]+\"")
+  string(REGEX REPLACE ".*\"([0-9.]+)\".*" "\\1" Gmsh_VERSION "${_gmsh_version_line}")
+endif()
+
+find_package_handle_standard_args(Gmsh REQUIRED_VARS GMSH_LIBRARY GMSH_INCLUDE_DIR
+                                  VERSION_VAR Gmsh_VERSION)
+
+if(Gmsh_FOUND AND NOT TARGET Gmsh::Gmsh)
+  add_library(Gmsh::Gmsh UNKNOWN IMPORTED)
+  set_target_properties(Gmsh::Gmsh PROPERTIES IMPORTED_LOCATION "${GMSH_LIBRARY}"
+                                              INTERFACE_INCLUDE_DIRECTORIES "${GMSH_INCLUDE_DIR}")
+endif()

@@ -1,0 +1,270 @@
+#include <jelly/geometry/mesh_io.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <unordered_map>
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <assimp/Importer.hpp>
+
+#include <jelly/core/errors.hpp>
+
+namespace jelly {
+
+namespace {
+
+// Meshes larger than this are refused before reading (a mistaken path to a huge file).
+constexpr std::uintmax_t kMaxMeshFileBytes = 1ull << 30;
+
+std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// Index of each distinct position, in order of first appearance; -0 and +0 are the same.
+class Welder {
+ public:
+  int index(const Vec3& p, std::vector<Vec3>& vertices) {
+    const Key key{p.x() + 0.0, p.y() + 0.0, p.z() + 0.0};
+    const auto [it, inserted] = map_.try_emplace(key, static_cast<int>(vertices.size()));
+    if (inserted) vertices.push_back(p);
+    return it->second;
+  }
+
+ private:
+  struct Key {
+    double x, y, z;
+    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = 1469598103934665603ull;
+      for (double d : {k.x, k.y, k.z}) {
+        std::uint64_t bits;
+        std::memcpy(&bits, &d, sizeof bits);
+        h = (h ^ bits) * 1099511628211ull;
+        h ^= h >> 29;
+      }
+      return static_cast<std::size_t>(h);
+    }
+  };
+  std::unordered_map<Key, int, Hash> map_;
+};
+
+}  // namespace
+
+MeshTopology mesh_topology(const TriangleMesh& mesh) {
+  MeshTopology topo;
+  // Every directed edge (a, b) of every triangle, sorted by its undirected key.
+  struct Directed {
+    std::uint64_t key;  // min * 2^32 + max
+    int a, b;
+  };
+  std::vector<Directed> edges;
+  edges.reserve(3 * mesh.triangles.size());
+  for (const Triangle& t : mesh.triangles) {
+    for (int c = 0; c < 3; ++c) {
+      const int a = t[c], b = t[(c + 1) % 3];
+      const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+      const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+      edges.push_back({(lo << 32) | hi, a, b});
+    }
+  }
+  std::sort(edges.begin(), edges.end(),
+            [](const Directed& x, const Directed& y) { return x.key < y.key; });
+  // Boundary edges as directed a -> b, to be chained into loops.
+  std::unordered_multimap<int, int> next;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    const std::size_t uses = j - i;
+    ++topo.edges;
+    if (uses == 1) {
+      ++topo.boundary_edges;
+      next.emplace(edges[i].a, edges[i].b);
+    } else if (uses > 2) {
+      if (topo.non_manifold_edges++ == 0) {
+        topo.first_non_manifold_edge[0] = edges[i].a;
+        topo.first_non_manifold_edge[1] = edges[i].b;
+      }
+    } else if (edges[i].a == edges[i + 1].a) {
+      if (topo.misoriented_edges++ == 0) {
+        topo.first_misoriented_edge[0] = edges[i].a;
+        topo.first_misoriented_edge[1] = edges[i].b;
+      }
+    }
+    i = j;
+  }
+  // Chain the boundary edges into loops (a vertex where several holes touch is left by any of
+  // its outgoing edges: the loops then differ, their union does not).
+  while (!next.empty()) {
+    MeshHole hole;
+    const int start = next.begin()->first;
+    int at = start;
+    Eigen::AlignedBox3d box;
+    while (true) {
+      const auto it = next.find(at);
+      if (it == next.end()) break;
+      hole.vertices.push_back(at);
+      box.extend(mesh.vertices[at]);
+      at = it->second;
+      next.erase(it);
+      if (at == start) break;
+    }
+    hole.diameter = box.isEmpty() ? 0 : box.diagonal().norm();
+    hole.centre = box.isEmpty() ? Vec3(Vec3::Zero()) : Vec3(box.center());
+    topo.holes.push_back(std::move(hole));
+  }
+  std::sort(topo.holes.begin(), topo.holes.end(),
+            [](const MeshHole& x, const MeshHole& y) { return x.diameter > y.diameter; });
+  return topo;
+}
+
+MeshFile read_mesh(const std::string& path, const std::string& field) {
+  namespace fs = std::filesystem;
+  const std::string value = quoted(path);
+  const std::string ext = lower_extension(path);
+  require(ext == ".obj" || ext == ".stl" || ext == ".ply", field, value,
+          "a mesh file ending in .obj, .stl or .ply");
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  require(fs::exists(status), field, value, "an existing mesh file (not found)");
+  require(fs::is_regular_file(status), field, value, "a regular file (this is not one)");
+  const std::uintmax_t bytes = fs::file_size(path, ec);
+  require(!ec && bytes <= kMaxMeshFileBytes, field, value,
+          "a mesh file of at most 1 GiB (this one has " + std::to_string(bytes) + " bytes)");
+  require(static_cast<bool>(std::ifstream(path)), field, value, "a readable file");
+
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate);
+  if (scene == nullptr) {
+    throw InputError(
+        field, value,
+        "a mesh file the reader (assimp) accepts: " + std::string(importer.GetErrorString()));
+  }
+
+  MeshFile out;
+  Welder welder;
+  std::map<std::string, std::vector<int>> groups;
+  int dropped = 0;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    std::vector<int> index(am->mNumVertices);
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      const aiVector3D& p = am->mVertices[v];
+      const Vec3 q(p.x, p.y, p.z);
+      if (!q.allFinite()) {  // (the message is built only then: this loop is hot)
+        throw InputError(
+            field, value,
+            "a mesh with finite coordinates (a vertex is at (" + to_text(q.transpose()) + "))");
+      }
+      index[v] = welder.index(q, out.mesh.vertices);
+    }
+    const std::string name = am->mName.C_Str();
+    std::vector<int>* group = (name.empty() || name == "defaultobject") ? nullptr : &groups[name];
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines
+      const Triangle t{index[face.mIndices[0]], index[face.mIndices[1]], index[face.mIndices[2]]};
+      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+        ++dropped;
+        continue;
+      }
+      out.mesh.triangles.push_back(t);
+      if (group != nullptr) group->insert(group->end(), t.begin(), t.end());
+    }
+  }
+  require(out.mesh.num_triangles() > 0, field, value,
+          "a mesh with at least one triangle (it has none" +
+              std::string(dropped > 0 ? ", " + std::to_string(dropped) + " degenerate" : "") + ")");
+  for (auto& [name, vertices] : groups) {
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    if (!vertices.empty()) out.groups.push_back({name, std::move(vertices)});
+  }
+
+  const MeshTopology topo = mesh_topology(out.mesh);
+  const auto at = [&](int v) { return "(" + to_text(out.mesh.vertices[v].transpose()) + ")"; };
+  require(topo.non_manifold_edges == 0, field, value,
+          "a manifold mesh: each edge shared by at most two triangles (" +
+              std::to_string(topo.non_manifold_edges) + " edges are shared by more, e.g. " +
+              at(topo.first_non_manifold_edge[0]) + "-" + at(topo.first_non_manifold_edge[1]) +
+              ")");
+  require(topo.misoriented_edges == 0, field, value,
+          "a consistently oriented mesh: neighbouring triangles run through their shared edge "
+          "in opposite directions (" +
+              std::to_string(topo.misoriented_edges) + " edges do not, e.g. " +
+              at(topo.first_misoriented_edge[0]) + "-" + at(topo.first_misoriented_edge[1]) + ")");
+  return out;
+}
+
+void require_small_holes(const MeshTopology& topology, Real max_hole_diameter,
+                         const std::string& field, const std::string& file,
+                         const std::string& what_fills) {
+  if (topology.holes.empty()) return;
+  const MeshHole& worst = topology.holes.front();  // sorted by diameter, largest first
+  require(worst.diameter <= max_hole_diameter, field, quoted(file),
+          "a closed mesh, or one whose holes are at most " + to_text(max_hole_diameter) +
+              " across (" + what_fills + "); it has " + std::to_string(topology.holes.size()) +
+              " hole(s), the largest " + to_text(worst.diameter) + " across at (" +
+              to_text(worst.centre.transpose()) + ")");
+}
+
+void write_mesh(const std::string& path, const TriangleMesh& mesh) {
+  const std::string ext = lower_extension(path);
+  require(ext == ".obj" || ext == ".stl" || ext == ".ply", "mesh file", quoted(path),
+          "a file ending in .obj, .stl or .ply");
+  std::ofstream out(path, std::ios::binary);
+  require(static_cast<bool>(out), "mesh file", quoted(path), "a file that can be written");
+  out.precision(17);
+  if (ext == ".obj") {
+    for (const Vec3& v : mesh.vertices)
+      out << "v " << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
+    for (const Triangle& t : mesh.triangles) {
+      out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    }
+  } else if (ext == ".ply") {
+    out << "ply\nformat ascii 1.0\nelement vertex " << mesh.num_vertices()
+        << "\nproperty double x\nproperty double y\nproperty double z\nelement face "
+        << mesh.num_triangles() << "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const Vec3& v : mesh.vertices) out << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
+    for (const Triangle& t : mesh.triangles)
+      out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  } else {
+    // Binary STL: 80-byte header, count, then per triangle normal, 3 vertices (float32) and a
+    // 2-byte attribute.
+    char header[80] = "binary STL written by jelly";
+    out.write(header, sizeof header);
+    const auto count = static_cast<std::uint32_t>(mesh.num_triangles());
+    out.write(reinterpret_cast<const char*>(&count), 4);
+    for (const Triangle& t : mesh.triangles) {
+      const Vec3& a = mesh.vertices[t[0]];
+      const Vec3& b = mesh.vertices[t[1]];
+      const Vec3& c = mesh.vertices[t[2]];
+      const Vec3 n = (b - a).cross(c - a).normalized();
+      float data[12];
+      for (int k = 0; k < 3; ++k) {
+        data[k] = static_cast<float>(n[k]);
+        data[3 + k] = static_cast<float>(a[k]);
+        data[6 + k] = static_cast<float>(b[k]);
+        data[9 + k] = static_cast<float>(c[k]);
+      }
+      out.write(reinterpret_cast<const char*>(data), sizeof data);
+      const std::uint16_t attribute = 0;
+      out.write(reinterpret_cast<const char*>(&attribute), 2);
+    }
+  }
+  require(static_cast<bool>(out.flush()), "mesh file", quoted(path), "a file that can be written");
+}
+
+}  // namespace jelly

@@ -1,0 +1,23 @@
+#pragma once
+// Tetrahedral meshes from and to files: Gmsh .msh (through Gmsh's API) and TetGen .node/.ele.
+#include <string>
+
+#include <jelly/geometry/tetmesh.hpp>
+
+namespace jelly {
+
+// Reads a Gmsh mesh (.msh, format 4 or 2, through Gmsh) or a TetGen mesh (`path` naming its
+// .node or .ele file; both must exist). Vertices no tet uses are dropped. Groups: each Gmsh
+// physical group (any dimension; by its name, or "physical_<dim>_<tag>" when it has none) as the
+// vertices of its elements; TetGen regions (the .ele's first attribute) as "region_<a>" and
+// non-zero boundary markers of the .node as "marker_<m>". Throws InputError naming `field` and
+// the file for a missing or unreadable file, a file the reader refuses, 3D elements other than
+// 4-node tetrahedra, and what validate_tet_mesh refuses.
+TetMesh read_tet_mesh(const std::string& path, const std::string& field);
+
+// Writes a tet mesh as Gmsh .msh 4.1 (ASCII): the tets as volume 1 (physical group "volume"),
+// the boundary triangles as surface 1 (physical group "boundary"); vertex groups are not
+// written. Throws InputError naming the path when it does not end in .msh or cannot be written.
+void write_msh(const std::string& path, const TetMesh& mesh);
+
+}  // namespace jelly

@@ -1,0 +1,126 @@
+// Reading meshes: formats, welding, vertex groups, topology, and each kind of bad file.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <jelly/geometry/mesh_io.hpp>
+
+#include "geometry_support.hpp"
+
+namespace jelly {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::input_error;
+using testing::TempDir;
+using testing::write_text;
+
+// A tetrahedron, outward, as OBJ text with two groups.
+constexpr const char* kTetrahedronObj =
+    "# a tetrahedron\n"
+    "o body\n"
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+    "f 1 3 2\nf 1 2 4\n"
+    "g foot\nf 1 4 3\n"
+    "g head\nf 2 3 4\n";
+
+TEST(MeshIo, ReadsEachFormatAndWeldsRepeatedVertices) {
+  TempDir dir;
+  const TriangleMesh box = box_mesh(Vec3(1, 2, 3));
+  for (const char* name : {"box.obj", "box.stl", "box.ply", "BOX.STL"}) {
+    write_mesh(dir.file(name), box);
+    const MeshFile read = read_mesh(dir.file(name), "file");
+    EXPECT_EQ(read.mesh.num_vertices(), 8) << name;  // STL repeats them per triangle
+    EXPECT_EQ(read.mesh.num_triangles(), 12) << name;
+    EXPECT_TRUE(read.mesh.bounds().isApprox(box.bounds())) << name;
+    const MeshTopology topo = mesh_topology(read.mesh);
+    EXPECT_TRUE(topo.closed() && topo.manifold()) << name;
+    EXPECT_EQ(topo.edges, 18) << name;
+  }
+}
+
+TEST(MeshIo, ObjectAndGroupNamesAreVertexGroups) {
+  TempDir dir;
+  const MeshFile read = read_mesh(write_text(dir.file("t.obj"), kTetrahedronObj), "file");
+  ASSERT_EQ(read.mesh.num_triangles(), 4);
+  ASSERT_EQ(read.groups.size(), 3u);
+  std::map<std::string, std::vector<Vec3>> points;
+  for (const VertexGroup& g : read.groups) {
+    for (int v : g.vertices) points[g.name].push_back(read.mesh.vertices[v]);
+  }
+  ASSERT_EQ(points["foot"].size(), 3u);  // 1 4 3: (0,0,0), (0,0,1), (0,1,0)
+  for (const Vec3& p : points["foot"]) EXPECT_EQ(p.x(), 0);
+  ASSERT_EQ(points["head"].size(), 3u);
+  EXPECT_EQ(points["body"].size(), 4u);
+}
+
+TEST(MeshIo, PolygonsAreSplitAndDegenerateTrianglesDropped) {
+  TempDir dir;
+  // A cube of quads, one extra triangle with a repeated vertex.
+  const std::string text =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+      "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\nf 1 1 2\n";
+  const MeshFile read = read_mesh(write_text(dir.file("q.obj"), text), "file");
+  EXPECT_EQ(read.mesh.num_triangles(), 12);
+  EXPECT_TRUE(mesh_topology(read.mesh).closed());
+}
+
+TEST(MeshIo, HolesAreFoundAsLoops) {
+  TriangleMesh sphere = sphere_mesh(1, 8, 16);
+  sphere.triangles.erase(sphere.triangles.begin() + 100);
+  sphere.triangles.erase(sphere.triangles.begin() + 40);  // two rings apart: two holes
+  const MeshTopology topo = mesh_topology(sphere);
+  EXPECT_FALSE(topo.closed());
+  EXPECT_TRUE(topo.manifold());
+  EXPECT_EQ(topo.boundary_edges, 6);
+  ASSERT_EQ(topo.holes.size(), 2u);
+  EXPECT_EQ(topo.holes[0].vertices.size(), 3u);
+  EXPECT_GT(topo.holes[0].diameter, 0);
+  EXPECT_LT(topo.holes[0].diameter, 1);
+  EXPECT_NO_THROW(require_small_holes(topo, 1, "file", "s.obj", "filled"));
+  const std::string message =
+      input_error([&] { require_small_holes(topo, 0.01, "bodies[0].file", "s.obj", "filled"); });
+  EXPECT_THAT(message, HasSubstr("bodies[0].file = \"s.obj\" is invalid"));
+  EXPECT_THAT(message, HasSubstr("2 hole(s)"));
+}
+
+TEST(MeshIo, BadFilesAreInputErrorsNamingFieldAndFile) {
+  TempDir dir;
+  const std::string field = "bodies[1].file";
+  const auto error = [&](const std::string& path) {
+    return input_error([&] { read_mesh(path, field); });
+  };
+  const std::string missing = dir.file("missing.obj");
+  EXPECT_THAT(error(missing), HasSubstr(field + " = \"" + missing + "\" is invalid: an existing"));
+  EXPECT_THAT(error(dir.path().string() + "/folder.obj"), HasSubstr("not found"));
+  std::filesystem::create_directory(dir.file("dir.obj"));
+  EXPECT_THAT(error(dir.file("dir.obj")), HasSubstr("a regular file"));
+  EXPECT_THAT(error(write_text(dir.file("m.3ds"), "x")), HasSubstr(".obj, .stl or .ply"));
+  EXPECT_THAT(error(write_text(dir.file("empty.obj"), "")), HasSubstr(field + " = \""));
+  EXPECT_THAT(error(write_text(dir.file("nofaces.obj"), "# nothing\nv 0 0 0\nv 1 0 0\n")),
+              HasSubstr(field));
+  EXPECT_THAT(error(write_text(dir.file("empty.stl"), "solid e\nendsolid e\n")), HasSubstr(field));
+  EXPECT_THAT(error(write_text(dir.file("garbage.ply"), "not a ply file\n")), HasSubstr(field));
+  const std::string nan = write_text(dir.file("nan.obj"),
+                                     "v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                     "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  EXPECT_THAT(error(nan), HasSubstr("finite coordinates"));
+  // Three triangles on the edge 1-2.
+  const std::string fin = write_text(dir.file("fin.obj"),
+                                     "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0 -1 0\n"
+                                     "f 1 2 3\nf 2 1 4\nf 1 2 5\n");
+  EXPECT_THAT(error(fin), HasSubstr("manifold"));
+  // One triangle of a tetrahedron turned inside out.
+  const std::string flipped = write_text(dir.file("flipped.obj"),
+                                         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                         "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 4 3\n");
+  EXPECT_THAT(error(flipped), HasSubstr("consistently oriented"));
+}
+
+TEST(MeshIo, WriteRefusesOtherExtensions) {
+  TempDir dir;
+  EXPECT_THROW(write_mesh(dir.file("x.off"), box_mesh(Vec3::Ones())), InputError);
+  EXPECT_THROW(write_mesh(dir.file("no/such/folder/x.obj"), box_mesh(Vec3::Ones())), InputError);
+}
+
+}  // namespace
+}  // namespace jelly
