@@ -234,7 +234,8 @@ TEST(BodySpec, BadInputNamesTheField) {
             "bodies[0].name = \"a/b\" is invalid: a name without '/' or '.' (it names an HDF5 "
             "group)");
   EXPECT_EQ(body_error(R"({"kind": "blob"})"),
-            "bodies[0].kind = \"blob\" is invalid: one of \"box\", \"cloth\", \"cube\"");
+            "bodies[0].kind = \"blob\" is invalid: one of \"box\", \"cloth\", \"cube\", "
+            "\"tetmesh\", \"voxelized\"");
   EXPECT_EQ(body_error(R"({"kind": "cube", "forces": [{"kind": "wind", "velocity": [1, 0, 0]}]})"),
             "bodies[0].forces[0].drag is missing: it is required");
 }
