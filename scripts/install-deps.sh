@@ -12,6 +12,8 @@ packages=(
   python3-h5py python3-matplotlib python3-numpy ffmpeg clang-format ccache
   # meshes: reading OBJ/STL/PLY (assimp), tetrahedral meshes and `jelly mesh` (Gmsh)
   libassimp-dev libgmsh-dev
+  # scripts/make_assets.py (the meshes under assets/) and its test: Gmsh's Python API
+  python3-gmsh
   # the viewer (jelly view / render): OpenGL through GLVND, Mesa's EGL and software drivers
   # (llvmpipe), GLFW, Dear ImGui with its backends, stb for PNG; Xvfb for its tests (and for the
   # test jelly_paraview's screenshot)
