@@ -360,6 +360,33 @@ TEST(MakeSimulator, BuildsTheSceneAndRunsIt) {
   EXPECT_NEAR(com.y(), 79.0 / 9 - 0.5 * 9.8 * 0.2 * 0.2, 1e-2);
 }
 
+// scenes/gummy_bear.json: the voxelized bear (its surface the mesh of assets/gummy_bear.obj)
+// falls freely, its centre of mass on the parabola, then lands on the slope and slides down it
+// (towards +x) without any particle passing through the slope.
+TEST(MakeSimulator, GummyBearFallsThenLandsOnTheSlope) {
+  Simulator sim = make_simulator(load_scene(scene_path("gummy_bear.json")));
+  const Model& model = sim.model();
+  ASSERT_EQ(model.num_bodies(), 1);
+  EXPECT_EQ(model.bodies[0].kind, "voxelized");
+  EXPECT_EQ(model.bodies[0].surface.num_triangles(), 3836);  // the mesh's
+  EXPECT_GT(model.num_particles(), 500);
+  const Vec3 start = center_of_mass(model, sim.state());
+  const Real t = 0.1;  // still in the air (its lowest point is 2 m above the slope)
+  ASSERT_TRUE(sim.run_until(t).ok());
+  const Vec3 fallen = center_of_mass(model, sim.state());
+  EXPECT_NEAR(fallen.y(), start.y() - 0.5 * 9.8 * t * t, 1e-9);
+  EXPECT_NEAR(fallen.x(), start.x(), 1e-9);
+  ASSERT_TRUE(sim.run_until(1.2).ok());
+  const Vec3 normal(std::sin(20 * M_PI / 180), std::cos(20 * M_PI / 180), 0);
+  Real lowest = 1e9;
+  for (int i = 0; i < model.num_particles(); ++i) {
+    lowest = std::min(lowest, normal.dot(particle(sim.state().x, i)));
+  }
+  EXPECT_GT(lowest, -0.02);  // on the slope, not through it
+  EXPECT_LT(lowest, 0.1);    // landed
+  EXPECT_GT(center_of_mass(model, sim.state()).x(), start.x() + 0.05);  // sliding or rolling down
+}
+
 // scenes/jelly_stack.json: the three cubes come to rest on each other, no particle of one body
 // closer to one of another than the sum of their radii less 1 %.
 TEST(MakeSimulator, JellyStackComesToRestWithoutOverlap) {
