@@ -98,8 +98,8 @@ TEST(Assets, BearPartsAreGroupsAndItsVolumeIsFilled) {
     names.push_back(g.name);
     EXPECT_FALSE(g.particles.empty()) << g.name;
   }
-  EXPECT_THAT(names, ElementsAre("arm_left", "arm_right", "belly", "ear_left", "ear_right",
-                                 "head", "leg_left", "leg_right", "snout"));
+  EXPECT_THAT(names, ElementsAre("arm_left", "arm_right", "belly", "ear_left", "ear_right", "head",
+                                 "leg_left", "leg_right", "snout"));
 }
 
 // The bear hung by its left ear: the ear's mesh vertices stay where they are to the last bit
@@ -113,8 +113,8 @@ TEST(Assets, APinnedVertexGroupHoldsItsVerticesExactly) {
                   "spacing": 0.03, "density": 1100,
                   "springs": {"structural": {"ks": 300, "kd": 1}, "shear": {"ks": 300, "kd": 1},
                               "bending": {"ks": 300, "kd": 1}},
-                  "pins": [{"group": ")" +
-                                                 group + R"("}]}],
+                  "pins": [{"group": ")" + group +
+                                                 R"("}]}],
       "integrator": {"name": "implicit_euler", "dt": 0.016666666666666666}, "duration": 1})");
   };
   EXPECT_EQ(input_error([&] { make_model(load_scene(scene_with_pin("tail"))); }),
