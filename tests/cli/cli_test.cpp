@@ -95,6 +95,30 @@ TEST(Cli, SeedContactAtLargeStepsWarns) {
   EXPECT_EQ(r.err, "");
 }
 
+// Bad bodies exit 2 naming the field, the value and what is allowed (issue 12's bad input): a
+// pin by a group the mesh does not have lists the groups it has; a spacing that would make
+// more particles than max_particles (default 2 million); two bodies of one name.
+TEST(Cli, BadBodiesExitTwoNamingTheField) {
+  Result r = jelly("run '" + scene("gummy_bear.json") +
+                   "' --set 'bodies[0].pins=[{\"group\": \"tail\"}]'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "error: bodies[0].pins[0].group = \"tail\" is invalid: a group of the body: one of "
+            "arm_left, arm_right, belly, ear_left, ear_right, head, leg_left, leg_right, snout\n");
+  r = jelly("run '" + scene("gummy_bear.json") + "' --set bodies[0].spacing=0.004");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("is invalid: at most max_particles = 2000000"));
+  r = jelly("run '" + scene("gummy_bear.json") + "' --set bodies[0].spacing=1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: bodies[0].spacing = 1 is invalid: a spacing that leaves "
+                                "at least 8 lattice points"));
+  r = jelly("run '" + scene("two_jellies.json") + "' --set bodies[1].name=soft");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "error: bodies[1].name = \"soft\" is invalid: a name no other body has (bodies[0] has "
+            "it)\n");
+}
+
 TEST(Cli, BadScenesExitTwoNamingTheJsonPath) {
   const std::string bad_range = write_scene(R"({
     "terrains": [{"kind": "plane", "contact": {"restitution": 1.5}}],
