@@ -18,13 +18,6 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-CholmodOrdering ordering_of(const std::string& name) {
-  if (name == "amd") return CholmodOrdering::kAmd;
-  if (name == "nesdis") return CholmodOrdering::kNesdis;
-  if (name == "best") return CholmodOrdering::kBest;
-  return CholmodOrdering::kMetis;
-}
-
 // Contact penalties in the factor, as multiples of the particle's diagonal entry of A: a
 // sticking contact is (nearly) held in place by the global solve, a sliding one partly. The
 // exact contact comes from the residual (position_contact.hpp); the penalties only make the
@@ -115,7 +108,7 @@ StepResult ProjectiveDynamics::prepare(const Model& model, Real h) {
   a_ = global_matrix(model, h);
   if (!same_model) {
     CholmodOptions cholmod;
-    cholmod.ordering = ordering_of(options_.ordering);
+    cholmod.ordering = options_.ordering;
     if (solver_) rank_updates_ += solver_->rank_updates();
     solver_ = std::make_unique<CholmodSolver>(cholmod);
     const LinearResult r = solver_->analyze(a_);

@@ -33,7 +33,7 @@ class ProjectiveDynamics final : public Integrator {
   int order() const override { return 1; }
   bool is_implicit() const override { return true; }
   bool resolves_contact() const override {
-    return options_.contact == "projection" && terrains_seen_;
+    return options_.contact == PositionContactMode::kProjection && terrains_seen_;
   }
   int contacts_resolved() const override;
   // steps, symbolic_analyses, factorizations (once per model and dt), iterations (global

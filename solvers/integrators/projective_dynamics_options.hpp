@@ -1,11 +1,24 @@
 #pragma once
-// Options of the projective dynamics integrator (docs/realtime.md).
+// Options of the projective dynamics integrator (docs/realtime.md): each named choice an enum
+// with its name table (core/enum_names.hpp), as implicit_euler's.
 #include <string>
+#include <vector>
 
+#include <jelly/core/enum_names.hpp>
 #include <jelly/core/json.hpp>
 #include <jelly/core/types.hpp>
+#include <jelly/solvers/linear/cholmod_solver.hpp>
 
 namespace jelly {
+
+// How coulomb terrains enter a step of the position-based integrators (projective_dynamics,
+// xpbd).
+enum class PositionContactMode {
+  kProjection,  // inside the step: particles kept on the surface, Coulomb friction
+  kAfterStep,   // the explicit integrators' resolve after the step
+};
+// "projection", "after_step".
+const std::vector<EnumName<PositionContactMode>>& position_contact_modes();
 
 struct ProjectiveDynamicsOptions {
   // Local/global iterations per step (one force evaluation and one prefactored solve each).
@@ -21,12 +34,12 @@ struct ProjectiveDynamicsOptions {
   Real chebyshev_gamma = 0.9;
   // Plain iterations of each step before the acceleration starts (Wang's S).
   int chebyshev_delay = 2;
-  // How coulomb terrains enter the step: "projection" (inside the iterations: contact particles
+  // How coulomb terrains enter the step: kProjection (inside the iterations: contact particles
   // kept on the surface, their inward residual taken by the contact, Coulomb friction) or
-  // "after_step" (the explicit integrators' resolve after the step).
-  std::string contact = "projection";
-  // Fill-reducing ordering of the CHOLMOD factor: "metis", "amd", "nesdis" or "best".
-  std::string ordering = "metis";
+  // kAfterStep (the explicit integrators' resolve after the step).
+  PositionContactMode contact = PositionContactMode::kProjection;
+  // Fill-reducing ordering of the CHOLMOD factor.
+  CholmodOrdering ordering = CholmodOrdering::kMetis;
 
   // Throws InputError "<prefix><field> = <value> is invalid: <allowed>" for the first invalid
   // field (prefix e.g. "integrator.options.").

@@ -32,7 +32,7 @@ class Xpbd final : public Integrator {
   // The springs are solved implicitly (compliant constraints): stable at any step.
   bool is_implicit() const override { return true; }
   bool resolves_contact() const override {
-    return options_.contact == "projection" && terrains_seen_;
+    return options_.contact == PositionContactMode::kProjection && terrains_seen_;
   }
   int contacts_resolved() const override;
   // steps, substeps, sweeps, contact_restitution_limited.

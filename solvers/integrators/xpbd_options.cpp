@@ -9,8 +9,8 @@ void XpbdOptions::validate(const std::string& prefix) const {
           "an integer in [1, 100000]");
   require(iterations >= 1 && iterations <= 10000, prefix + "iterations", iterations,
           "an integer in [1, 10000]");
-  require(contact == "projection" || contact == "after_step", prefix + "contact",
-          "\"" + contact + "\"", "\"projection\" or \"after_step\"");
+  require(name_of(position_contact_modes(), contact) != "unknown", prefix + "contact",
+          static_cast<int>(contact), "one of " + quoted_names(position_contact_modes()));
 }
 
 }  // namespace jelly
@@ -21,7 +21,10 @@ XpbdOptions XpbdOptions::read(JsonFields& f) {
   XpbdOptions o;
   o.substeps = f.integer_or("substeps", o.substeps);
   o.iterations = f.integer_or("iterations", o.iterations);
-  o.contact = f.string_or("contact", o.contact);
+  o.contact =
+      value_of(position_contact_modes(),
+               f.string_or("contact", std::string(name_of(position_contact_modes(), o.contact))),
+               f.path("contact"));
   o.validate(f.prefix());
   return o;
 }
@@ -30,7 +33,7 @@ Json XpbdOptions::to_json() const {
   Json out = Json::object();
   out["substeps"] = substeps;
   out["iterations"] = iterations;
-  out["contact"] = contact;
+  out["contact"] = std::string(name_of(position_contact_modes(), contact));
   return out;
 }
 

@@ -4,6 +4,7 @@
 
 #include <jelly/core/json.hpp>
 #include <jelly/core/types.hpp>
+#include <jelly/solvers/integrators/projective_dynamics_options.hpp>  // PositionContactMode
 
 namespace jelly {
 
@@ -15,10 +16,10 @@ struct XpbdOptions {
   // too soft at frame-sized substeps: the seed jelly landing at 11 m/s at 1/60 s is crushed
   // (inverted springs, +87 % energy); two hold it (docs/realtime.md).
   int iterations = 2;
-  // How coulomb terrains enter the step: "projection" (position constraints with friction in
-  // every sweep, restitution after each substep) or "after_step" (the explicit integrators'
-  // resolve after the step).
-  std::string contact = "projection";
+  // How coulomb terrains enter the step: kProjection (position constraints with friction in
+  // every sweep, restitution after each substep) or kAfterStep (the explicit integrators'
+  // resolve after the step). Names: position_contact_modes().
+  PositionContactMode contact = PositionContactMode::kProjection;
 
   // Throws InputError "<prefix><field> = <value> is invalid: <allowed>" for the first invalid
   // field (prefix e.g. "integrator.options.").

@@ -24,7 +24,7 @@ TEST(SceneRealtimeOptions, RoundTrip) {
   const Scene pd_again = parse_scene(scene_to_json(pd));
   EXPECT_EQ(pd_again.integrator.options.pd.iterations, 7);
   EXPECT_EQ(pd_again.integrator.options.pd.tolerance, 1e-6);
-  EXPECT_EQ(pd_again.integrator.options.pd.ordering, "amd");
+  EXPECT_EQ(pd_again.integrator.options.pd.ordering, CholmodOrdering::kAmd);
   EXPECT_NO_THROW(make_simulator(pd));
 
   const Scene xpbd = parse_scene(
@@ -33,7 +33,7 @@ TEST(SceneRealtimeOptions, RoundTrip) {
   const Scene xpbd_again = parse_scene(scene_to_json(xpbd));
   EXPECT_EQ(xpbd_again.integrator.options.xpbd.substeps, 8);
   EXPECT_EQ(xpbd_again.integrator.options.xpbd.iterations, 1);
-  EXPECT_EQ(xpbd_again.integrator.options.xpbd.contact, "after_step");
+  EXPECT_EQ(xpbd_again.integrator.options.xpbd.contact, PositionContactMode::kAfterStep);
   EXPECT_NO_THROW(make_simulator(xpbd));
 }
 
@@ -44,6 +44,29 @@ TEST(SceneRealtimeOptions, BadOptionsNameTheirPath) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::StartsWith("integrator.options.substeps = 0 is invalid"));
   }
+  // Named choices come from their enum tables (core/enum_names.hpp): the message lists them.
+  try {
+    parse_scene(kScene,
+                {"integrator.name=projective_dynamics", "integrator.options.contact=\"implicit\""});
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(
+        e.what(),
+        ::testing::StartsWith(
+            R"(integrator.options.contact = "implicit" is invalid: one of "projection", "after_step")"));
+  }
+  try {
+    parse_scene(kScene,
+                {"integrator.name=projective_dynamics", "integrator.options.ordering=\"colamd\""});
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(
+        e.what(),
+        ::testing::StartsWith(
+            R"(integrator.options.ordering = "colamd" is invalid: one of "amd", "metis", "nesdis", "best")"));
+  }
+  EXPECT_THROW(parse_scene(kScene, {"integrator.name=xpbd", "integrator.options.contact=\"x\""}),
+               InputError);
   // substeps belongs to xpbd, not to projective_dynamics.
   EXPECT_THROW(
       parse_scene(kScene, {"integrator.name=projective_dynamics", "integrator.options.substeps=2"}),

@@ -151,7 +151,10 @@ TEST(RealtimeOptions, InvalidOptionsNameTheField) {
   o.pd.chebyshev_rho = 1;
   EXPECT_THROW(make_integrator("projective_dynamics", o), InputError);
   o = {};
-  o.pd.contact = "implicit";
+  o.pd.contact = static_cast<PositionContactMode>(7);  // not in the table
+  EXPECT_THROW(make_integrator("projective_dynamics", o), InputError);
+  o = {};
+  o.pd.ordering = static_cast<CholmodOrdering>(9);
   EXPECT_THROW(make_integrator("projective_dynamics", o), InputError);
   o = {};
   o.xpbd.substeps = 0;
