@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
 
@@ -85,6 +87,10 @@ void spring_jacobian_blocks(const Model& model, const VecX& x, const VecX& v,
   }
 }
 
+// Column particles per thread below which another thread costs more than it saves (each has
+// about 30 springs at the seed lattice's 26 neighbours).
+constexpr long kMinColumnsPerThread = 256;
+
 SpringJacobian::SpringJacobian(const Model& model) : num_particles_(model.num_particles()) {
   const Springs& s = model.springs;
   const int n = num_particles_;
@@ -93,51 +99,57 @@ SpringJacobian::SpringJacobian(const Model& model) : num_particles_(model.num_pa
             "springs.a/b", std::to_string(s.a[k]) + ", " + std::to_string(s.b[k]),
             "two different particle indices in [0, N)");
   }
-  // Neighbour lists (incl. the particle itself) of every particle, sorted and unique.
-  std::vector<std::vector<int>> neighbours(n);
-  for (int i = 0; i < n; ++i) neighbours[i].push_back(i);
+  // Adjacency (other particle, spring) of every particle, by counting sort on the particle and
+  // then sorted per particle by (other particle, spring).
+  adjacency_start_.assign(n + 1, 0);
   for (int k = 0; k < s.size(); ++k) {
-    neighbours[s.a[k]].push_back(s.b[k]);
-    neighbours[s.b[k]].push_back(s.a[k]);
+    ++adjacency_start_[s.a[k] + 1];
+    ++adjacency_start_[s.b[k] + 1];
   }
-  for (auto& list : neighbours) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
+  for (int j = 0; j < n; ++j) adjacency_start_[j + 1] += adjacency_start_[j];
+  neighbour_.resize(2 * static_cast<size_t>(s.size()));
+  spring_.resize(neighbour_.size());
+  {
+    std::vector<int> fill(adjacency_start_.begin(), adjacency_start_.end() - 1);
+    for (int k = 0; k < s.size(); ++k) {
+      int e = fill[s.a[k]]++;
+      neighbour_[e] = s.b[k];
+      spring_[e] = k;
+      e = fill[s.b[k]]++;
+      neighbour_[e] = s.a[k];
+      spring_[e] = k;
+    }
   }
-  // Column 3j + c holds rows 3i, 3i + 1, 3i + 2 of every neighbour i of j, in order.
-  col_start_.assign(3 * n + 1, 0);
+  std::vector<std::pair<int, int>> pairs;
   column_stride_.resize(n);
+  self_slot_.resize(n);
   for (int j = 0; j < n; ++j) {
-    column_stride_[j] = 3 * static_cast<int>(neighbours[j].size());
+    const int begin = adjacency_start_[j], end = adjacency_start_[j + 1];
+    pairs.clear();
+    for (int e = begin; e < end; ++e) pairs.emplace_back(neighbour_[e], spring_[e]);
+    std::sort(pairs.begin(), pairs.end());
+    int distinct = 0, below = 0;
+    for (size_t q = 0; q < pairs.size(); ++q) {
+      neighbour_[begin + q] = pairs[q].first;
+      spring_[begin + q] = pairs[q].second;
+      if (q == 0 || pairs[q].first != pairs[q - 1].first) {
+        ++distinct;
+        if (pairs[q].first < j) ++below;
+      }
+    }
+    column_stride_[j] = 3 * (distinct + 1);
+    self_slot_[j] = below;
+  }
+  // Column 3j + c holds rows 3i, 3i + 1, 3i + 2 of every neighbour i of j and of j, in order.
+  col_start_.assign(3 * static_cast<size_t>(n) + 1, 0);
+  for (int j = 0; j < n; ++j) {
     for (int c = 0; c < 3; ++c)
       col_start_[3 * j + c + 1] = col_start_[3 * j + c] + column_stride_[j];
   }
-  row_index_.resize(col_start_.back());
-  diagonal_.resize(3 * n);
+  diagonal_.resize(3 * static_cast<size_t>(n));
   for (int j = 0; j < n; ++j) {
-    for (int c = 0; c < 3; ++c) {
-      int at = col_start_[3 * j + c];
-      for (int i : neighbours[j]) {
-        for (int r = 0; r < 3; ++r) {
-          if (i == j && r == c) diagonal_[3 * j + c] = at;
-          row_index_[at++] = 3 * i + r;
-        }
-      }
-    }
-  }
-  // Value index of entry (0, 0) of block (row particle i, column particle j).
-  const auto block = [&](int i, int j) {
-    const auto& list = neighbours[j];
-    const int pos = static_cast<int>(std::lower_bound(list.begin(), list.end(), i) - list.begin());
-    return col_start_[3 * j] + 3 * pos;
-  };
-  spring_base_.resize(4 * static_cast<size_t>(s.size()));
-  for (int k = 0; k < s.size(); ++k) {
-    const int a = s.a[k], b = s.b[k];
-    spring_base_[4 * k] = block(a, a);
-    spring_base_[4 * k + 1] = block(a, b);
-    spring_base_[4 * k + 2] = block(b, a);
-    spring_base_[4 * k + 3] = block(b, b);
+    for (int c = 0; c < 3; ++c)
+      diagonal_[3 * j + c] = col_start_[3 * j + c] + 3 * self_slot_[j] + c;
   }
 }
 
@@ -146,7 +158,24 @@ SparseMatrix SpringJacobian::make_matrix() const {
   SparseMatrix m(n, n);
   m.resizeNonZeros(non_zeros());
   std::copy(col_start_.begin(), col_start_.end(), m.outerIndexPtr());
-  std::copy(row_index_.begin(), row_index_.end(), m.innerIndexPtr());
+  int* rows_out = m.innerIndexPtr();
+  for (int j = 0; j < num_particles_; ++j) {
+    const int begin = adjacency_start_[j], end = adjacency_start_[j + 1];
+    for (int c = 0; c < 3; ++c) {
+      int at = col_start_[3 * j + c];
+      bool self_done = false;
+      for (int e = begin; e <= end; ++e) {
+        if (e < end && e > begin && neighbour_[e] == neighbour_[e - 1]) continue;
+        const int i = e < end ? neighbour_[e] : num_particles_;
+        if (!self_done && j < i) {
+          for (int r = 0; r < 3; ++r) rows_out[at++] = 3 * j + r;
+          self_done = true;
+        }
+        if (e == end) break;
+        for (int r = 0; r < 3; ++r) rows_out[at++] = 3 * i + r;
+      }
+    }
+  }
   std::fill(m.valuePtr(), m.valuePtr() + non_zeros(), 0.0);
   return m;
 }
@@ -156,84 +185,125 @@ bool SpringJacobian::matches(const SparseMatrix& m) const {
          m.nonZeros() == non_zeros();
 }
 
+template <class Column>
+void SpringJacobian::for_columns(int threads, Column&& column) const {
+  const int team = parallel::team_size(threads, num_particles_, kMinColumnsPerThread);
+  parallel::run(team, [&](int part, int parts) {
+    const parallel::Range r = parallel::split(num_particles_, part, parts);
+    for (long j = r.begin; j < r.end; ++j) column(static_cast<int>(j));
+  });
+}
+
+namespace {
+
+// Writes the row-major 3x3 block `b` into slot `slot` of the three columns starting at `col`.
+inline void write_block(Real* col, int stride, int slot, const Real* b) {
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) col[c * stride + 3 * slot + r] = b[3 * r + c];
+}
+
+}  // namespace
+
 void SpringJacobian::assemble(const Model& model, const VecX& x, const VecX& v,
-                              const JacobianOptions& options, SparseMatrix& k,
-                              SparseMatrix& d) const {
+                              const JacobianOptions& options, SparseMatrix& k, SparseMatrix& d,
+                              int threads) const {
   require(matches(k) && matches(d), "jacobian.matrix", k.rows(),
           "matrices made by this SpringJacobian's make_matrix()");
   Real* kv = k.valuePtr();
   Real* dv = d.valuePtr();
-  std::fill(kv, kv + non_zeros(), 0.0);
-  std::fill(dv, dv + non_zeros(), 0.0);
   const Springs& s = model.springs;
-  SpringBlocks blocks;
-  for (int sp = 0; sp < s.size(); ++sp) {
-    const int a = s.a[sp], b = s.b[sp];
-    spring_blocks(x.data(), v.data(), model.rest_position.data(), 3 * a, 3 * b, s.rest_length[sp],
-                  s.ks[sp], s.kd[sp], options, blocks);
-    const int* base = &spring_base_[4 * sp];
-    const int stride[4] = {column_stride_[a], column_stride_[b], column_stride_[a],
-                           column_stride_[b]};
-    const Real sign[4] = {1, -1, -1, 1};
-    for (int q = 0; q < 4; ++q) {
-      for (int c = 0; c < 3; ++c) {
-        const int at = base[q] + c * stride[q];
-        for (int r = 0; r < 3; ++r) {
-          kv[at + r] += sign[q] * blocks.k[3 * r + c];
-          dv[at + r] += sign[q] * blocks.d[3 * r + c];
+  const Real* px = x.data();
+  const Real* pv = v.data();
+  const Real* pr = model.rest_position.data();
+  // Column j, row block i (spring k = (j, i)): df_i/dx_j = -K_k; the diagonal block sums K_k.
+  for_columns(threads, [&](int j) {
+    const int stride = column_stride_[j];
+    Real* kcol = kv + col_start_[3 * j];
+    Real* dcol = dv + col_start_[3 * j];
+    Real kdiag[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    Real ddiag[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    const int end = adjacency_start_[j + 1];
+    int e = adjacency_start_[j];
+    const int blocks = stride / 3;
+    SpringBlocks sb;
+    for (int slot = 0; slot < blocks; ++slot) {
+      if (slot == self_slot_[j]) continue;
+      const int i = neighbour_[e];
+      Real koff[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+      Real doff[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+      for (; e < end && neighbour_[e] == i; ++e) {
+        const int sp = spring_[e];
+        spring_blocks(px, pv, pr, 3 * j, 3 * i, s.rest_length[sp], s.ks[sp], s.kd[sp], options, sb);
+        for (int q = 0; q < 9; ++q) {
+          koff[q] -= sb.k[q];
+          doff[q] -= sb.d[q];
+          kdiag[q] += sb.k[q];
+          ddiag[q] += sb.d[q];
         }
       }
+      write_block(kcol, stride, slot, koff);
+      write_block(dcol, stride, slot, doff);
     }
-  }
+    write_block(kcol, stride, self_slot_[j], kdiag);
+    write_block(dcol, stride, self_slot_[j], ddiag);
+  });
 }
 
 void SpringJacobian::assemble_system(const Model& model, const VecX& x, const VecX& v,
                                      const JacobianOptions& options, Real alpha, Real beta,
-                                     SparseMatrix& a_matrix, const VecX& w, VecX& kw) const {
+                                     SparseMatrix& a_matrix, const VecX& w, VecX& kw,
+                                     int threads) const {
   require(matches(a_matrix), "jacobian.matrix", a_matrix.rows(),
           "a matrix made by this SpringJacobian's make_matrix()");
   require(!options.exact_damper, "jacobian.exact_damper", "true",
           "false for the (symmetric) system matrix");
+  require(kw.size() == rows() && w.size() == rows(), "jacobian.kw", kw.size(),
+          "vectors of 3N entries");
   Real* av = a_matrix.valuePtr();
-  std::fill(av, av + non_zeros(), 0.0);
-  kw.setZero();
   const Real* m = model.mass.data();
-  for (int i = 0; i < rows(); ++i) av[diagonal_[i]] = m[i / 3];
   const Springs& s = model.springs;
+  const Real* px = x.data();
+  const Real* pv = v.data();
+  const Real* pr = model.rest_position.data();
   const Real* pw = w.data();
   Real* pkw = kw.data();
-  SpringBlocks blocks;
-  Real ab[9];
-  for (int sp = 0; sp < s.size(); ++sp) {
-    const int a = s.a[sp], b = s.b[sp];
-    const int ia = 3 * a, ib = 3 * b;
-    spring_blocks(x.data(), v.data(), model.rest_position.data(), ia, ib, s.rest_length[sp],
-                  s.ks[sp], s.kd[sp], options, blocks);
-    // Block of A = -alpha D - beta K; kw_a += K (wa - wb), kw_b -= K (wa - wb).
-    const Real dw[3] = {pw[ia] - pw[ib], pw[ia + 1] - pw[ib + 1], pw[ia + 2] - pw[ib + 2]};
-    for (int r = 0; r < 3; ++r) {
-      const Real kdw =
-          blocks.k[3 * r] * dw[0] + blocks.k[3 * r + 1] * dw[1] + blocks.k[3 * r + 2] * dw[2];
-      pkw[ia + r] += kdw;
-      pkw[ib + r] -= kdw;
-    }
-    for (int e = 0; e < 9; ++e) ab[e] = -alpha * blocks.d[e] - beta * blocks.k[e];
-    const int* base = &spring_base_[4 * sp];
-    const int sa = column_stride_[a], sb = column_stride_[b];
-    for (int c = 0; c < 3; ++c) {
-      Real* aa = av + base[0] + c * sa;
-      Real* abk = av + base[1] + c * sb;
-      Real* ba = av + base[2] + c * sa;
-      Real* bb = av + base[3] + c * sb;
-      for (int r = 0; r < 3; ++r) {
-        const Real e = ab[3 * r + c];
-        aa[r] += e;
-        abk[r] -= e;
-        ba[r] -= e;
-        bb[r] += e;
+  // Column j: the block of spring k = (j, i) from j's side, ab = -alpha D_k - beta K_k, is
+  // added to the diagonal block and subtracted at row block i; (K w)_j = sum K_k (w_j - w_i).
+  for_columns(threads, [&](int j) {
+    const int stride = column_stride_[j];
+    Real* col = av + col_start_[3 * j];
+    const Real mj = m[j];
+    Real diag[9] = {mj, 0, 0, 0, mj, 0, 0, 0, mj};
+    Real kwj[3] = {0, 0, 0};
+    const Real* wj = pw + 3 * j;
+    const int end = adjacency_start_[j + 1];
+    int e = adjacency_start_[j];
+    const int blocks = stride / 3;
+    SpringBlocks sb;
+    for (int slot = 0; slot < blocks; ++slot) {
+      if (slot == self_slot_[j]) continue;
+      const int i = neighbour_[e];
+      const Real* wi = pw + 3 * i;
+      const Real dw[3] = {wj[0] - wi[0], wj[1] - wi[1], wj[2] - wi[2]};
+      Real off[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+      for (; e < end && neighbour_[e] == i; ++e) {
+        const int sp = spring_[e];
+        spring_blocks(px, pv, pr, 3 * j, 3 * i, s.rest_length[sp], s.ks[sp], s.kd[sp], options, sb);
+        for (int r = 0; r < 3; ++r)
+          kwj[r] += sb.k[3 * r] * dw[0] + sb.k[3 * r + 1] * dw[1] + sb.k[3 * r + 2] * dw[2];
+        for (int q = 0; q < 9; ++q) {
+          const Real ab = -alpha * sb.d[q] - beta * sb.k[q];
+          off[q] -= ab;
+          diag[q] += ab;
+        }
       }
+      write_block(col, stride, slot, off);
     }
-  }
+    write_block(col, stride, self_slot_[j], diag);
+    pkw[3 * j] = kwj[0];
+    pkw[3 * j + 1] = kwj[1];
+    pkw[3 * j + 2] = kwj[2];
+  });
 }
 
 }  // namespace jelly

@@ -50,6 +50,8 @@ class Dynamics {
   const ContactSolver& contacts() const { return *contacts_; }
   // The terrains of the scene, or null.
   const Terrains* terrains() const { return terrains_; }
+  // The vectorised force loop's bands (core/detail/spring_bands.hpp), or null.
+  const SpringBands* bands() const { return bands_; }
   // The anchor springs, or null when there are none.
   const AnchorSprings* anchors() const { return anchors_; }
   long force_evaluations() const { return evaluations_; }

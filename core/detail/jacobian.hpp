@@ -1,6 +1,8 @@
 #pragma once
 // Sparse Jacobians df/dx (K) and df/dv (D) of the spring and damper forces on one fixed 3x3-block
-// sparsity pattern, built once with a scatter map; each assembly only refills the values.
+// sparsity pattern, built once with a per-particle neighbour list; each assembly only refills the
+// values, column by column (a gather: every column is written by one thread, in one order, so
+// the values are the same bit for bit for any thread count; docs/threads.md).
 #include <vector>
 
 #include <jelly/core/definiteness.hpp>
@@ -33,21 +35,24 @@ class SpringJacobian {
   explicit SpringJacobian(const Model& model);
 
   int rows() const { return 3 * num_particles_; }
-  int non_zeros() const { return static_cast<int>(row_index_.size()); }
-  int num_springs() const { return static_cast<int>(spring_base_.size() / 4); }
+  int non_zeros() const { return col_start_.back(); }
+  int num_springs() const { return static_cast<int>(neighbour_.size() / 2); }
   // A matrix with this pattern and zero values (allocates; call once).
   SparseMatrix make_matrix() const;
   // True when `m` has this pattern's size (the matrices passed below must come from make_matrix).
   bool matches(const SparseMatrix& m) const;
 
-  // K = df/dx and D = df/dv of the spring and damper forces at (x, v). No allocation.
+  // K = df/dx and D = df/dv of the spring and damper forces at (x, v), on up to `threads`
+  // threads. No allocation.
   void assemble(const Model& model, const VecX& x, const VecX& v, const JacobianOptions& options,
-                SparseMatrix& k, SparseMatrix& d) const;
+                SparseMatrix& k, SparseMatrix& d, int threads = 1) const;
   // The backward-Euler matrix A = M - alpha D - beta K and kw = K w, in one pass over the
-  // springs (K as assembled with `options`, which must not set exact_damper). No allocation.
+  // columns (K as assembled with `options`, which must not set exact_damper), on up to
+  // `threads` threads (each spring's blocks are computed for both of its columns). No
+  // allocation.
   void assemble_system(const Model& model, const VecX& x, const VecX& v,
                        const JacobianOptions& options, Real alpha, Real beta, SparseMatrix& a,
-                       const VecX& w, VecX& kw) const;
+                       const VecX& w, VecX& kw, int threads = 1) const;
   // Adds `value` to entry (dof, dof) of a matrix with this pattern (an external force's
   // diagonal Jacobian, core/anchor_springs.hpp).
   void add_to_diagonal(SparseMatrix& m, int dof, Real value) const {
@@ -55,12 +60,21 @@ class SpringJacobian {
   }
 
  private:
+  // Calls column(j, begin, end) for the column particles j of a static split of [0, N).
+  template <class Column>
+  void for_columns(int threads, Column&& column) const;
+
   int num_particles_ = 0;
   std::vector<int> col_start_;      // [3N + 1]
-  std::vector<int> row_index_;      // [nnz]
-  std::vector<int> spring_base_;    // [4 M]: value index of entry (0, 0) of blocks aa, ab, ba, bb
   std::vector<int> column_stride_;  // [N]: distance between columns 3j and 3j + 1 of particle j
   std::vector<int> diagonal_;       // [3N]: value index of entry (i, i)
+  // Per particle j, its springs sorted by the other particle i (then by spring):
+  // neighbour_[e], spring_[e] for e in [adjacency_start_[j], adjacency_start_[j + 1]). The row
+  // blocks of column j are its distinct neighbours and j itself (at self_slot_[j]), in order.
+  std::vector<int> adjacency_start_;  // [N + 1]
+  std::vector<int> neighbour_;        // [2M]
+  std::vector<int> spring_;           // [2M]
+  std::vector<int> self_slot_;        // [N]
 };
 
 }  // namespace jelly

@@ -280,6 +280,73 @@ void ImplicitContact::unconstrain(SparseMatrix& a) const {
   }
 }
 
+bool ImplicitContact::constrain_rhs(const VecX& b, bool prescribe, const VecX* a_z, VecX& rhs,
+                                    VecX& z, VecX& guess) {
+  if (a_z == nullptr) {
+    z.setZero();
+    bool any = false;
+    if (!prescribe) return false;
+    for (const Contact& c : contacts_) {
+      const Vec3 v0 = particle(v0_, c.particle);
+      Vec3 dz;
+      if (c.pinned) {
+        dz = c.target_velocity - v0;
+      } else if (c.mode == Mode::kStick) {
+        dz = tangential(c.surface_velocity, c.normal) + c.target_normal * c.normal - v0;
+      } else {
+        dz = (c.target_normal - v0.dot(c.normal)) * c.normal;
+      }
+      particle(z, c.particle) = dz;
+      any = any || dz != Vec3::Zero();
+    }
+    return any;
+  }
+  // rhs = S (b - C w0 - A z).
+  rhs = b - *a_z;
+  if (prescribe) {
+    for (const Contact& c : contacts_) {
+      if (c.pinned || c.mode != Mode::kSlide) continue;
+      const Vec3 v0 = particle(v0_, c.particle);
+      particle(rhs, c.particle) -= c.viscosity * tangential(v0 - c.surface_velocity, c.normal);
+    }
+  }
+  for (const Contact& c : contacts_) {
+    const Mat3 sc = free_projector(c);
+    particle(rhs, c.particle) = sc * particle(rhs, c.particle);
+    particle(guess, c.particle) = sc * particle(guess, c.particle);
+  }
+  return true;
+}
+
+void ImplicitContact::filter_input(const VecX& p, VecX& q) const {
+  q = p;
+  for (const Contact& c : contacts_)
+    particle(q, c.particle) = free_projector(c) * particle(p, c.particle);
+}
+
+void ImplicitContact::filter_output(const VecX& p, VecX& y) const {
+  for (const Contact& c : contacts_) {
+    const Mat3 sc = free_projector(c);
+    const Real viscosity = c.mode == Mode::kSlide && !c.pinned ? c.viscosity : 0.0;
+    const Vec3 pc = particle(p, c.particle);
+    particle(y, c.particle) = sc * particle(y, c.particle) + viscosity * (sc * pc) + (pc - sc * pc);
+  }
+}
+
+bool ImplicitContact::filter_diagonal_block(int i, Real block[9]) const {
+  if (i < 0 || i >= static_cast<int>(slot_.size()) || slot_[i] < 0) return false;
+  const Contact& c = contacts_[slot_[i]];
+  const Mat3 sc = free_projector(c);
+  Mat3 d;
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) d(r, q) = block[3 * r + q];
+  const Real viscosity = c.mode == Mode::kSlide && !c.pinned ? c.viscosity : 0.0;
+  const Mat3 f = sc * d * sc + viscosity * sc + Mat3::Identity() - sc;
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) block[3 * r + q] = f(r, q);
+  return true;
+}
+
 void ImplicitContact::project(VecX& w) const {
   for (const Contact& c : contacts_)
     particle(w, c.particle) = free_projector(c) * particle(w, c.particle);
@@ -327,6 +394,36 @@ void ImplicitContact::subtract_friction(const VecX& v1, VecX& w) const {
 
 bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX& dv, bool commit,
                              SparseMatrix& a) {
+  // p = (A dv - b)_c from the original column (A is symmetric).
+  return update_impl(
+      terrains, dv, commit,
+      [&](int ci, const Contact& c) {
+        const BlockColumn col = block_column(a, c.particle);
+        const Real* orig = saved_.data() + saved_at_[ci];
+        Vec3 p = -particle(b, c.particle);
+        for (int k = 0; k < col.blocks(); ++k) {
+          const int i = row_particle(a, col, k);
+          for (int q = 0; q < 3; ++q)
+            for (int r = 0; r < 3; ++r) p[q] += orig[q * col.stride + 3 * k + r] * dv[3 * i + r];
+        }
+        return p;
+      },
+      [&] { unconstrain(a); });
+}
+
+bool ImplicitContact::update_from_product(const Terrains& terrains, const VecX& b, const VecX& dv,
+                                          bool commit, const VecX& a_dv) {
+  return update_impl(
+      terrains, dv, commit,
+      [&](int, const Contact& c) {
+        return Vec3(particle(a_dv, c.particle) - particle(b, c.particle));
+      },
+      [] {});
+}
+
+template <class Impulse, class Unconstrain>
+bool ImplicitContact::update_impl(const Terrains& terrains, const VecX& dv, bool commit,
+                                  Impulse&& impulse, Unconstrain&& unconstrain_matrix) {
   bool changed = false;
   next_.clear();
   for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
@@ -335,16 +432,8 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
       next_.push_back(c);
       continue;
     }
-    // p = (A dv - b)_c from the original column (A is symmetric).
-    const BlockColumn col = block_column(a, c.particle);
-    const Real* orig = saved_.data() + saved_at_[ci];
     // (Sliding friction is tangential and only p_n of a sliding contact is used.)
-    Vec3 p = -particle(b, c.particle);
-    for (int k = 0; k < col.blocks(); ++k) {
-      const int i = row_particle(a, col, k);
-      for (int q = 0; q < 3; ++q)
-        for (int r = 0; r < 3; ++r) p[q] += orig[q * col.stride + 3 * k + r] * dv[3 * i + r];
-    }
+    const Vec3 p = impulse(ci, c);
     const Vec3& n = c.normal;
     const Real pn = p.dot(n);
     c.normal_impulse = pn;
@@ -401,7 +490,7 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
   if (!changed) {  // same particles in the same order: keep the new impulses and friction
     contacts_.swap(next_);
   } else if (commit) {
-    unconstrain(a);
+    unconstrain_matrix();
     contacts_.swap(next_);
     index_contacts();
     ++counters_.extra_solves;

@@ -1,11 +1,14 @@
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
 
 #include <jelly/core/detail/anchor_jacobian.hpp>
+#include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
@@ -52,7 +55,17 @@ struct ImplicitEuler::Impl {
   }
   void add_statistics(Statistics& s) const;
   StepResult step(const Dynamics& dynamics, State& state, Real h);
-  StepResult prepare(const Model& model, Real h);
+  StepResult prepare(const Dynamics& dynamics, Real h);
+  // A = M - h D - h^2 K (+ anchors, wind drag) and kw_ = K w at (x, v), into a_ or band_.
+  StepResult assemble(const Dynamics& dynamics, const VecX& x, const VecX& v, Real t, Real h);
+  // The contact filter of the system and its right-hand side (constrain() of ImplicitContact,
+  // or its matrix-free counterpart).
+  void constrain(const VecX& b, bool prescribe, VecX& guess);
+  // The contacts' next active set after a solve (ImplicitContact::update).
+  bool update_contacts(const Terrains& terrains, const VecX& b, bool commit);
+  // Matrix-free block-Jacobi CG on band_ (filtered by the contacts when constrained).
+  StepResult solve_matrix_free(const Model& model, const VecX& b, VecX& y, bool constrained,
+                               Real t);
   // Factorizes A (filtered by the contact constraints, if any) and solves for dv_: the
   // linearized step, repeated while the contacts' active set changes.
   StepResult linearized_solve(const Dynamics& dynamics, const State& s, Real h);
@@ -69,7 +82,11 @@ struct ImplicitEuler::Impl {
     add_external_damping(model.external_forces, t, damping_);
     for (int i = 0; i < model.num_particles(); ++i) {
       if (damping_[i] == 0) continue;
-      for (int d = 0; d < 3; ++d) jacobian_->add_to_diagonal(a_, 3 * i + d, h * damping_[i]);
+      if (matrix_free_) {
+        band_->add_diagonal(i, h * damping_[i]);
+      } else {
+        for (int d = 0; d < 3; ++d) jacobian_->add_to_diagonal(a_, 3 * i + d, h * damping_[i]);
+      }
     }
   }
 
@@ -78,6 +95,15 @@ struct ImplicitEuler::Impl {
   std::optional<SpringJacobian> jacobian_;
   std::unique_ptr<LinearSolver> solver_;
   SparseMatrix a_;
+  // Matrix-free path (auto and block-Jacobi CG on a lattice whose springs fill the force loop's
+  // bands): no sparse matrix, A's blocks per spring (core/detail/band_system.hpp).
+  bool matrix_free_ = false;
+  bool matrix_free_failed_ = false;  // a collapsed spring: the assembled path from then on
+  std::optional<BandSystem> band_;
+  MatrixFreeCg band_cg_;
+  std::vector<Real> inverse_blocks_;
+  VecX az_, filtered_;
+  int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
   const Terrains* contact_terrains_ = nullptr;  // the terrains contact_ resolves this step
@@ -115,6 +141,7 @@ const std::vector<Real>& ImplicitEuler::last_residuals() const { return impl_->r
 bool ImplicitEuler::last_converged() const { return impl_->converged_; }
 
 std::string_view ImplicitEuler::linear_solver_name() const {
+  if (impl_->matrix_free_) return "cg_jacobi_matrix_free";
   return impl_->solver_ ? impl_->solver_->name() : std::string_view();
 }
 
@@ -129,7 +156,10 @@ StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
 }
 
 void ImplicitEuler::Impl::add_statistics(Statistics& s) const {
-  const LinearSolverCounters c = solver_ ? solver_->counters() : LinearSolverCounters{};
+  LinearSolverCounters c = solver_ ? solver_->counters() : LinearSolverCounters{};
+  const LinearSolverCounters& mf = band_cg_.counters();
+  c.solves += mf.solves;
+  c.cg_iterations += mf.cg_iterations;
   s["symbolic_analyses"] = static_cast<double>(c.analyses);
   s["numeric_factorizations"] = static_cast<double>(c.factorizations);
   s["linear_solves"] = static_cast<double>(c.solves);
@@ -169,19 +199,55 @@ void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
           "integrator state (warm start size)", n, "the size of a saved implicit_euler state");
   const size_t size = static_cast<size_t>(n);
   // A warm start of another size (another model) is dropped; prepare() sizes dv_ then.
-  m.have_dv_ = size > 0 && (!m.jacobian_ || static_cast<int>(size) == m.jacobian_->rows());
+  const int rows = m.jacobian_ ? m.jacobian_->rows() : m.band_ ? m.band_->rows() : -1;
+  m.have_dv_ = size > 0 && (rows < 0 || static_cast<int>(size) == rows);
   if (m.have_dv_) m.dv_ = Eigen::Map<const VecX>(data.data() + 1, static_cast<Eigen::Index>(size));
   m.contact_.restore(data.data() + 1 + size, data.size() - 1 - size);
 }
 
-StepResult ImplicitEuler::Impl::prepare(const Model& model, Real h) {
+StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
+  const Model& model = dynamics.model();
   const int n = model.num_dofs();
-  if (!jacobian_ || jacobian_->rows() != n || jacobian_->num_springs() != model.springs.size()) {
+  const bool automatic = options_.linear_solver == ImplicitLinearSolver::kAuto;
+  const ImplicitLinearSolver kind = automatic ? auto_linear_solver(n) : options_.linear_solver;
+  const SpringBands* bands = dynamics.bands();
+  // Block-Jacobi CG needs only products with A: from the bands when the springs fill them.
+  const bool matrix_free =
+      kind == ImplicitLinearSolver::kCg &&
+      (automatic || options_.cg_preconditioner == CgPreconditionerKind::kJacobi) &&
+      bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_;
+  const auto size_vectors = [&] {
+    for (VecX* w : {&f_, &kw_, &b_, &v1_, &x1_, &g_, &delta_, &rhs_, &z_})
+      if (w->size() != n) w->setZero(n);
+    if (dv_.size() != n) {  // (a restored warm start of the right size stays)
+      dv_.setZero(n);
+      have_dv_ = false;
+    }
+  };
+  if (matrix_free) {
+    if (!matrix_free_ || !band_ || !band_->built_for(*bands) || band_->rows() != n) {
+      const auto start = Clock::now();
+      jacobian_.reset();
+      solver_.reset();
+      a_ = SparseMatrix();
+      band_.emplace(*bands, model.num_particles());
+      inverse_blocks_.assign(3 * static_cast<size_t>(n), 0.0);
+      az_.setZero(n);
+      filtered_.setZero(n);
+      size_vectors();
+      matrix_free_ = true;
+      factorization_seconds_ += seconds_since(start);
+    }
+    last_h_ = h;
+    return StepResult::success();
+  }
+  if (matrix_free_ || !jacobian_ || jacobian_->rows() != n ||
+      jacobian_->num_springs() != model.springs.size()) {
     const auto start = Clock::now();
+    matrix_free_ = false;
+    band_.reset();
     jacobian_.emplace(model);
     a_ = jacobian_->make_matrix();
-    const bool automatic = options_.linear_solver == ImplicitLinearSolver::kAuto;
-    const ImplicitLinearSolver kind = automatic ? auto_linear_solver(n) : options_.linear_solver;
     CholmodOptions cholmod;
     cholmod.ordering = options_.ordering;
     if (kind == ImplicitLinearSolver::kCholmod) {
@@ -202,27 +268,113 @@ StepResult ImplicitEuler::Impl::prepare(const Model& model, Real h) {
     const LinearResult r = solver_->analyze(a_);
     factorization_seconds_ += seconds_since(start);
     if (!r.ok()) return StepResult::failure("implicit_euler: " + r.message);
-    f_.setZero(n);
-    kw_.setZero(n);
-    b_.setZero(n);
-    if (dv_.size() != n) {  // (a restored warm start of the right size stays)
-      dv_.setZero(n);
-      have_dv_ = false;
-    }
-    v1_.setZero(n);
-    x1_.setZero(n);
-    g_.setZero(n);
-    delta_.setZero(n);
-    rhs_.setZero(n);
-    z_.setZero(n);
+    size_vectors();
   }
   if (h != last_h_) solver_->invalidate();
   last_h_ = h;
   return StepResult::success();
 }
 
+StepResult ImplicitEuler::Impl::assemble(const Dynamics& dynamics, const VecX& x, const VecX& v,
+                                         Real t, Real h) {
+  const Model& model = dynamics.model();
+  if (matrix_free_ &&
+      !band_->assemble(model, x, v, jacobian_options_.definiteness, h, h * h, v, kw_, threads_)) {
+    // A collapsed spring (its direction from the rest positions): the assembled matrix.
+    matrix_free_failed_ = true;
+    if (StepResult r = prepare(dynamics, h); !r.ok) return r;
+    solver_->set_threads(threads_);
+  }
+  if (matrix_free_) {
+    if (dynamics.anchors() != nullptr) {
+      for (const AnchorSpring& anchor : *dynamics.anchors()) {
+        band_->add_diagonal(anchor.particle, h * anchor.damping + h * h * anchor.stiffness);
+        kw_.segment<3>(3 * anchor.particle) -= anchor.stiffness * v.segment<3>(3 * anchor.particle);
+      }
+    }
+  } else {
+    jacobian_->assemble_system(model, x, v, jacobian_options_, h, h * h, a_, v, kw_, threads_);
+    if (dynamics.anchors() != nullptr)
+      add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, v, kw_);
+  }
+  add_external_damping_system(model, t, h);
+  return StepResult::success();
+}
+
+void ImplicitEuler::Impl::constrain(const VecX& b, bool prescribe, VecX& guess) {
+  if (!matrix_free_) {
+    contact_.constrain(a_, b, prescribe, rhs_, z_, guess);
+    return;
+  }
+  if (contact_.constrain_rhs(b, prescribe, nullptr, rhs_, z_, guess)) {
+    band_->multiply(z_, az_, threads_);
+  } else {
+    az_.setZero();
+  }
+  contact_.constrain_rhs(b, prescribe, &az_, rhs_, z_, guess);
+}
+
+bool ImplicitEuler::Impl::update_contacts(const Terrains& terrains, const VecX& b, bool commit) {
+  if (!matrix_free_) return contact_.update(terrains, b, dv_, commit, a_);
+  band_->multiply(dv_, az_, threads_);
+  return contact_.update_from_product(terrains, b, dv_, commit, az_);
+}
+
+StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX& b, VecX& y,
+                                                  bool constrained, Real t) {
+  auto start = Clock::now();
+  // Block Jacobi: the inverses of the (filtered) diagonal blocks.
+  const int np = model.num_particles();
+  std::vector<int> bad(parallel::team_size(threads_, np, 1024), np);
+  parallel::run(static_cast<int>(bad.size()), [&](int part, int parts) {
+    const parallel::Range range = parallel::split(np, part, parts);
+    for (long i = range.begin; i < range.end; ++i) {
+      Real d[9];
+      band_->diagonal_block(static_cast<int>(i), d);
+      if (constrained) contact_.filter_diagonal_block(static_cast<int>(i), d);
+      const Eigen::Matrix3d block = Eigen::Map<const Eigen::Matrix<Real, 3, 3, Eigen::RowMajor>>(d);
+      Eigen::Matrix3d inverse;
+      bool invertible = false;
+      block.computeInverseWithCheck(inverse, invertible);
+      if (!invertible || !(block(0, 0) > 0 && block(1, 1) > 0 && block(2, 2) > 0)) {
+        bad[part] = static_cast<int>(i);
+        return;
+      }
+      Eigen::Map<Eigen::Matrix<Real, 3, 3, Eigen::RowMajor>> out(&inverse_blocks_[9 * i]);
+      out = inverse;
+    }
+  });
+  factorization_seconds_ += seconds_since(start);
+  const int first_bad = *std::min_element(bad.begin(), bad.end());
+  if (first_bad < np)
+    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(t) +
+                               " (not_positive_definite): CG: diagonal block " +
+                               std::to_string(first_bad + 1) + " is not positive definite");
+  start = Clock::now();
+  const auto apply = [&](const VecX& in, VecX& out) {
+    if (!constrained) {
+      band_->multiply(in, out, threads_);
+      return;
+    }
+    contact_.filter_input(in, filtered_);
+    band_->multiply(filtered_, out, threads_);
+    contact_.filter_output(in, out);
+  };
+  const LinearResult r = band_cg_.solve(apply, inverse_blocks_, b, y, options_.cg_tolerance,
+                                        options_.cg_max_iterations, threads_);
+  solve_seconds_ += seconds_since(start);
+  if (!r.ok())
+    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(t) + " (" +
+                               std::string(linear_status_name(r.status)) + "): " + r.message);
+  if (!y.allFinite())
+    return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
+  if (r.iterations > 0 && !constrained && !anchored_) restore_momentum(model.mass, b, y);
+  return StepResult::success();
+}
+
 StepResult ImplicitEuler::Impl::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
                                                     bool constrained, Real t) {
+  if (matrix_free_) return solve_matrix_free(model, b, y, constrained, t);
   auto start = Clock::now();
   LinearResult r = solver_->factorize(a_);
   factorization_seconds_ += seconds_since(start);
@@ -252,10 +404,8 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   if (!have_dv_) {  // first guess for CG: the explicit step h M^-1 f; later the last dv
     for (int i = 0; i < np; ++i) dv_.segment<3>(3 * i) = (h / m[i]) * f_.segment<3>(3 * i);
   }
-  jacobian_->assemble_system(model, s.x, s.v, jacobian_options_, h, h * h, a_, s.v, kw_);
   anchored_ = dynamics.anchors() != nullptr;
-  if (anchored_) add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, s.v, kw_);
-  add_external_damping_system(model, s.t + h, h);
+  if (StepResult r = assemble(dynamics, s.x, s.v, s.t + h, h); !r.ok) return r;
   b_ = h * (f_ + h * kw_);
   assembly_seconds_ += seconds_since(start);
   terrains_seen_ = dynamics.terrains() != nullptr;
@@ -269,7 +419,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   // Solve; with contacts, again while their active set changes.
   for (int round = 1;; ++round) {
     const bool constrained = contact_active_ && contact_.has_constraints();
-    if (constrained) contact_.constrain(a_, b_, true, rhs_, z_, dv_);
+    if (constrained) constrain(b_, true, dv_);
     if (StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t);
         !r.ok) {
       have_dv_ = false;
@@ -279,7 +429,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     ++newton_iterations_;
     if (!contact_active_) break;
     const bool last = round >= options_.contact_iterations;
-    if (!contact_.update(*terrains, b_, dv_, !last, a_) || last) break;
+    if (!update_contacts(*terrains, b_, !last) || last) break;
   }
   have_dv_ = true;
   return StepResult::success();
@@ -318,11 +468,9 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
     g_ = -g_;
     delta_.setZero();
     const auto start = Clock::now();
-    jacobian_->assemble_system(model, x1_, v1_, jacobian_options_, h, h * h, a_, v1_, kw_);
-    if (anchored_) add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, v1_, kw_);
-    add_external_damping_system(model, s.t + h, h);
+    if (StepResult r = assemble(dynamics, x1_, v1_, s.t + h, h); !r.ok) return r;
     assembly_seconds_ += seconds_since(start);
-    if (constrained) contact_.constrain(a_, g_, false, rhs_, z_, delta_);
+    if (constrained) constrain(g_, false, delta_);
     if (StepResult r =
             factorize_and_solve(model, constrained ? rhs_ : g_, delta_, constrained, s.t);
         !r.ok)
@@ -336,7 +484,9 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
 }
 
 StepResult ImplicitEuler::Impl::step(const Dynamics& dynamics, State& s, Real h) {
-  if (StepResult r = prepare(dynamics.model(), h); !r.ok) return r;
+  threads_ = dynamics.threads();
+  if (StepResult r = prepare(dynamics, h); !r.ok) return r;
+  if (solver_) solver_->set_threads(threads_);
   if (StepResult r = linearized_solve(dynamics, s, h); !r.ok) return r;
   v1_ = s.v + dv_;
   residuals_.clear();

@@ -8,6 +8,8 @@
 
 #include <Eigen/LU>
 
+#include <jelly/core/detail/parallel.hpp>
+
 namespace jelly {
 
 namespace {
@@ -38,6 +40,131 @@ bool has_block3_pattern(const SparseMatrix& a) {
 
 }  // namespace
 
+// The vectors of CG and its threaded vector operations.
+struct CgWork {
+  int threads = 1;
+  std::vector<Real> partials;
+  VecX r, z, p, q;
+
+  void resize(Eigen::Index n) {
+    if (r.size() == n) return;
+    r.setZero(n);
+    z.setZero(n);
+    p.setZero(n);
+    q.setZero(n);
+  }
+  // Sum of f(begin, end) over fixed chunks of [0, n), in chunk order (parallel::ordered_sum).
+  template <class ChunkSum>
+  Real sum(ChunkSum&& f) {
+    return parallel::ordered_sum(threads, r.size(), partials, f);
+  }
+  // body(begin, end) over a static split of [0, n) (boundaries multiples of 3).
+  template <class Body>
+  void for_entries(Body&& body) {
+    const long n = r.size();
+    parallel::run(parallel::team_size(threads, n), [&](int part, int parts) {
+      const parallel::Range range = parallel::split(n, part, parts, 3);
+      if (range.begin < range.end) body(range.begin, range.end);
+    });
+  }
+};
+
+// Preconditioned CG from x on A x = b; every vector operation on a static split and every sum in
+// fixed chunks: the iterates are the same bits for any number of threads.
+template <class Apply, class Precondition>
+LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition&& precondition,
+                    const VecX& b, VecX& x, int max_iterations, LinearSolverCounters& counters) {
+  VecX& r_ = work.r;
+  VecX& z_ = work.z;
+  VecX& p_ = work.p;
+  VecX& q_ = work.q;
+  const auto sum = [&work](auto&& f) { return work.sum(f); };
+  const auto for_entries = [&work](auto&& f) { work.for_entries(f); };
+  // Every vector operation on a static split and every sum in fixed chunks: the iterates are
+  // the same bits for any number of threads.
+  const Real* pb = b.data();
+  Real* px = x.data();
+  Real* pr = r_.data();
+  Real* pz = z_.data();
+  Real* pp = p_.data();
+  Real* pq = q_.data();
+  const Real b_norm = std::sqrt(sum([&](long begin, long end) {
+    Real s = 0;
+    for (long i = begin; i < end; ++i) s += pb[i] * pb[i];
+    return s;
+  }));
+  LinearResult result;
+  if (b_norm == 0) {
+    x.setZero();
+    return result;
+  }
+  multiply(x, q_);
+  Real r_norm = std::sqrt(sum([&](long begin, long end) {
+    Real s = 0;
+    for (long i = begin; i < end; ++i) {
+      pr[i] = pb[i] - pq[i];
+      s += pr[i] * pr[i];
+    }
+    return s;
+  }));
+  const Real target = tolerance * b_norm;
+  const auto dot = [&](const Real* u, const Real* w) {
+    return sum([&](long begin, long end) {
+      Real s = 0;
+      for (long i = begin; i < end; ++i) s += u[i] * w[i];
+      return s;
+    });
+  };
+  int k = 0;
+  if (r_norm > target) {
+    precondition(r_, z_);
+    for_entries([&](long begin, long end) { std::copy(pz + begin, pz + end, pp + begin); });
+    Real rz = dot(pr, pz);
+    while (k < max_iterations) {
+      multiply(p_, q_);
+      const Real curvature = dot(pp, pq);
+      if (!(curvature > 0)) {
+        result = LinearResult::failure(
+            LinearStatus::kNotPositiveDefinite,
+            "CG: non-positive curvature p^T A p = " + std::to_string(curvature) + " at iteration " +
+                std::to_string(k + 1) + ": matrix not positive definite");
+        break;
+      }
+      const Real alpha = rz / curvature;
+      r_norm = std::sqrt(sum([&](long begin, long end) {
+        Real s = 0;
+        for (long i = begin; i < end; ++i) {
+          px[i] += alpha * pp[i];
+          pr[i] -= alpha * pq[i];
+          s += pr[i] * pr[i];
+        }
+        return s;
+      }));
+      ++k;
+      if (r_norm <= target || !std::isfinite(r_norm)) break;
+      precondition(r_, z_);
+      const Real rz_next = dot(pr, pz);
+      const Real beta = rz_next / rz;
+      rz = rz_next;
+      for_entries([&](long begin, long end) {
+        for (long i = begin; i < end; ++i) pp[i] = pz[i] + beta * pp[i];
+      });
+    }
+  }
+  counters.cg_iterations += k;
+  result.iterations = k;
+  result.residual = r_norm / b_norm;
+  if (result.ok() && !(r_norm <= target)) {
+    result = LinearResult::failure(LinearStatus::kNotConverged,
+                                   "CG: relative residual " + std::to_string(r_norm / b_norm) +
+                                       " after " + std::to_string(k) + " iterations (tolerance " +
+                                       std::to_string(tolerance) + ")");
+    result.iterations = k;
+    result.residual = r_norm / b_norm;
+  }
+  return result;
+}
+
 struct CgSolver::Impl {
   explicit Impl(const CgOptions& o) : options_(o) {}
 
@@ -46,24 +173,26 @@ struct CgSolver::Impl {
   LinearResult solve(const VecX& b, VecX& x, LinearSolverCounters& counters);
   LinearResult run(const VecX& b, VecX& x, int max_iterations, LinearSolverCounters& counters);
   void precondition(const VecX& r, VecX& z);
-  void multiply(const VecX& x, VecX& y) const;  // y = A x
+  void multiply(const VecX& x, VecX& y);  // y = A x
+  template <class Body>
+  void for_entries(Body&& body) {
+    work_.threads = threads_;
+    work_.for_entries(body);
+  }
 
   bool block3_ = false;  // columns 3j, 3j + 1, 3j + 2 share one row pattern (3x3 blocks)
   std::vector<int> diagonal_block_;     // [N]: value index of diagonal block (0, 0), when block3_
   std::vector<double> inverse_blocks_;  // [9 N]: inverses of the 3x3 diagonal blocks
-  // Upper block triangle of A (block3_): for column block j, blocks (i, j) with i <= j, each
-  // 9 values row-major; half the memory traffic of the full matrix per mat-vec.
-  std::vector<int> upper_start_;    // [N + 1] first block of column block j
-  std::vector<int> upper_row_;      // [blocks] row block i
-  std::vector<int> upper_source_;   // [blocks] value index of entry (0, 0) of the block in A
-  std::vector<Real> upper_values_;  // [9 blocks]
-  double factor_seconds_ = 0;       // CPU time of the last refresh of the lagged factor
-  double lagged_seconds_ = 0;       // ... plus the CPU time of the solves since
-  long lagged_solves_ = 0;          // solves since the last refresh
+  std::vector<long> bad_blocks_;        // per thread: its first non-positive diagonal block
+  double factor_seconds_ = 0;           // CPU time of the last refresh of the lagged factor
+  double lagged_seconds_ = 0;           // ... plus the CPU time of the solves since
+  long lagged_solves_ = 0;              // solves since the last refresh
 
   CgOptions options_;
+  int threads_ = 1;
   const SparseMatrix* a_ = nullptr;
-  VecX inverse_diagonal_, r_, z_, p_, q_;
+  VecX inverse_diagonal_;
+  CgWork work_;
   std::unique_ptr<CholmodSolver> factor_;
   bool stale_ = true;   // the next factorize must refactor
   bool fresh_ = false;  // the factor is of the current matrix
@@ -90,6 +219,8 @@ LinearResult CgSolver::solve(const VecX& b, VecX& x) { return impl_->solve(b, x,
 
 void CgSolver::invalidate() { impl_->stale_ = true; }
 
+void CgSolver::set_threads(int threads) { impl_->threads_ = std::max(1, threads); }
+
 long CgSolver::preconditioner_factorizations() const {
   return impl_->preconditioner_factorizations_;
 }
@@ -100,10 +231,8 @@ LinearResult CgSolver::Impl::analyze(const SparseMatrix& a, LinearSolverCounters
                                  "CG: the matrix must be square and compressed");
   const Eigen::Index n = a.rows();
   inverse_diagonal_.setZero(n);
-  r_.setZero(n);
-  z_.setZero(n);
-  p_.setZero(n);
-  q_.setZero(n);
+  work_.r.resize(0);
+  work_.resize(n);
   a_ = nullptr;
   stale_ = true;
   block3_ = has_block3_pattern(a);
@@ -123,22 +252,6 @@ LinearResult CgSolver::Impl::analyze(const SparseMatrix& a, LinearSolverCounters
     }
     inverse_blocks_.assign(block3_ ? 3 * static_cast<size_t>(n) : 0, 0.0);
   }
-  upper_start_.assign(1, 0);
-  upper_row_.clear();
-  upper_source_.clear();
-  if (block3_) {
-    const int* outer = a.outerIndexPtr();
-    const int* inner = a.innerIndexPtr();
-    for (Eigen::Index j = 0; j < n; j += 3) {
-      for (int q = outer[j]; q < outer[j + 1]; q += 3) {
-        if (inner[q] > j) break;  // rows are sorted: the rest is below the diagonal
-        upper_row_.push_back(inner[q] / 3);
-        upper_source_.push_back(q);
-      }
-      upper_start_.push_back(static_cast<int>(upper_row_.size()));
-    }
-    upper_values_.assign(9 * upper_row_.size(), 0.0);
-  }
   ++counters.analyses;
   if (factor_) {
     LinearResult r = factor_->analyze(a);
@@ -148,44 +261,41 @@ LinearResult CgSolver::Impl::analyze(const SparseMatrix& a, LinearSolverCounters
 }
 
 LinearResult CgSolver::Impl::factorize(const SparseMatrix& a, LinearSolverCounters& counters) {
-  if (a.rows() != r_.size())
+  if (a.rows() != work_.r.size())
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CG: factorize: the matrix does not have the analysed size");
   a_ = &a;
-  if (block3_) {
-    const int* outer = a.outerIndexPtr();
-    const Real* values = a.valuePtr();
-    const int blocks_per_row = static_cast<int>(upper_start_.size()) - 1;
-    for (int j = 0; j < blocks_per_row; ++j) {
-      const int s = outer[3 * j + 1] - outer[3 * j];
-      for (int k = upper_start_[j]; k < upper_start_[j + 1]; ++k) {
-        const Real* src = values + upper_source_[k];
-        Real* dst = &upper_values_[9 * static_cast<size_t>(k)];
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) dst[3 * r + c] = src[c * s + r];
-      }
-    }
-  }
   if (!factor_) {
     if (block3_) {
       const int* outer = a.outerIndexPtr();
       const Real* values = a.valuePtr();
-      for (size_t i = 0; i < diagonal_block_.size(); ++i) {
-        const int base = diagonal_block_[i];
-        const int s = outer[3 * i + 1] - outer[3 * i];
-        Eigen::Matrix3d block;
-        for (int c = 0; c < 3; ++c)
-          for (int r = 0; r < 3; ++r) block(r, c) = values[base + c * s + r];
-        Eigen::Matrix3d inverse;
-        bool invertible = false;
-        block.computeInverseWithCheck(inverse, invertible);
-        if (!invertible || !(block(0, 0) > 0 && block(1, 1) > 0 && block(2, 2) > 0)) {
-          a_ = nullptr;
-          return LinearResult::failure(
-              LinearStatus::kNotPositiveDefinite,
-              "CG: diagonal block " + std::to_string(i + 1) + " is not positive definite");
+      const long np = static_cast<long>(diagonal_block_.size());
+      std::vector<long>& bad = bad_blocks_;
+      bad.assign(parallel::team_size(threads_, np, 1024), np);
+      parallel::run(static_cast<int>(bad.size()), [&](int part, int parts) {
+        const parallel::Range range = parallel::split(np, part, parts);
+        for (long i = range.begin; i < range.end; ++i) {
+          const int base = diagonal_block_[i];
+          const int s = outer[3 * i + 1] - outer[3 * i];
+          Eigen::Matrix3d block;
+          for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) block(r, c) = values[base + c * s + r];
+          Eigen::Matrix3d inverse;
+          bool invertible = false;
+          block.computeInverseWithCheck(inverse, invertible);
+          if (!invertible || !(block(0, 0) > 0 && block(1, 1) > 0 && block(2, 2) > 0)) {
+            bad[part] = i;
+            return;
+          }
+          std::copy(inverse.data(), inverse.data() + 9, &inverse_blocks_[9 * i]);
         }
-        std::copy(inverse.data(), inverse.data() + 9, &inverse_blocks_[9 * i]);
+      });
+      const long first_bad = *std::min_element(bad.begin(), bad.end());
+      if (first_bad < np) {
+        a_ = nullptr;
+        return LinearResult::failure(
+            LinearStatus::kNotPositiveDefinite,
+            "CG: diagonal block " + std::to_string(first_bad + 1) + " is not positive definite");
       }
       return {};
     }
@@ -220,42 +330,39 @@ LinearResult CgSolver::Impl::factorize(const SparseMatrix& a, LinearSolverCounte
   return {};
 }
 
-void CgSolver::Impl::multiply(const VecX& x, VecX& y) const {
+void CgSolver::Impl::multiply(const VecX& x, VecX& y) {
   if (!block3_) {
     y.noalias() = *a_ * x;
     return;
   }
-  // Upper block triangle only: block (i, j), i < j, adds B x_j to y_i and B^T x_i to y_j.
+  // A is symmetric: y_j = (column block j)^T x, a gather per particle j over the rows of its
+  // three columns (one row pattern), written by one thread: the same bits for any split.
+  const int* outer = a_->outerIndexPtr();
+  const int* inner = a_->innerIndexPtr();
+  const Real* values = a_->valuePtr();
   const Real* px = x.data();
   Real* py = y.data();
-  y.setZero();
-  const int blocks_per_row = static_cast<int>(upper_start_.size()) - 1;
-  const Real* b = upper_values_.data();
-  for (int j = 0; j < blocks_per_row; ++j) {
-    const Real xj0 = px[3 * j], xj1 = px[3 * j + 1], xj2 = px[3 * j + 2];
-    Real yj0 = 0, yj1 = 0, yj2 = 0;
-    const int end = upper_start_[j + 1];
-    for (int k = upper_start_[j]; k < end; ++k, b += 9) {
-      const int i = upper_row_[k];
-      if (i == j) {
-        yj0 += b[0] * xj0 + b[1] * xj1 + b[2] * xj2;
-        yj1 += b[3] * xj0 + b[4] * xj1 + b[5] * xj2;
-        yj2 += b[6] * xj0 + b[7] * xj1 + b[8] * xj2;
-        continue;
+  const long np = static_cast<long>(diagonal_block_.size());
+  parallel::run(parallel::team_size(threads_, np, 1024), [&](int part, int parts) {
+    const parallel::Range range = parallel::split(np, part, parts);
+    for (long j = range.begin; j < range.end; ++j) {
+      const int begin = outer[3 * j], s = outer[3 * j + 1] - begin;
+      const int* rows = inner + begin;
+      const Real* c0 = values + begin;
+      const Real* c1 = c0 + s;
+      const Real* c2 = c1 + s;
+      Real y0 = 0, y1 = 0, y2 = 0;
+      for (int q = 0; q < s; ++q) {
+        const Real xi = px[rows[q]];
+        y0 += c0[q] * xi;
+        y1 += c1[q] * xi;
+        y2 += c2[q] * xi;
       }
-      Real* yi = py + 3 * i;
-      const Real* xi = px + 3 * i;
-      yi[0] += b[0] * xj0 + b[1] * xj1 + b[2] * xj2;
-      yi[1] += b[3] * xj0 + b[4] * xj1 + b[5] * xj2;
-      yi[2] += b[6] * xj0 + b[7] * xj1 + b[8] * xj2;
-      yj0 += b[0] * xi[0] + b[3] * xi[1] + b[6] * xi[2];
-      yj1 += b[1] * xi[0] + b[4] * xi[1] + b[7] * xi[2];
-      yj2 += b[2] * xi[0] + b[5] * xi[1] + b[8] * xi[2];
+      py[3 * j] = y0;
+      py[3 * j + 1] = y1;
+      py[3 * j + 2] = y2;
     }
-    py[3 * j] += yj0;
-    py[3 * j + 1] += yj1;
-    py[3 * j + 2] += yj2;
-  }
+  });
 }
 
 void CgSolver::Impl::precondition(const VecX& r, VecX& z) {
@@ -264,14 +371,15 @@ void CgSolver::Impl::precondition(const VecX& r, VecX& z) {
   } else if (block3_) {
     const Real* pr = r.data();
     Real* pz = z.data();
-    const Real* inv = inverse_blocks_.data();
-    const Eigen::Index n = r.size();
-    for (Eigen::Index i = 0; i < n; i += 3, inv += 9) {
-      // Column-major 3x3 inverse times r_i.
-      pz[i] = inv[0] * pr[i] + inv[3] * pr[i + 1] + inv[6] * pr[i + 2];
-      pz[i + 1] = inv[1] * pr[i] + inv[4] * pr[i + 1] + inv[7] * pr[i + 2];
-      pz[i + 2] = inv[2] * pr[i] + inv[5] * pr[i + 1] + inv[8] * pr[i + 2];
-    }
+    for_entries([&](long begin, long end) {
+      const Real* inv = inverse_blocks_.data() + 3 * begin;
+      for (long i = begin; i < end; i += 3, inv += 9) {
+        // Column-major 3x3 inverse times r_i.
+        pz[i] = inv[0] * pr[i] + inv[3] * pr[i + 1] + inv[6] * pr[i + 2];
+        pz[i + 1] = inv[1] * pr[i] + inv[4] * pr[i + 1] + inv[7] * pr[i + 2];
+        pz[i + 2] = inv[2] * pr[i] + inv[5] * pr[i + 1] + inv[8] * pr[i + 2];
+      }
+    });
   } else {
     z = inverse_diagonal_.cwiseProduct(r);
   }
@@ -279,63 +387,17 @@ void CgSolver::Impl::precondition(const VecX& r, VecX& z) {
 
 LinearResult CgSolver::Impl::run(const VecX& b, VecX& x, int max_iterations,
                                  LinearSolverCounters& counters) {
-  const Real b_norm = b.norm();
-  LinearResult result;
-  if (b_norm == 0) {
-    x.setZero();
-    return result;
-  }
-  multiply(x, q_);
-  r_ = b - q_;
-  Real r_norm = r_.norm();
-  const Real target = options_.tolerance * b_norm;
-  int k = 0;
-  if (r_norm > target) {
-    precondition(r_, z_);
-    p_ = z_;
-    Real rz = r_.dot(z_);
-    while (k < max_iterations) {
-      multiply(p_, q_);
-      const Real curvature = p_.dot(q_);
-      if (!(curvature > 0)) {
-        result = LinearResult::failure(
-            LinearStatus::kNotPositiveDefinite,
-            "CG: non-positive curvature p^T A p = " + std::to_string(curvature) + " at iteration " +
-                std::to_string(k + 1) + ": matrix not positive definite");
-        break;
-      }
-      const Real alpha = rz / curvature;
-      x.noalias() += alpha * p_;
-      r_.noalias() -= alpha * q_;
-      ++k;
-      r_norm = r_.norm();
-      if (r_norm <= target || !std::isfinite(r_norm)) break;
-      precondition(r_, z_);
-      const Real rz_next = r_.dot(z_);
-      const Real beta = rz_next / rz;
-      rz = rz_next;
-      p_ = z_ + beta * p_;
-    }
-  }
-  counters.cg_iterations += k;
-  result.iterations = k;
-  result.residual = r_norm / b_norm;
-  if (result.ok() && !(r_norm <= target)) {
-    result = LinearResult::failure(LinearStatus::kNotConverged,
-                                   "CG: relative residual " + std::to_string(r_norm / b_norm) +
-                                       " after " + std::to_string(k) + " iterations (tolerance " +
-                                       std::to_string(options_.tolerance) + ")");
-    result.iterations = k;
-    result.residual = r_norm / b_norm;
-  }
-  return result;
+  work_.threads = threads_;
+  return cg_run(
+      work_, options_.tolerance, [this](const VecX& in, VecX& out) { multiply(in, out); },
+      [this](const VecX& in, VecX& out) { precondition(in, out); }, b, x, max_iterations, counters);
 }
 
 LinearResult CgSolver::Impl::solve(const VecX& b, VecX& x, LinearSolverCounters& counters) {
   if (a_ == nullptr)
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CG: solve without a successful factorize");
-  if (b.size() != r_.size() || x.size() != r_.size())
+  if (b.size() != work_.r.size() || x.size() != work_.r.size())
     return LinearResult::failure(LinearStatus::kInvalidInput, "CG: solve: wrong vector size");
   ++counters.solves;
   const double start = factor_ ? thread_seconds() : 0;
@@ -364,6 +426,41 @@ LinearResult CgSolver::Impl::solve(const VecX& b, VecX& x, LinearSolverCounters&
       stale_ = true;
   }
   return result;
+}
+
+struct MatrixFreeCg::Impl {
+  CgWork work;
+  LinearSolverCounters counters;
+};
+
+MatrixFreeCg::MatrixFreeCg() : impl_(std::make_unique<Impl>()) {}
+MatrixFreeCg::~MatrixFreeCg() = default;
+
+const LinearSolverCounters& MatrixFreeCg::counters() const { return impl_->counters; }
+
+LinearResult MatrixFreeCg::solve(const Product& apply, const std::vector<Real>& inverse_blocks,
+                                 const VecX& b, VecX& x, Real tolerance, int max_iterations,
+                                 int threads) {
+  CgWork& work = impl_->work;
+  if (b.size() % 3 != 0 || x.size() != b.size() ||
+      inverse_blocks.size() != 3 * static_cast<size_t>(b.size()))
+    return LinearResult::failure(LinearStatus::kInvalidInput, "CG: solve: wrong vector size");
+  work.resize(b.size());
+  work.threads = std::max(1, threads);
+  ++impl_->counters.solves;
+  const auto precondition = [&](const VecX& r, VecX& z) {
+    const Real* pr = r.data();
+    Real* pz = z.data();
+    work.for_entries([&](long begin, long end) {
+      const Real* inv = inverse_blocks.data() + 3 * begin;
+      for (long i = begin; i < end; i += 3, inv += 9) {
+        pz[i] = inv[0] * pr[i] + inv[1] * pr[i + 1] + inv[2] * pr[i + 2];
+        pz[i + 1] = inv[3] * pr[i] + inv[4] * pr[i + 1] + inv[5] * pr[i + 2];
+        pz[i + 2] = inv[6] * pr[i] + inv[7] * pr[i + 1] + inv[8] * pr[i + 2];
+      }
+    });
+  };
+  return cg_run(work, tolerance, apply, precondition, b, x, max_iterations, impl_->counters);
 }
 
 }  // namespace jelly

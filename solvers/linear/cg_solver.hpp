@@ -2,7 +2,9 @@
 // Preconditioned conjugate gradients behind the LinearSolver interface, preconditioned either by
 // the inverse diagonal (Jacobi) or by a CHOLMOD factor of an earlier matrix ("lagged"), which is
 // refreshed only when CG needs more than a few iterations with it or after invalidate().
+#include <functional>
 #include <memory>
+#include <vector>
 
 #include <jelly/solvers/linear/cholmod_solver.hpp>
 #include <jelly/solvers/linear/linear_solver.hpp>
@@ -38,11 +40,33 @@ class CgSolver final : public LinearSolver {
   LinearResult factorize(const SparseMatrix& a) override;
   LinearResult solve(const VecX& b, VecX& x) override;
   void invalidate() override;
+  // Threads of the mat-vec, the preconditioner and the vector operations (results do not
+  // depend on it: fixed partitions and sums in fixed chunks, docs/threads.md).
+  void set_threads(int threads) override;
   // The CHOLMOD factorizations done for the lagged preconditioner (counted in counters() too).
   long preconditioner_factorizations() const;
 
  private:
   struct Impl;  // the preconditioner, the upper block triangle of A, the CG vectors
+  std::unique_ptr<Impl> impl_;
+};
+
+// Conjugate gradients on an operator given as a product function (matrix-free, e.g.
+// core/detail/band_system.hpp), preconditioned by given inverse 3x3 diagonal blocks; threaded as
+// CgSolver (the same bits for any thread count).
+class MatrixFreeCg {
+ public:
+  using Product = std::function<void(const VecX& in, VecX& out)>;
+  MatrixFreeCg();
+  ~MatrixFreeCg();
+  // Solves A x = b from x with A x = apply(x); inverse_blocks[9i .. 9i + 9) is the row-major
+  // inverse of A's diagonal block i. Stops at |b - A x| <= tolerance |b|.
+  LinearResult solve(const Product& apply, const std::vector<Real>& inverse_blocks, const VecX& b,
+                     VecX& x, Real tolerance, int max_iterations, int threads);
+  const LinearSolverCounters& counters() const;
+
+ private:
+  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

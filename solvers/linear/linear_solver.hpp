@@ -58,6 +58,8 @@ class LinearSolver {
   virtual LinearResult solve(const VecX& b, VecX& x) = 0;
   // The next factorize must not reuse an old factor (lagged backends; e.g. dt changed).
   virtual void invalidate() {}
+  // How many threads the backend may use for its own loops (the CHOLMOD backends stay on one).
+  virtual void set_threads(int /*threads*/) {}
   const LinearSolverCounters& counters() const { return counters_; }
 
  protected:

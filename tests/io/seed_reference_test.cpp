@@ -1,7 +1,9 @@
 // The seed scenes give bit for bit the trajectories they gave before the model held bodies:
 // the states at t = 2 s equal those of recordings made with jelly 0.1.0 at commit c6f30bd
 // (`jelly run SCENE --duration 2 --set output_interval=0.5 ...`, last frame), compared through
-// a 64-bit FNV-1a hash of the bytes of x and v (little-endian doubles).
+// a 64-bit FNV-1a hash of the bytes of x and v (little-endian doubles). implicit_euler's hash
+// was renewed when its solve became matrix-free and threaded (issue 17: other summation orders,
+// a rounding-level change; its first particle is where it was to 1e-7).
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -57,7 +59,7 @@ INSTANTIATE_TEST_SUITE_P(
                   Vec3(-2.24047018, 7.00606025, -2.24047018)},
         Reference{"drop_coulomb.json",
                   {"integrator.name=implicit_euler", "integrator.dt=0.016666666666666666"},
-                  0x302939b802a177e7ULL,
+                  0x63787fa8df2a1a8cULL,
                   Vec3(-0.99997102, 0, -0.99997102)},
         Reference{"seed_slope.json",
                   {"integrator.name=symplectic_euler", "terrains.0.contact.model=coulomb"},

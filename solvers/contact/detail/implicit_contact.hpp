@@ -90,6 +90,23 @@ class ImplicitContact {
   // unconstrained and the new set replaces the old (solve again), else nothing changes.
   bool update(const Terrains& terrains, const VecX& b, const VecX& dv, bool commit,
               SparseMatrix& a);
+  // Matrix-free counterparts (A given only by products, core/detail/band_system.hpp); the
+  // filtered operator is y = S A (S p) + C p + (I - S) p:
+  //   constrain_rhs: as constrain without touching a matrix; `a_z` must be A z for the z this
+  //     call returns in `z` -- it is called twice: first with a_z = null (computes z; returns
+  //     whether z is non-zero), then with A z (forms rhs and projects guess).
+  bool constrain_rhs(const VecX& b, bool prescribe, const VecX* a_z, VecX& rhs, VecX& z,
+                     VecX& guess);
+  //   filter_input: q = p with q_c = S_c p_c at the contacts (q = p elsewhere);
+  //   filter_output: y_c = S_c y_c + C_c p_c + (I - S_c) p_c at the contacts, for y = A q.
+  void filter_input(const VecX& p, VecX& q) const;
+  void filter_output(const VecX& p, VecX& y) const;
+  //   the filtered diagonal block S D S + C + I - S of a contact particle (D row-major, in
+  //     place), for block Jacobi; returns false for a particle without contact.
+  bool filter_diagonal_block(int particle, Real block[9]) const;
+  //   update from the product a_dv = A dv with the original A (no matrix to unconstrain).
+  bool update_from_product(const Terrains& terrains, const VecX& b, const VecX& dv, bool commit,
+                           const VecX& a_dv);
   // S applied in place to a 3N vector (a Newton residual).
   void project(VecX& w) const;
   // w += c_i (v1 - u)_t: removes the sliding friction impulses at velocities v1 from w.
@@ -119,6 +136,11 @@ class ImplicitContact {
   // the particle would end the step without it.
   Contact make_contact(const Terrains& terrains, int i, int k, const Vec3& v1, Real mass) const;
   void index_contacts();
+  // update() with the constraint impulse of contact ci from impulse(ci, c) and the matrix put
+  // back by unconstrain_matrix() when the set changes.
+  template <class Impulse, class Unconstrain>
+  bool update_impl(const Terrains& terrains, const VecX& dv, bool commit, Impulse&& impulse,
+                   Unconstrain&& unconstrain_matrix);
   // The coulomb terrain that position p (at time t1) penetrates deepest, or -1.
   int penetrated_terrain(const Terrains& terrains, const Vec3& p, Real tolerance) const;
 
@@ -126,10 +148,10 @@ class ImplicitContact {
   const Model* model_ = nullptr;  // of the current step
   VecX x0_, v0_;
   std::vector<Contact> contacts_, next_;
-  std::vector<int> slot_;      // [N]: index into contacts_ or -1
+  std::vector<int> slot_;          // [N]: index into contacts_ or -1
   std::vector<char> pinned_mask_;  // [N]: pinned this step
-  std::vector<Real> saved_;    // original values of the constrained columns
-  std::vector<int> saved_at_;  // [contacts]: offset into saved_
+  std::vector<Real> saved_;        // original values of the constrained columns
+  std::vector<int> saved_at_;      // [contacts]: offset into saved_
   int projected_ = 0;
   int pinned_ = 0;  // the first pinned_ entries of contacts_ are pins
   Counters counters_;

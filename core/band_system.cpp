@@ -1,0 +1,325 @@
+#include <jelly/core/detail/band_system.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include <jelly/core/detail/parallel.hpp>
+#include <jelly/core/forces.hpp>
+
+// As spring_bands.cpp: one copy of the band loops per instruction set, chosen at load time.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define JELLY_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define JELLY_VECTOR_CLONES
+#endif
+
+namespace jelly {
+
+namespace {
+
+// Springs per thread below which another thread costs more than it saves (as the force loop).
+constexpr long kMinSlotsPerThread = 8192;
+
+struct Ends {
+  const Real *xa, *ya, *za, *xb, *yb, *zb;
+};
+
+// Per slot: B = c1 u u^T + c2 I and t = K_k (w_a - w_b), with (the spring_blocks of
+// core/jacobian.cpp) s the geometric stiffness after the definiteness fix,
+// K_k = -(ks - s) u u^T - s I, D_k = -kd u u^T, B = -alpha D_k - beta K_k. Returns the number of
+// collapsed springs.
+JELLY_VECTOR_CLONES
+int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
+                const Real* __restrict rest, const Real* __restrict ks, const Real* __restrict kd,
+                Real* __restrict c1, Real* __restrict c2, Real* __restrict ux, Real* __restrict uy,
+                Real* __restrict uz, Real* __restrict tx, Real* __restrict ty,
+                Real* __restrict tz) {
+  const Real* __restrict xa = x.xa;
+  const Real* __restrict ya = x.ya;
+  const Real* __restrict za = x.za;
+  const Real* __restrict xb = x.xb;
+  const Real* __restrict yb = x.yb;
+  const Real* __restrict zb = x.zb;
+  const Real* __restrict va = v.xa;
+  const Real* __restrict vb = v.xb;
+  const Real* __restrict va1 = v.ya;
+  const Real* __restrict vb1 = v.yb;
+  const Real* __restrict va2 = v.za;
+  const Real* __restrict vb2 = v.zb;
+  const Real* __restrict wa = w.xa;
+  const Real* __restrict wb = w.xb;
+  const Real* __restrict wa1 = w.ya;
+  const Real* __restrict wb1 = w.yb;
+  const Real* __restrict wa2 = w.za;
+  const Real* __restrict wb2 = w.zb;
+  int collapsed = 0;
+  for (int j = 0; j < n; ++j) {
+    const Real dx = xa[j] - xb[j], dy = ya[j] - yb[j], dz = za[j] - zb[j];
+    const Real length = std::sqrt(dx * dx + dy * dy + dz * dz);
+    // + tiny: a slot without a spring may join two coincident particles (its coefficients are 0).
+    const Real inv = 1.0 / (length + 1e-300);
+    const Real u0 = dx * inv, u1 = dy * inv, u2 = dz * inv;
+    const Real c = (va[j] - vb[j]) * u0 + (va1[j] - vb1[j]) * u1 + (va2[j] - vb2[j]) * u2;
+    const Real spring_geometric = ks[j] * (1 - rest[j] * inv);
+    const Real damper_geometric = kd[j] * c * inv;
+    Real s;
+    if (fix == 1) {  // kClampCompressed
+      s = std::max<Real>(spring_geometric, 0) + std::max<Real>(damper_geometric, 0);
+    } else if (fix == 2) {  // kProjectPsd
+      s = std::max<Real>(spring_geometric + damper_geometric, 0);
+    } else {
+      s = spring_geometric + damper_geometric;
+    }
+    const Real along = ks[j] - s;
+    c1[j] = alpha * kd[j] + beta * along;
+    c2[j] = beta * s;
+    ux[j] = u0;
+    uy[j] = u1;
+    uz[j] = u2;
+    const Real d0 = wa[j] - wb[j], d1 = wa1[j] - wb1[j], d2 = wa2[j] - wb2[j];
+    const Real ud = along * (u0 * d0 + u1 * d1 + u2 * d2);
+    tx[j] = -ud * u0 - s * d0;
+    ty[j] = -ud * u1 - s * d1;
+    tz[j] = -ud * u2 - s * d2;
+    collapsed += length < kDegenerateLength * rest[j];
+  }
+  return collapsed;
+}
+
+// Per slot t = B (p_a - p_b) = c1 (u . d) u + c2 d.
+JELLY_VECTOR_CLONES
+void band_products(int n, Ends p, const Real* __restrict c1, const Real* __restrict c2,
+                   const Real* __restrict ux, const Real* __restrict uy, const Real* __restrict uz,
+                   Real* __restrict tx, Real* __restrict ty, Real* __restrict tz) {
+  const Real* __restrict xa = p.xa;
+  const Real* __restrict ya = p.ya;
+  const Real* __restrict za = p.za;
+  const Real* __restrict xb = p.xb;
+  const Real* __restrict yb = p.yb;
+  const Real* __restrict zb = p.zb;
+  for (int j = 0; j < n; ++j) {
+    const Real d0 = xa[j] - xb[j], d1 = ya[j] - yb[j], d2 = za[j] - zb[j];
+    const Real ud = c1[j] * (ux[j] * d0 + uy[j] * d1 + uz[j] * d2);
+    tx[j] = ud * ux[j] + c2[j] * d0;
+    ty[j] = ud * uy[j] + c2[j] * d1;
+    tz[j] = ud * uz[j] + c2[j] * d2;
+  }
+}
+
+// a[j] += sign t[j] for the three coordinates.
+JELLY_VECTOR_CLONES
+void accumulate(int n, Real sign, const Real* __restrict tx, const Real* __restrict ty,
+                const Real* __restrict tz, Real* __restrict ax, Real* __restrict ay,
+                Real* __restrict az) {
+  for (int j = 0; j < n; ++j) {
+    ax[j] += sign * tx[j];
+    ay[j] += sign * ty[j];
+    az[j] += sign * tz[j];
+  }
+}
+
+// The six entries xx, yy, zz, xy, xz, yz of B = c1 u u^T + c2 I added to d[0..5][j].
+JELLY_VECTOR_CLONES
+void accumulate_blocks(int n, const Real* __restrict c1, const Real* __restrict c2,
+                       const Real* __restrict ux, const Real* __restrict uy,
+                       const Real* __restrict uz, Real* __restrict dxx, Real* __restrict dyy,
+                       Real* __restrict dzz, Real* __restrict dxy, Real* __restrict dxz,
+                       Real* __restrict dyz) {
+  for (int j = 0; j < n; ++j) {
+    dxx[j] += c1[j] * ux[j] * ux[j] + c2[j];
+    dyy[j] += c1[j] * uy[j] * uy[j] + c2[j];
+    dzz[j] += c1[j] * uz[j] * uz[j] + c2[j];
+    dxy[j] += c1[j] * ux[j] * uy[j];
+    dxz[j] += c1[j] * ux[j] * uz[j];
+    dyz[j] += c1[j] * uy[j] * uz[j];
+  }
+}
+
+// The slots of a band that touch particles [p0, p1): [lo, hi).
+struct SlotRange {
+  int lo, hi;
+};
+SlotRange touching(const SpringBands::Band& band, int p0, int p1) {
+  return {std::max(0, p0 - band.offset - band.first), std::min(band.slots(), p1 - band.first)};
+}
+
+}  // namespace
+
+BandSystem::BandSystem(const SpringBands& bands, int num_particles)
+    : bands_(&bands), num_particles_(num_particles) {
+  for (const SpringBands::Band& band : bands.bands()) {
+    Slots s;
+    const size_t n = band.spring.size();
+    s.c1.assign(n, 0.0);
+    s.c2.assign(n, 0.0);
+    s.ux.assign(n, 0.0);
+    s.uy.assign(n, 0.0);
+    s.uz.assign(n, 0.0);
+    slots_.push_back(std::move(s));
+  }
+  mass_.assign(num_particles, 0.0);
+  diagonal_.assign(6 * static_cast<size_t>(num_particles), 0.0);
+  scratch_.assign(12 * static_cast<size_t>(num_particles), 0.0);
+}
+
+bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, DefinitenessFix fix,
+                          Real alpha, Real beta, const VecX& w, VecX& kw, int threads) {
+  const int n = num_particles_;
+  const std::vector<SpringBands::Band>& bands = bands_->bands();
+  long slots = 0;
+  for (const auto& band : bands) slots += band.slots();
+  const int team = parallel::team_size(threads, slots, kMinSlotsPerThread);
+  const size_t stride = static_cast<size_t>(n) + static_cast<size_t>(bands_->max_offset());
+  if (band_.size() < static_cast<size_t>(team) * 8 * stride) {
+    band_.assign(static_cast<size_t>(team) * 8 * stride, 0.0);
+  }
+  if (collapsed_.size() < static_cast<size_t>(team)) collapsed_.assign(team, 0);
+  const int fix_code = fix == DefinitenessFix::kClampCompressed ? 1
+                       : fix == DefinitenessFix::kProjectPsd    ? 2
+                                                                : 0;
+  Real* sx = scratch_.data();
+  Real* sv = sx + 3 * static_cast<size_t>(n);
+  Real* sw = sv + 3 * static_cast<size_t>(n);
+  Real* acc = sw + 3 * static_cast<size_t>(n);
+  Real* diag = diagonal_.data();
+  const Real* m = model.mass.data();
+  bool any_collapsed = false;
+  parallel::run(team, [&](int part, int parts) {
+    const parallel::Range range = parallel::split(n, part, parts);
+    const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
+    for (int i = p0; i < p1; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        sx[c * n + i] = x[3 * i + c];
+        sv[c * n + i] = v[3 * i + c];
+        sw[c * n + i] = w[3 * i + c];
+        acc[c * n + i] = 0;
+      }
+      for (int c = 0; c < 6; ++c) diag[c * static_cast<size_t>(n) + i] = 0;
+      mass_[i] = m[i];
+    }
+#pragma omp barrier
+    Real* buffer = band_.data() + static_cast<size_t>(part) * 8 * stride;
+    Real* c1 = buffer;
+    Real* c2 = c1 + stride;
+    Real* ux = c2 + stride;
+    Real* uy = ux + stride;
+    Real* uz = uy + stride;
+    Real* tx = uz + stride;
+    Real* ty = tx + stride;
+    Real* tz = ty + stride;
+    int collapsed = 0;
+    for (size_t k = 0; k < bands.size(); ++k) {
+      const SpringBands::Band& band = bands[k];
+      const int o = band.offset, first = band.first;
+      const SlotRange sr = touching(band, p0, p1);
+      if (sr.lo >= sr.hi) continue;
+      const int a = first + sr.lo, b = a + o;
+      const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
+      const Ends ev{sv + a, sv + n + a, sv + 2 * n + a, sv + b, sv + n + b, sv + 2 * n + b};
+      const Ends ew{sw + a, sw + n + a, sw + 2 * n + a, sw + b, sw + n + b, sw + 2 * n + b};
+      const int count = sr.hi - sr.lo;
+      collapsed += band_blocks(count, fix_code, alpha, beta, ex, ev, ew, band.rest.data() + sr.lo,
+                               band.ks.data() + sr.lo, band.kd.data() + sr.lo, c1, c2, ux, uy, uz,
+                               tx, ty, tz);
+      // This thread stores the slots whose first particle is its own.
+      Slots& out = slots_[k];
+      const int a0 = std::max(p0, a), a1 = std::min(p1, first + sr.hi);
+      if (a0 < a1) {
+        const int q = a0 - a, slot = a0 - first, len = a1 - a0;
+        std::copy(c1 + q, c1 + q + len, out.c1.data() + slot);
+        std::copy(c2 + q, c2 + q + len, out.c2.data() + slot);
+        std::copy(ux + q, ux + q + len, out.ux.data() + slot);
+        std::copy(uy + q, uy + q + len, out.uy.data() + slot);
+        std::copy(uz + q, uz + q + len, out.uz.data() + slot);
+        accumulate(len, 1.0, tx + q, ty + q, tz + q, acc + a0, acc + n + a0, acc + 2 * n + a0);
+        accumulate_blocks(len, c1 + q, c2 + q, ux + q, uy + q, uz + q, diag + a0, diag + n + a0,
+                          diag + 2 * n + a0, diag + 3 * n + a0, diag + 4 * n + a0,
+                          diag + 5 * n + a0);
+      }
+      const int b0 = std::max(p0, b), b1 = std::min(p1, first + o + sr.hi);
+      if (b0 < b1) {
+        const int q = b0 - b, len = b1 - b0;
+        accumulate(len, -1.0, tx + q, ty + q, tz + q, acc + b0, acc + n + b0, acc + 2 * n + b0);
+        accumulate_blocks(len, c1 + q, c2 + q, ux + q, uy + q, uz + q, diag + b0, diag + n + b0,
+                          diag + 2 * n + b0, diag + 3 * n + b0, diag + 4 * n + b0,
+                          diag + 5 * n + b0);
+      }
+    }
+    collapsed_[part] = collapsed;
+    for (int i = p0; i < p1; ++i) {
+      for (int c = 0; c < 3; ++c) kw[3 * i + c] = acc[c * n + i];
+    }
+#pragma omp barrier
+#pragma omp single
+    for (int t = 0; t < parts; ++t) any_collapsed = any_collapsed || collapsed_[t] > 0;
+  });
+  return !any_collapsed;
+}
+
+void BandSystem::add_diagonal(int particle, Real value) { mass_[particle] += value; }
+
+void BandSystem::diagonal_block(int i, Real out[9]) const {
+  const size_t n = static_cast<size_t>(num_particles_);
+  const Real* d = diagonal_.data() + i;
+  const Real m = mass_[i];
+  out[0] = d[0] + m;
+  out[4] = d[n] + m;
+  out[8] = d[2 * n] + m;
+  out[1] = out[3] = d[3 * n];
+  out[2] = out[6] = d[4 * n];
+  out[5] = out[7] = d[5 * n];
+}
+
+void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
+  const int n = num_particles_;
+  const std::vector<SpringBands::Band>& bands = bands_->bands();
+  long slots = 0;
+  for (const auto& band : bands) slots += band.slots();
+  const int team = parallel::team_size(threads, slots, kMinSlotsPerThread);
+  const size_t stride = static_cast<size_t>(n) + static_cast<size_t>(bands_->max_offset());
+  if (band_.size() < static_cast<size_t>(team) * 8 * stride) {
+    band_.assign(static_cast<size_t>(team) * 8 * stride, 0.0);
+  }
+  Real* sp = scratch_.data();
+  Real* acc = sp + 9 * static_cast<size_t>(n);
+  parallel::run(team, [&](int part, int parts) {
+    const parallel::Range range = parallel::split(n, part, parts);
+    const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
+    for (int i = p0; i < p1; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        sp[c * n + i] = p[3 * i + c];
+        acc[c * n + i] = mass_[i] * p[3 * i + c];
+      }
+    }
+#pragma omp barrier
+    Real* tx = band_.data() + static_cast<size_t>(part) * 8 * stride;
+    Real* ty = tx + stride;
+    Real* tz = ty + stride;
+    for (size_t k = 0; k < bands.size(); ++k) {
+      const SpringBands::Band& band = bands[k];
+      const int o = band.offset, first = band.first;
+      const SlotRange sr = touching(band, p0, p1);
+      if (sr.lo >= sr.hi) continue;
+      const int a = first + sr.lo, b = a + o;
+      const Ends ep{sp + a, sp + n + a, sp + 2 * n + a, sp + b, sp + n + b, sp + 2 * n + b};
+      const Slots& s = slots_[k];
+      band_products(sr.hi - sr.lo, ep, s.c1.data() + sr.lo, s.c2.data() + sr.lo,
+                    s.ux.data() + sr.lo, s.uy.data() + sr.lo, s.uz.data() + sr.lo, tx, ty, tz);
+      const int a0 = std::max(p0, a), a1 = std::min(p1, first + sr.hi);
+      if (a0 < a1) {
+        const int q = a0 - a;
+        accumulate(a1 - a0, 1.0, tx + q, ty + q, tz + q, acc + a0, acc + n + a0, acc + 2 * n + a0);
+      }
+      const int b0 = std::max(p0, b), b1 = std::min(p1, first + o + sr.hi);
+      if (b0 < b1) {
+        const int q = b0 - b;
+        accumulate(b1 - b0, -1.0, tx + q, ty + q, tz + q, acc + b0, acc + n + b0, acc + 2 * n + b0);
+      }
+    }
+    for (int i = p0; i < p1; ++i) {
+      for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c * n + i];
+    }
+  });
+}
+
+}  // namespace jelly

@@ -1,0 +1,56 @@
+#pragma once
+// The backward-Euler matrix A = M - alpha D - beta K of a lattice without an assembled sparse
+// matrix: per spring slot of the force loop's bands (core/detail/spring_bands.hpp) its 3x3 block
+// B = -alpha D_k - beta K_k = c1 u u^T + c2 I (u the spring's unit direction) as five numbers,
+// and products A p = M p + sum over springs of +-B (p_a - p_b) computed band by band like the
+// force loop (vectorised, threaded by particle ranges: the same bits for any thread count).
+// 40 bytes per spring instead of about 220 for the full compressed-column matrix, and each
+// product reads a fifth of the memory (docs/implicit.md, "Matrix-free CG").
+#include <vector>
+
+#include <jelly/core/definiteness.hpp>
+#include <jelly/core/detail/spring_bands.hpp>
+#include <jelly/core/model.hpp>
+
+namespace jelly {
+
+class BandSystem {
+ public:
+  BandSystem() = default;
+  // For the springs of `bands` (dense, built for a model of `num_particles` particles); keeps a
+  // pointer to `bands`, which must outlive this object. Allocates.
+  BandSystem(const SpringBands& bands, int num_particles);
+
+  bool built_for(const SpringBands& bands) const { return bands_ == &bands; }
+  int rows() const { return 3 * num_particles_; }
+
+  // A = M - alpha D - beta K at (x, v), K and D as SpringJacobian assembles them with the
+  // definiteness fix (without the damper's non-symmetric term), and kw = K w. Returns false
+  // when a spring has collapsed (shorter than kDegenerateLength times its rest length; its
+  // direction is then undefined here: use SpringJacobian). No allocation after the first call
+  // with this thread count.
+  bool assemble(const Model& model, const VecX& x, const VecX& v, DefinitenessFix fix, Real alpha,
+                Real beta, const VecX& w, VecX& kw, int threads);
+  // A_pp += value I (anchors, wind drag). Call after assemble.
+  void add_diagonal(int particle, Real value);
+  // y = A p. No allocation after the first call with this thread count.
+  void multiply(const VecX& p, VecX& y, int threads) const;
+  // The diagonal 3x3 block of particle i, row-major.
+  void diagonal_block(int i, Real out[9]) const;
+
+ private:
+  struct Slots {
+    std::vector<Real> c1, c2, ux, uy, uz;  // [slots]
+  };
+  const SpringBands* bands_ = nullptr;
+  int num_particles_ = 0;
+  std::vector<Slots> slots_;    // per band
+  std::vector<Real> mass_;      // [N] m + the diagonal additions
+  std::vector<Real> diagonal_;  // [6N] xx, yy, zz, xy, xz, yz of the spring part of A_ii
+  // Scratch: SoA copies of the inputs, accumulators, and per thread its slots' terms.
+  mutable std::vector<Real> scratch_;
+  mutable std::vector<Real> band_;
+  mutable std::vector<int> collapsed_;
+};
+
+}  // namespace jelly
