@@ -68,7 +68,8 @@ Scene scene_from_json(const Json& j, const std::string& base_directory) {
       throw InputError("terrains", json_text(*ts), "a list of terrains [{...}, ...]");
     }
     for (std::size_t i = 0; i < ts->size(); ++i) {
-      s.terrains.emplace_back(read_terrain_spec((*ts)[i], json_element("terrains", i)));
+      s.terrains.emplace_back(
+          read_terrain_spec((*ts)[i], json_element("terrains", i), base_directory));
     }
   }
 

@@ -2,6 +2,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/mesh_obstacle.hpp>
 #include <jelly/terrain/obstacle.hpp>
 #include <jelly/terrain/plane.hpp>
 
@@ -24,6 +25,10 @@ const std::vector<TerrainKindInfo>& terrain_kinds() {
       {"elevator",
        "a moving platform: center, size_x, size_z, thickness, mass, motion (phases or \"seed\")",
        &ElevatorSpec::read},
+      {"mesh",
+       "a closed triangle mesh obstacle (OBJ, STL, PLY): file, scale, position, "
+       "rotation_degrees, motion, angular_velocity_degrees",
+       &MeshObstacleSpec::read},
       {"plane", "a fixed plane: point, normal", &PlaneSpec::read},
       {"slope", "a fixed plane tilted about z: angle_degrees, point", &SlopeSpec::read},
       {"sphere", "a sphere obstacle: center, radius, motion, angular_velocity_degrees",
@@ -41,8 +46,10 @@ const TerrainKindInfo& find_terrain_kind(std::string_view name, const std::strin
   throw InputError(field, "\"" + std::string(name) + "\"", "one of " + known);
 }
 
-std::unique_ptr<TerrainSpec> read_terrain_spec(const Json& object, const std::string& path) {
+std::unique_ptr<TerrainSpec> read_terrain_spec(const Json& object, const std::string& path,
+                                               const std::string& base_directory) {
   JsonFields f(object, path);
+  f.set_base_directory(base_directory);
   const std::string kind = f.string("kind");
   std::unique_ptr<TerrainSpec> t = find_terrain_kind(kind, f.path("kind")).read(f);
   if (const Json* c = f.value("contact")) {

@@ -25,8 +25,10 @@ const std::vector<TerrainKindInfo>& terrain_kinds();
 const TerrainKindInfo& find_terrain_kind(std::string_view name, const std::string& field);
 
 // A whole terrain object of a scene ({"kind": ..., the kind's keys, "contact": {...}}) at the JSON
-// path `path`: read, validated, unknown keys refused (InputError naming the path).
-std::unique_ptr<TerrainSpec> read_terrain_spec(const Json& object, const std::string& path);
+// path `path`: read, validated, unknown keys refused (InputError naming the path). File names
+// (a mesh obstacle's) are relative to `base_directory` ("" = the current directory).
+std::unique_ptr<TerrainSpec> read_terrain_spec(const Json& object, const std::string& path,
+                                               const std::string& base_directory = "");
 // The same object written out with every key.
 Json terrain_spec_json(const TerrainSpec& spec);
 

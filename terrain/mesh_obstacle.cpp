@@ -1,0 +1,183 @@
+#include <jelly/terrain/mesh_obstacle.hpp>
+
+#include <atomic>
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/geometry/mesh_io.hpp>
+
+namespace jelly {
+
+namespace {
+
+constexpr Real kDegree = M_PI / 180;
+
+std::uint64_t next_serial() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+
+std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+
+// The last query of this thread: which shape, the point in its frame, the answer.
+struct LastQuery {
+  std::uint64_t serial = 0;
+  Vec3 q = Vec3::Zero();
+  MeshDistance::Query answer;
+};
+thread_local LastQuery last_query;
+
+}  // namespace
+
+MeshObstacleShape::MeshObstacleShape(std::string file_, Real scale_, TriangleMesh scaled_outwards,
+                                     Real volume_, Real area_)
+    : file(std::move(file_)),
+      scale(scale_),
+      distance(std::move(scaled_outwards)),
+      volume(volume_),
+      area(area_),
+      serial(next_serial()) {}
+
+std::shared_ptr<const MeshObstacleShape> MeshObstacleSpec::shape(const std::string& prefix) const {
+  std::shared_ptr<const MeshObstacleShape> cache = std::atomic_load(&cache_);
+  if (cache && cache->file == file && cache->scale == pose.scale) return cache;
+  const std::string field = prefix + "file";
+  require(!file.empty(), field, "\"\"", "the name of an OBJ, STL or PLY file");
+  require(std::isfinite(pose.scale) && pose.scale > 0, prefix + "scale", pose.scale,
+          "a finite scale > 0");
+  // read_mesh refuses a missing file, no triangle, non-finite coordinates, non-manifold and
+  // inconsistently oriented edges.
+  MeshFile read = read_mesh(file, field);
+  const MeshTopology topology = mesh_topology(read.mesh);
+  if (!topology.closed()) {
+    const MeshHole& worst = topology.holes.front();  // the largest first
+    throw InputError(field, quoted(file),
+                     "a closed mesh (the obstacle's inside must be defined); it has " +
+                         std::to_string(topology.holes.size()) + " hole(s), the largest " +
+                         to_text(worst.diameter) + " across at (" +
+                         to_text(worst.centre.transpose()) + ")");
+  }
+  TriangleMesh mesh = std::move(read.mesh);
+  for (Vec3& v : mesh.vertices) v *= pose.scale;
+  // Area and enclosed volume (divergence theorem: sum of a . (b x c) / 6).
+  Real area = 0, volume = 0;
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    area += 0.5 * (b - a).cross(c - a).norm();
+    volume += a.dot(b.cross(c)) / 6;
+  }
+  const Real size = mesh.bounds().diagonal().norm();
+  require(area > 1e-12 * size * size, field, quoted(file),
+          "a mesh of non-zero area (this one has " + to_text(area) + " m^2 after scaling)");
+  require(std::abs(volume) > 1e-9 * size * size * size, field, quoted(file),
+          "a mesh enclosing a volume (this one encloses " + to_text(volume) +
+              " m^3 after scaling: flat or folded onto itself)");
+  if (volume < 0) {  // oriented inwards: turned outwards
+    for (Triangle& t : mesh.triangles) std::swap(t[1], t[2]);
+    volume = -volume;
+  }
+  cache =
+      std::make_shared<const MeshObstacleShape>(file, pose.scale, std::move(mesh), volume, area);
+  std::atomic_store(&cache_, cache);
+  return cache;
+}
+
+void MeshObstacleSpec::validate(const std::string& prefix) const {
+  require(!file.empty(), prefix + "file", "\"\"", "the name of an OBJ, STL or PLY file");
+  pose.validate(prefix);
+  require(angular_velocity_degrees.allFinite(), prefix + "angular_velocity_degrees",
+          angular_velocity_degrees.transpose(), "finite rates (degrees per second)");
+  shape(prefix);
+}
+
+std::unique_ptr<Terrain> MeshObstacleSpec::make() const {
+  return std::make_unique<MeshObstacle>(*this, contact);
+}
+
+void MeshObstacleSpec::write(Json& j) const {
+  j["file"] = file;
+  j["scale"] = pose.scale;
+  j["position"] = json_of(pose.position);
+  j["rotation_degrees"] = json_of(pose.rotation_degrees);
+  j["motion"] = motion.to_json();
+  j["angular_velocity_degrees"] = json_of(angular_velocity_degrees);
+}
+
+std::unique_ptr<TerrainSpec> MeshObstacleSpec::read(JsonFields& f) {
+  auto s = std::make_unique<MeshObstacleSpec>();
+  s->file = f.file("file");
+  s->pose.scale = f.number_or("scale", s->pose.scale);
+  s->pose.position = f.vec3_or("position", s->pose.position);
+  s->pose.rotation_degrees = f.vec3_or("rotation_degrees", s->pose.rotation_degrees);
+  if (const Json* m = f.value("motion")) s->motion = Path::read(*m, f.path("motion"));
+  s->angular_velocity_degrees = f.vec3_or("angular_velocity_degrees", s->angular_velocity_degrees);
+  s->validate(f.prefix());
+  return s;
+}
+
+MeshObstacle::MeshObstacle(MeshObstacleSpec spec, ContactParams contact)
+    : Terrain(contact), spec_(std::move(spec)) {
+  spec_.validate("obstacle.");
+  contact.validate("contact.");
+  shape_ = spec_.shape("obstacle.");
+  Pose rotation_only;
+  rotation_only.rotation_degrees = spec_.pose.rotation_degrees;
+  rotation0_ = rotation_only.rotation();
+  omega_ = spec_.angular_velocity_degrees * kDegree;
+}
+
+Eigen::Matrix3d MeshObstacle::rotation(Real t) const {
+  const Real angle = omega_.norm() * t;
+  if (angle == 0) return rotation0_;
+  return Eigen::AngleAxisd(angle, omega_.normalized()).toRotationMatrix() * rotation0_;
+}
+
+Vec3 MeshObstacle::position(Real t) const {
+  return spec_.motion.is_fixed() ? spec_.pose.position
+                                 : Vec3(spec_.pose.position + spec_.motion.sample(t).offset);
+}
+
+Eigen::Isometry3d MeshObstacle::pose(Real t) const {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation(t);
+  pose.translation() = position(t);
+  return pose;
+}
+
+MeshDistance::Query MeshObstacle::local_query(const Vec3& p, Real t) const {
+  const Vec3 q = rotation(t).transpose() * (p - position(t));
+  LastQuery& last = last_query;
+  if (last.serial != shape_->serial || last.q != q) {
+    last.answer = shape_->distance.query(q);
+    last.q = q;
+    last.serial = shape_->serial;
+  }
+  return last.answer;
+}
+
+Real MeshObstacle::signed_distance(const Vec3& p, Real t) const {
+  return local_query(p, t).distance;
+}
+
+Vec3 MeshObstacle::normal(const Vec3& p, Real t) const {
+  return rotation(t) * local_query(p, t).normal;
+}
+
+Vec3 MeshObstacle::closest_point(const Vec3& p, Real t) const {
+  return position(t) + rotation(t) * local_query(p, t).closest;
+}
+
+Vec3 MeshObstacle::surface_velocity(const Vec3& p, Real t) const {
+  Vec3 u = spec_.motion.is_fixed() ? Vec3(Vec3::Zero()) : spec_.motion.sample(t).velocity;
+  if (omega_.squaredNorm() > 0) u += omega_.cross(rotation(t) * local_query(p, t).closest);
+  return u;
+}
+
+std::vector<std::pair<std::string, Real>> MeshObstacle::attributes() const {
+  return {{"scale", shape_->scale},
+          {"triangles", static_cast<Real>(shape_->distance.mesh().num_triangles())},
+          {"volume", shape_->volume},
+          {"area", shape_->area}};
+}
+
+}  // namespace jelly
