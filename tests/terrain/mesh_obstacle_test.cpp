@@ -82,7 +82,7 @@ TEST(MeshObstacle, SceneJsonRoundTrip) {
   const Json j = Json::parse(R"({"kind": "mesh", "file": "bowl.obj", "scale": 2,
       "position": [0, 1, 0], "rotation_degrees": [0, 90, 0],
       "motion": {"kind": "oscillation", "amplitude": [0, 0.1, 0], "frequency": 1},
-      "angular_velocity_degrees": [0, 30, 0], "contact": {"model": "coulomb", "friction": 0.7}})");
+      "angular_velocity_degrees": [0, 30, 0], "contact": {"model": "coulomb", "friction": 0.7, "static_friction": 0.8}})");
   const auto spec = read_terrain_spec(j, "terrains[0]", dir.path().string());
   const auto& m = dynamic_cast<const MeshObstacleSpec&>(*spec);
   EXPECT_EQ(m.file, dir.file("bowl.obj"));
