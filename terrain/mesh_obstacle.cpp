@@ -148,7 +148,9 @@ MeshDistance::Query MeshObstacle::local_query(const Vec3& p, Real t) const {
   const Vec3 q = rotation(t).transpose() * (p - position(t));
   LastQuery& last = last_query;
   if (last.serial != shape_->serial || last.q != q) {
-    last.answer = shape_->distance.query(q);
+    // The previous particle's nearest triangle bounds the search (neighbours come in turn).
+    last.answer =
+        shape_->distance.query(q, last.serial == shape_->serial ? last.answer.triangle : -1);
     last.q = q;
     last.serial = shape_->serial;
   }

@@ -1,5 +1,6 @@
 // The mesh obstacle's signed distance: the tree's nearest point against a search over every
-// triangle, and distance, normal and closest point against the analytic box and sphere.
+// triangle, distance, normal and closest point against the analytic box and sphere, and the
+// sign against the winding number.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,6 +8,9 @@
 #include <random>
 
 #include <jelly/geometry/mesh_distance.hpp>
+#include <jelly/geometry/winding_number.hpp>
+
+#include "support/meshes.hpp"
 
 namespace jelly {
 namespace {
@@ -111,15 +115,43 @@ TEST(MeshDistance, SphereMeshIsTheSphereToItsChordError) {
   EXPECT_GT(inside, 50);  // the sample reached inside
 }
 
-// The sign is the winding number's: a point inside a mesh oriented outwards is negative; far
-// points are found as exactly as near ones.
-TEST(MeshDistance, FarPointsAndTheSign) {
+// Far points are found as exactly as near ones.
+TEST(MeshDistance, FarPoints) {
   const MeshDistance mesh(box_mesh(Vec3(1, 1, 1)));
   EXPECT_NEAR(mesh.query(Vec3(0, 100, 0)).distance, 99.5, 1e-12);
   EXPECT_NEAR(mesh.query(Vec3(100, 100, 100)).distance, std::sqrt(3.0) * 99.5, 1e-9);
   EXPECT_NEAR(mesh.query(Vec3(0, 0, 0)).distance, -0.5, 1e-15);
-  EXPECT_TRUE(mesh.inside(Vec3(0.4, -0.4, 0.4)));
-  EXPECT_FALSE(mesh.inside(Vec3(0.6, 0, 0)));
+}
+
+// The pseudo-normal sign agrees with the generalized winding number (summed exactly) on a
+// concave mesh, near its surface (where the nearest feature is often an edge or a vertex) and
+// away from it; and a hint changes nothing, not even which of equally near triangles is named.
+TEST(MeshDistance, SignIsTheWindingNumbersAndHintsChangeNothing) {
+  const TriangleMesh bowl = testing::bowl_mesh(1.0, 0.1, 12, 20);
+  const MeshDistance mesh(bowl);
+  const WindingNumber winding(bowl);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<Real> u(-1.3, 1.3), v(-1e-3, 1e-3), pick(0, 1);
+  int inside = 0;
+  for (int k = 0; k < 3000; ++k) {
+    Vec3 q(u(rng), u(rng), u(rng));
+    if (k % 2 == 1) {  // near a vertex or an edge of the mesh
+      const Triangle& t = bowl.triangles[k % bowl.num_triangles()];
+      const Real s = pick(rng);
+      q = (k % 4 == 1 ? bowl.vertices[t[0]]
+                      : Vec3(s * bowl.vertices[t[0]] + (1 - s) * bowl.vertices[t[1]])) +
+          Vec3(v(rng), v(rng), v(rng));
+    }
+    const MeshDistance::Query r = mesh.query(q);
+    const bool in = winding.exact(q) >= 0.5;
+    ASSERT_EQ(r.distance < 0, in) << q.transpose() << " d = " << r.distance;
+    inside += in;
+    const MeshDistance::Query h = mesh.query(q, (7 * k) % bowl.num_triangles());
+    EXPECT_EQ(h.distance, r.distance);
+    EXPECT_EQ(h.triangle, r.triangle);
+    EXPECT_EQ(h.closest, r.closest);
+  }
+  EXPECT_GT(inside, 100);
 }
 
 }  // namespace
