@@ -260,7 +260,7 @@ TEST(BadScenes, OutOfRangeValuesSayWhatIsAllowed) {
             "terrains[2].normal = 0 0 0 is invalid: a finite, non-zero vector");
   EXPECT_EQ(error_of(kGood, {"terrains[2].kind=wall"}),
             "terrains[2].kind = \"wall\" is invalid: one of \"box\", \"capsule\", \"cylinder\", "
-            "\"elevator\", \"plane\", \"slope\", \"sphere\"");
+            "\"elevator\", \"mesh\", \"plane\", \"slope\", \"sphere\"");
   EXPECT_EQ(error_of(kGood, {"integrator.dt=0"}),
             "integrator.dt = 0 is invalid: a finite time step > 0 s");
   EXPECT_EQ(error_of(kGood, {"duration=-1"}), "duration = -1 is invalid: a finite duration > 0 s");
