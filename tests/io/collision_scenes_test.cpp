@@ -1,5 +1,5 @@
 // The collision scenes of issue 13 run as shipped: scenes/folding_strip.json folds onto itself
-// without ever self-penetrating.
+// without ever self-penetrating; in scenes/bear_in_bowl.json the bears come to rest in the bowl.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,6 +12,9 @@
 #include <jelly/core/measures.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/contact/broad_phase.hpp>
+#include <jelly/terrain/mesh_obstacle.hpp>
+
+#include "support/systems.hpp"
 
 namespace jelly {
 namespace {
@@ -83,6 +86,47 @@ TEST(CollisionScenes, FoldingStripNeverSelfPenetrates) {
   for (int i = 0; i < m.num_particles(); ++i) highest = std::max(highest, sim.state().x[3 * i + 1]);
   EXPECT_GT(highest, 0.5 + 0.3);
   EXPECT_LT((center_of_mass(m, sim.state()) - com_at_3).norm(), 0.01);
+}
+
+// The three bears fall into the bowl (a mesh obstacle), pile at its bottom and come to rest: in
+// the last second no bear's centre moves 1 cm; at every frame no particle is more than 1 mm
+// inside the bowl's mesh, and at the end every particle is in the bowl (below its rim, inside
+// its inner radius).
+TEST(CollisionScenes, BearsComeToRestInTheBowl) {
+  const Scene scene = load_scene(scene_path("bear_in_bowl.json"));
+  Simulator sim = make_simulator(scene);
+  const Model& m = sim.model();
+  ASSERT_EQ(m.num_bodies(), 3);
+  const auto& bowl = dynamic_cast<const MeshObstacle&>(*sim.terrains().at(1));
+  const Real scale = bowl.spec().pose.scale;
+  // assets/bowl.obj: inner radius 0.36, rim at y = 0.4, centred on the y axis.
+  const Real inner_radius = 0.36 * scale, rim = 0.4 * scale;
+  Real deepest = 0;
+  testing::Probe probe([&](const Simulator& s) {
+    for (int i = 0; i < m.num_particles(); ++i)
+      deepest = std::min(deepest, bowl.signed_distance(particle(s.state().x, i), s.state().t));
+  });
+  sim.add_observer(probe);
+  const auto centres = [&] {
+    std::vector<Vec3> c;
+    for (const Body& b : m.bodies) {
+      Vec3 sum = Vec3::Zero();
+      for (int i = b.first_particle; i < b.end_particle(); ++i) sum += particle(sim.state().x, i);
+      c.push_back(sum / b.num_particles);
+    }
+    return c;
+  };
+  ASSERT_TRUE(sim.run_until(scene.duration - 1).ok());
+  const std::vector<Vec3> before = centres();
+  ASSERT_TRUE(sim.run_until(scene.duration).ok());
+  const std::vector<Vec3> after = centres();
+  for (int b = 0; b < 3; ++b) EXPECT_LT((after[b] - before[b]).norm(), 0.01) << b;
+  EXPECT_GE(deepest, -1e-3);
+  for (int i = 0; i < m.num_particles(); ++i) {
+    const Vec3 x = particle(sim.state().x, i);
+    EXPECT_LT(x.y(), rim) << i;
+    EXPECT_LT(std::hypot(x.x(), x.z()), inner_radius) << i;
+  }
 }
 
 }  // namespace
