@@ -30,7 +30,7 @@ def shaded(polygons, colour, light=(0.4, -0.3, 0.87)):
     return np.hstack([rgb, np.ones((len(rgb), 1))])
 
 
-def draw_snapshot(ax, rec, frame, limits, all_springs):
+def draw_snapshot(ax, rec, frame, limits, all_springs, elevation=15):
     x = rec.position[frame]
     keep = np.ones(len(rec.springs), bool) if all_springs else rec.spring_type == 0
     for X, Z, Y in jelly_h5.terrain_surfaces(rec, frame, limits):
@@ -53,7 +53,7 @@ def draw_snapshot(ax, rec, frame, limits, all_springs):
     ax.add_collection3d(lines)
     ax.scatter(x[~drawn, 0], x[~drawn, 2], x[~drawn, 1], s=0.5, c="navy", depthshade=False)
     jelly_h5.style_axis(ax, limits)
-    ax.view_init(elev=15, azim=-70)
+    ax.view_init(elev=elevation, azim=-70)
     ax.set_title(f"t = {rec.time[frame]:.2f} s")
 
 
@@ -62,6 +62,9 @@ def main():
     parser.add_argument("file", help="a recording written by jelly (HDF5)")
     parser.add_argument("-o", "--output", help="PNG path (default: FILE with .png)")
     parser.add_argument("--snapshots", type=int, default=4, help="3-D snapshots (default 4)")
+    parser.add_argument("--elevation", type=float, default=15,
+                        help="the snapshots' view from above, degrees (default 15; more to see "
+                             "into a bowl)")
     parser.add_argument("--all-springs", action="store_true",
                         help="draw every spring and particle instead of the surfaces "
                         "(default: surfaces; structural springs of bodies without one)")
@@ -125,7 +128,7 @@ def main():
     frames = np.unique(np.linspace(0, rec.frames - 1, args.snapshots).round().astype(int))
     for k, frame in enumerate(frames):
         draw_snapshot(fig.add_subplot(grid[1, k], projection="3d"), rec, frame, limits,
-                      args.all_springs)
+                      args.all_springs, args.elevation)
     fig.suptitle(f"{os.path.basename(args.file)}: {rec.title()}")
     fig.savefig(output, dpi=100)
     print(f"wrote {output}")
