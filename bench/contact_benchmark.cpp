@@ -59,6 +59,7 @@ BENCHMARK(BM_BodyContactResolve)
     ->Arg(10)
     ->Arg(20)
     ->Arg(30)
+    ->Arg(32)
     ->Arg(40)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
