@@ -95,7 +95,8 @@ int main(int argc, char** argv) {
   fit->add_option("recording", fit_args.recording, "HDF5 file")->required()->check(kNonEmpty);
   fit->add_option("--free", fit_args.free,
                   "Coefficients to fit: ks,kd (all types together) or per type, e.g. "
-                  "ks.structural,ks.shear,ks.bending,kd")
+                  "ks.structural,ks.shear,ks.bending,kd; each for every body or for one, "
+                  "prefixed by its name: soft.ks,stiff.ks,kd")
       ->capture_default_str()
       ->check(kNonEmpty);
   fit->add_option("--window", fit_args.window,

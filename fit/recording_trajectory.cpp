@@ -39,7 +39,7 @@ Trajectory trajectory_from_recording(const Recording& recording) {
 
 Scene fitted_scene(const Recording& recording, const FitResult& result) {
   Scene scene = recording_scene(recording);
-  for (BodySpec& body : scene.bodies) apply_fit(body.material, result);
+  for (BodySpec& body : scene.bodies) apply_fit(body.material, result, body.name);
   return scene;
 }
 

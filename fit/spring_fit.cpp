@@ -51,7 +51,8 @@ std::vector<Window> make_windows(const Trajectory& trajectory, Real length) {
 void set_parameter(Model& model, const FitParameter& p, Real value) {
   Springs& s = model.springs;
   std::vector<Real>& target = p.quantity == FitParameter::Quantity::kKs ? s.ks : s.kd;
-  for (int j = 0; j < s.size(); ++j)
+  const auto [first, end] = p.spring_range(model);
+  for (int j = first; j < end; ++j)
     if (p.applies_to(s.type[j])) target[j] = value;
 }
 
@@ -199,7 +200,8 @@ Real mean_coefficient(const Model& model, const FitParameter& p) {
   const Springs& s = model.springs;
   Real sum = 0;
   int count = 0;
-  for (int j = 0; j < s.size(); ++j) {
+  const auto [first, end] = p.spring_range(model);
+  for (int j = first; j < end; ++j) {
     if (!p.applies_to(s.type[j])) continue;
     sum += p.quantity == FitParameter::Quantity::kKs ? s.ks[j] : s.kd[j];
     ++count;
@@ -210,16 +212,29 @@ Real mean_coefficient(const Model& model, const FitParameter& p) {
 }  // namespace
 
 std::string FitParameter::name() const {
-  std::string n = quantity == Quantity::kKs ? "ks" : "kd";
+  std::string n = body.empty() ? "" : body + ".";
+  n += quantity == Quantity::kKs ? "ks" : "kd";
   if (type) n += "." + std::string(spring_type_name(*type));
   return n;
+}
+
+std::pair<int, int> FitParameter::spring_range(const Model& model) const {
+  if (body.empty()) return {0, model.springs.size()};
+  const Body* b = model.find_body(body);
+  if (b == nullptr) {
+    std::string known;
+    for (const Body& other : model.bodies) known += (known.empty() ? "" : ", ") + other.name;
+    throw InputError("free", name(), "a body of the recording: one of " + known);
+  }
+  return {b->first_spring, b->end_spring()};
 }
 
 std::vector<FitParameter> parse_free_parameters(std::string_view list) {
   std::vector<FitParameter> result;
   const std::string allowed =
       "a comma-separated list of ks, kd, ks.structural, ks.shear, ks.bending, kd.structural, "
-      "kd.shear, kd.bending, without overlaps";
+      "kd.shear, kd.bending, each for every body or prefixed by a body's name (soft.ks), "
+      "without overlaps";
   size_t start = 0;
   while (start <= list.size()) {
     const size_t comma = std::min(list.find(',', start), list.size());
@@ -227,6 +242,21 @@ std::vector<FitParameter> parse_free_parameters(std::string_view list) {
     while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
     while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
     FitParameter p;
+    // "<body>.ks...": a first word other than ks and kd, or ks/kd followed by one that is not a
+    // spring type (a body named "ks": "ks.ks"), names a body.
+    const std::string_view first_word = item.substr(0, item.find('.'));
+    const std::string_view after =
+        first_word.size() < item.size() ? item.substr(first_word.size() + 1) : std::string_view();
+    bool has_body = first_word != "ks" && first_word != "kd";
+    if (!has_body && !after.empty()) {
+      has_body = true;
+      for (SpringType t : kTypes) has_body = has_body && after != spring_type_name(t);
+    }
+    if (has_body) {
+      require(!first_word.empty() && !after.empty(), "free", std::string(list), allowed);
+      p.body = std::string(first_word);
+      item = after;
+    }
     const std::string_view quantity = item.substr(0, item.find('.'));
     require(quantity == "ks" || quantity == "kd", "free", std::string(list), allowed);
     p.quantity = quantity == "ks" ? FitParameter::Quantity::kKs : FitParameter::Quantity::kKd;
@@ -241,7 +271,8 @@ std::vector<FitParameter> parse_free_parameters(std::string_view list) {
       require(known, "free", std::string(list), allowed);
     }
     for (const FitParameter& q : result) {
-      const bool overlap = q.quantity == p.quantity && (!q.type || !p.type || *q.type == *p.type);
+      const bool overlap = q.quantity == p.quantity && (!q.type || !p.type || *q.type == *p.type) &&
+                           (q.body.empty() || p.body.empty() || q.body == p.body);
       require(!overlap, "free", std::string(list), allowed);
     }
     result.push_back(p);
@@ -323,8 +354,12 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
     fitted.parameter = free[p];
     fitted.name = free[p].name();
     int springs = 0;
-    for (SpringType t : trajectory.model.springs.type) springs += free[p].applies_to(t);
-    require(springs > 0, "free", fitted.name, "a spring type the model has");
+    const auto [first, end] = free[p].spring_range(trajectory.model);
+    for (int j = first; j < end; ++j)
+      springs += free[p].applies_to(trajectory.model.springs.type[j]);
+    require(springs > 0, "free", fitted.name,
+            free[p].body.empty() ? "a spring type the model has"
+                                 : "a spring type body \"" + free[p].body + "\" has");
     const auto given = options.initial.find(fitted.name);
     fitted.initial = given != options.initial.end() ? given->second
                                                     : mean_coefficient(trajectory.model, free[p]);
@@ -468,8 +503,10 @@ void apply_fit(Model& model, const FitResult& result) {
 
 namespace {
 
-void apply_fit(std::array<SpringCoefficients, kSpringTypeCount>& springs, const FitResult& result) {
+void apply_fit(std::array<SpringCoefficients, kSpringTypeCount>& springs, const FitResult& result,
+               std::string_view body) {
   for (const FittedParameter& p : result.parameters) {
+    if (!p.parameter.body.empty() && p.parameter.body != body) continue;
     for (SpringType t : kTypes) {
       if (!p.parameter.applies_to(t)) continue;
       SpringCoefficients& c = springs[static_cast<int>(t)];
@@ -480,8 +517,10 @@ void apply_fit(std::array<SpringCoefficients, kSpringTypeCount>& springs, const 
 
 }  // namespace
 
-void apply_fit(Material& material, const FitResult& result) { apply_fit(material.springs, result); }
+void apply_fit(Material& material, const FitResult& result, std::string_view body) {
+  apply_fit(material.springs, result, body);
+}
 
-void apply_fit(CubeSpec& spec, const FitResult& result) { apply_fit(spec.springs, result); }
+void apply_fit(CubeSpec& spec, const FitResult& result) { apply_fit(spec.springs, result, ""); }
 
 }  // namespace jelly

@@ -6,28 +6,36 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/fit/trajectory.hpp>
+#include <jelly/geometry/cube.hpp>
 
 namespace jelly {
 
-// One free coefficient: ks or kd, of one spring type or of all types together.
+// One free coefficient: ks or kd, of one spring type or of all types together, of one body or
+// of every body.
 struct FitParameter {
   enum class Quantity { kKs, kKd };
   Quantity quantity = Quantity::kKs;
   std::optional<SpringType> type;  // none = every spring type shares the value
+  std::string body;                // "" = every body shares the value
 
-  // "ks", "kd", "ks.structural", "kd.bending", ...
+  // "ks", "kd", "ks.structural", "kd.bending", ..., prefixed "<body>." for one body's:
+  // "soft.ks", "stiff.kd.shear".
   std::string name() const;
   bool applies_to(SpringType t) const { return !type || *type == t; }
+  // The springs [first, end) of the model it applies to (every spring when `body` is empty);
+  // throws InputError (field "free") naming the model's bodies when it has no body `body`.
+  std::pair<int, int> spring_range(const Model& model) const;
 };
 
-// Parses a comma-separated list such as "ks,kd" or "ks.structural,ks.shear,kd". Throws
-// InputError (field "free") for an unknown name, a duplicate or an overlap ("ks" and
-// "ks.shear").
+// Parses a comma-separated list such as "ks,kd", "ks.structural,ks.shear,kd" or, per body
+// (scene body names), "soft.ks,stiff.ks,kd". Throws InputError (field "free") for an unknown
+// name, a duplicate or an overlap ("ks" and "ks.shear", "ks" and "soft.ks"). Whether the bodies
+// exist is checked by fit_recording against the trajectory's model.
 std::vector<FitParameter> parse_free_parameters(std::string_view list);
 
 struct FitOptions {
@@ -102,8 +110,9 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options 
 
 // Writes the fitted values into every spring they apply to.
 void apply_fit(Model& model, const FitResult& result);
-void apply_fit(Material& material, const FitResult& result);
-void apply_fit(CubeSpec& spec, const FitResult& result);
+// A body's material: the fitted values of every body and those of the body named `body`.
+void apply_fit(Material& material, const FitResult& result, std::string_view body = "");
+void apply_fit(CubeSpec& spec, const FitResult& result);  // the values of every body
 
 // 1/2 sum over the windows of |x_replay - x_recorded|^2 with the model's current coefficients.
 Real replay_cost(const Trajectory& trajectory, Real window);

@@ -3,10 +3,12 @@
 
 #include <cmath>
 #include <iostream>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/body_spec.hpp>
 
 #include "fit/fit_scenes.hpp"
 
@@ -62,13 +64,65 @@ TEST(ParseFreeParameters, NamesAndErrors) {
   EXPECT_TRUE(per_type[1].applies_to(SpringType::kShear));
   EXPECT_FALSE(per_type[1].applies_to(SpringType::kBending));
   EXPECT_TRUE(per_type[3].applies_to(SpringType::kBending));
-  for (const char* bad : {"", "ks,", "k", "ks.diagonal", "ks,ks", "ks,ks.shear", "ksx", "kd."}) {
+  // Per body: a body's name before the coefficient's ("ks.ks": the body named "ks").
+  const auto per_body = parse_free_parameters("soft.ks,stiff.ks.shear,ks.ks,kd");
+  ASSERT_EQ(per_body.size(), 4u);
+  EXPECT_EQ(per_body[0].body, "soft");
+  EXPECT_EQ(per_body[0].name(), "soft.ks");
+  EXPECT_EQ(per_body[1].name(), "stiff.ks.shear");
+  EXPECT_TRUE(per_body[1].applies_to(SpringType::kShear));
+  EXPECT_EQ(per_body[2].body, "ks");
+  EXPECT_EQ(per_body[3].body, "");
+  for (const char* bad : {"", "ks,", "k", "ks.diagonal", "ks,ks", "ks,ks.shear", "ksx", "kd.",
+                          "soft.", "soft.kx", "soft.ks,ks", "soft.ks,soft.ks.shear", ".ks"}) {
     try {
       parse_free_parameters(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";
     } catch (const InputError& e) {
       EXPECT_EQ(std::string(e.what()).rfind("free = ", 0), 0u) << e.what();
     }
+  }
+}
+
+// Two cubes of different stiffness in one recording: one ks per body (and a shared kd) recovers
+// each body's own; a body the recording lacks is an error naming those it has.
+TEST(FitRecording, OneStiffnessPerBody) {
+  Model model;
+  for (const auto& [name, ks, x] : {std::tuple<const char*, Real, Real>{"soft", 800, -1.5},
+                                    std::tuple<const char*, Real, Real>{"stiff", 2000, 1.5}}) {
+    BodySpec body;
+    body.name = name;
+    CubeShape cube;
+    cube.n = 3;
+    cube.edge_length = 1;
+    cube.origin = Vec3(x, 1, -0.5);
+    body.shape = cube;
+    body.material.springs.fill({ks, 20});
+    add_body(model, body, "");
+  }
+  Trajectory recording = testing::free_recording(model);
+  reset_to_seed(recording);
+  FitOptions options;
+  options.free = parse_free_parameters("soft.ks,stiff.ks,kd");
+  const FitResult result = fit_recording(recording, options);
+  EXPECT_TRUE(result.converged) << result.report();
+  EXPECT_NEAR(result.at("soft.ks").value, 800, 8);
+  EXPECT_NEAR(result.at("stiff.ks").value, 2000, 20);
+  EXPECT_NEAR(result.at("kd").value, 20, 0.2);
+  Material soft, stiff;
+  apply_fit(soft, result, "soft");
+  apply_fit(stiff, result, "stiff");
+  EXPECT_EQ(soft.springs[1].ks, result.at("soft.ks").value);
+  EXPECT_EQ(stiff.springs[1].ks, result.at("stiff.ks").value);
+  EXPECT_EQ(stiff.springs[2].kd, result.at("kd").value);
+
+  options.free = parse_free_parameters("blob.ks");
+  try {
+    fit_recording(recording, options);
+    ADD_FAILURE() << "fitted a body the recording does not have";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "free = blob.ks is invalid: a body of the recording: one of soft, stiff");
   }
 }
 
