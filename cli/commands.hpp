@@ -41,6 +41,7 @@ struct FitArgs {
   int max_iterations = 50;           // --max-iterations
   std::string write_scene;           // --write-scene: the scene with the fitted values
   bool overwrite = false;            // --overwrite: replace an existing --write-scene file
+  bool no_covariance = false;        // --no-covariance: estimates without standard deviations
 };
 
 // jelly fit RECORDING.h5: the spring and damper coefficients that replay the recording best.

@@ -90,6 +90,7 @@ int fit_command(const FitArgs& args) {
   options.free = parse_free_parameters(args.free);
   options.window = args.window;
   options.max_iterations = args.max_iterations;
+  options.compute_covariance = !args.no_covariance;
   for (const std::string& assignment : args.initial) {
     const auto [name, value] = parse_initial(assignment);
     bool known = false;

@@ -116,6 +116,10 @@ int main(int argc, char** argv) {
                   "existing file is an error unless --overwrite")
       ->check(kNonEmpty);
   fit->add_flag("--overwrite", fit_args.overwrite, "Replace an existing --write-scene file");
+  fit->add_flag("--no-covariance", fit_args.no_covariance,
+                "No standard deviations: the restart-aware covariance replays every window twice "
+                "per coordinate of its start state (6 x particles replays per window), most of "
+                "the time on a large body");
 
   CLI::App* list = app.add_subcommand(
       "list", "List the integrators, terrain kinds and contact models, one per line");

@@ -342,6 +342,13 @@ TEST(Cli, FitRecoversTheCoefficientsOfARecording) {
   }
   EXPECT_THAT(r.out, HasSubstr("ks = "));
   EXPECT_THAT(r.out, HasSubstr("(start 1400"));
+  EXPECT_THAT(r.out, HasSubstr("covariance: ok"));
+
+  // --no-covariance: the same estimates, without the covariance's replays.
+  r = jelly("fit '" + file + "' --initial ks=1400 --initial kd=30 --no-covariance");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("covariance: failed: not requested"));
+  EXPECT_THAT(r.out, HasSubstr("ks = "));
 }
 
 TEST(Cli, FitErrorsExitTwo) {
