@@ -3,15 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <jelly/core/detail/band_kernels.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/forces.hpp>
-
-// As spring_bands.cpp: one copy of the band loops per instruction set, chosen at load time.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define JELLY_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define JELLY_VECTOR_CLONES
-#endif
 
 namespace jelly {
 
@@ -106,18 +100,6 @@ void band_products(int n, Ends p, const Real* __restrict c1, const Real* __restr
   }
 }
 
-// a[j] += sign t[j] for the three coordinates.
-JELLY_VECTOR_CLONES
-void accumulate(int n, Real sign, const Real* __restrict tx, const Real* __restrict ty,
-                const Real* __restrict tz, Real* __restrict ax, Real* __restrict ay,
-                Real* __restrict az) {
-  for (int j = 0; j < n; ++j) {
-    ax[j] += sign * tx[j];
-    ay[j] += sign * ty[j];
-    az[j] += sign * tz[j];
-  }
-}
-
 // The six entries xx, yy, zz, xy, xz, yz of B = c1 u u^T + c2 I added to d[0..5][j].
 JELLY_VECTOR_CLONES
 void accumulate_blocks(int n, const Real* __restrict c1, const Real* __restrict c2,
@@ -135,12 +117,22 @@ void accumulate_blocks(int n, const Real* __restrict c1, const Real* __restrict 
   }
 }
 
-// The slots of a band that touch particles [p0, p1): [lo, hi).
-struct SlotRange {
-  int lo, hi;
-};
-SlotRange touching(const SpringBands::Band& band, int p0, int p1) {
-  return {std::max(0, p0 - band.offset - band.first), std::min(band.slots(), p1 - band.first)};
+// The terms of `len` slots from position q of a thread's per-slot buffers, at the particles
+// from `particle` on (the slots' first ends, or their second ends when !first_end): +t (first
+// ends) or -t (second ends) into the accumulators acc (x, y, z: 3 arrays of n) and each slot's
+// block B into the particles' diagonal blocks diag (xx, yy, zz, xy, xz, yz: 6 arrays of n).
+void add_slot_terms(int n, int particle, int len, int q, bool first_end, const Real* c1,
+                    const Real* c2, const Real* ux, const Real* uy, const Real* uz, const Real* tx,
+                    const Real* ty, const Real* tz, Real* acc, Real* diag) {
+  Real* ax = acc + particle;
+  if (first_end) {
+    band_kernels::add(len, tx + q, ty + q, tz + q, ax, ax + n, ax + 2 * n);
+  } else {
+    band_kernels::subtract(len, tx + q, ty + q, tz + q, ax, ax + n, ax + 2 * n);
+  }
+  Real* d = diag + particle;
+  accumulate_blocks(len, c1 + q, c2 + q, ux + q, uy + q, uz + q, d, d + n, d + 2 * n, d + 3 * n,
+                    d + 4 * n, d + 5 * n);
 }
 
 }  // namespace
@@ -157,22 +149,27 @@ BandSystem::BandSystem(const SpringBands& bands, int num_particles)
     s.uz.assign(n, 0.0);
     slots_.push_back(std::move(s));
   }
+  for (const auto& band : bands.bands()) slots_total_ += band.slots();
+  stride_ = static_cast<size_t>(num_particles) + static_cast<size_t>(bands.max_offset());
   mass_.assign(num_particles, 0.0);
   diagonal_.assign(6 * static_cast<size_t>(num_particles), 0.0);
   scratch_.assign(12 * static_cast<size_t>(num_particles), 0.0);
+}
+
+int BandSystem::team(int threads) const {
+  const int team = parallel::team_size(threads, slots_total_, kMinSlotsPerThread);
+  if (band_.size() < static_cast<size_t>(team) * 8 * stride_) {
+    band_.assign(static_cast<size_t>(team) * 8 * stride_, 0.0);
+  }
+  return team;
 }
 
 bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, DefinitenessFix fix,
                           Real alpha, Real beta, const VecX& w, VecX& kw, int threads) {
   const int n = num_particles_;
   const std::vector<SpringBands::Band>& bands = bands_->bands();
-  long slots = 0;
-  for (const auto& band : bands) slots += band.slots();
-  const int team = parallel::team_size(threads, slots, kMinSlotsPerThread);
-  const size_t stride = static_cast<size_t>(n) + static_cast<size_t>(bands_->max_offset());
-  if (band_.size() < static_cast<size_t>(team) * 8 * stride) {
-    band_.assign(static_cast<size_t>(team) * 8 * stride, 0.0);
-  }
+  const int team = this->team(threads);
+  const size_t stride = stride_;
   if (collapsed_.size() < static_cast<size_t>(team)) collapsed_.assign(team, 0);
   const int fix_code = fix == DefinitenessFix::kClampCompressed ? 1
                        : fix == DefinitenessFix::kProjectPsd    ? 2
@@ -210,39 +207,29 @@ bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, Defi
     int collapsed = 0;
     for (size_t k = 0; k < bands.size(); ++k) {
       const SpringBands::Band& band = bands[k];
-      const int o = band.offset, first = band.first;
-      const SlotRange sr = touching(band, p0, p1);
-      if (sr.lo >= sr.hi) continue;
-      const int a = first + sr.lo, b = a + o;
+      const SpringBands::Band::Reach r = band.reach(p0, p1);
+      if (r.lo >= r.hi) continue;
+      const int a = band.first + r.lo, b = a + band.offset;
       const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
       const Ends ev{sv + a, sv + n + a, sv + 2 * n + a, sv + b, sv + n + b, sv + 2 * n + b};
       const Ends ew{sw + a, sw + n + a, sw + 2 * n + a, sw + b, sw + n + b, sw + 2 * n + b};
-      const int count = sr.hi - sr.lo;
-      collapsed += band_blocks(count, fix_code, alpha, beta, ex, ev, ew, band.rest.data() + sr.lo,
-                               band.ks.data() + sr.lo, band.kd.data() + sr.lo, c1, c2, ux, uy, uz,
-                               tx, ty, tz);
+      collapsed +=
+          band_blocks(r.hi - r.lo, fix_code, alpha, beta, ex, ev, ew, band.rest.data() + r.lo,
+                      band.ks.data() + r.lo, band.kd.data() + r.lo, c1, c2, ux, uy, uz, tx, ty, tz);
       // This thread stores the slots whose first particle is its own.
       Slots& out = slots_[k];
-      const int a0 = std::max(p0, a), a1 = std::min(p1, first + sr.hi);
-      if (a0 < a1) {
-        const int q = a0 - a, slot = a0 - first, len = a1 - a0;
+      if (r.a0 < r.a1) {
+        const int q = r.a0 - a, slot = r.a0 - band.first, len = r.a1 - r.a0;
         std::copy(c1 + q, c1 + q + len, out.c1.data() + slot);
         std::copy(c2 + q, c2 + q + len, out.c2.data() + slot);
         std::copy(ux + q, ux + q + len, out.ux.data() + slot);
         std::copy(uy + q, uy + q + len, out.uy.data() + slot);
         std::copy(uz + q, uz + q + len, out.uz.data() + slot);
-        accumulate(len, 1.0, tx + q, ty + q, tz + q, acc + a0, acc + n + a0, acc + 2 * n + a0);
-        accumulate_blocks(len, c1 + q, c2 + q, ux + q, uy + q, uz + q, diag + a0, diag + n + a0,
-                          diag + 2 * n + a0, diag + 3 * n + a0, diag + 4 * n + a0,
-                          diag + 5 * n + a0);
+        add_slot_terms(n, r.a0, len, q, true, c1, c2, ux, uy, uz, tx, ty, tz, acc, diag);
       }
-      const int b0 = std::max(p0, b), b1 = std::min(p1, first + o + sr.hi);
-      if (b0 < b1) {
-        const int q = b0 - b, len = b1 - b0;
-        accumulate(len, -1.0, tx + q, ty + q, tz + q, acc + b0, acc + n + b0, acc + 2 * n + b0);
-        accumulate_blocks(len, c1 + q, c2 + q, ux + q, uy + q, uz + q, diag + b0, diag + n + b0,
-                          diag + 2 * n + b0, diag + 3 * n + b0, diag + 4 * n + b0,
-                          diag + 5 * n + b0);
+      if (r.b0 < r.b1) {
+        add_slot_terms(n, r.b0, r.b1 - r.b0, r.b0 - b, false, c1, c2, ux, uy, uz, tx, ty, tz, acc,
+                       diag);
       }
     }
     collapsed_[part] = collapsed;
@@ -273,13 +260,8 @@ void BandSystem::diagonal_block(int i, Real out[9]) const {
 void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
   const int n = num_particles_;
   const std::vector<SpringBands::Band>& bands = bands_->bands();
-  long slots = 0;
-  for (const auto& band : bands) slots += band.slots();
-  const int team = parallel::team_size(threads, slots, kMinSlotsPerThread);
-  const size_t stride = static_cast<size_t>(n) + static_cast<size_t>(bands_->max_offset());
-  if (band_.size() < static_cast<size_t>(team) * 8 * stride) {
-    band_.assign(static_cast<size_t>(team) * 8 * stride, 0.0);
-  }
+  const int team = this->team(threads);
+  const size_t stride = stride_;
   Real* sp = scratch_.data();
   Real* acc = sp + 9 * static_cast<size_t>(n);
   parallel::run(team, [&](int part, int parts) {
@@ -297,23 +279,22 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
     Real* tz = ty + stride;
     for (size_t k = 0; k < bands.size(); ++k) {
       const SpringBands::Band& band = bands[k];
-      const int o = band.offset, first = band.first;
-      const SlotRange sr = touching(band, p0, p1);
-      if (sr.lo >= sr.hi) continue;
-      const int a = first + sr.lo, b = a + o;
+      const SpringBands::Band::Reach r = band.reach(p0, p1);
+      if (r.lo >= r.hi) continue;
+      const int a = band.first + r.lo, b = a + band.offset;
       const Ends ep{sp + a, sp + n + a, sp + 2 * n + a, sp + b, sp + n + b, sp + 2 * n + b};
       const Slots& s = slots_[k];
-      band_products(sr.hi - sr.lo, ep, s.c1.data() + sr.lo, s.c2.data() + sr.lo,
-                    s.ux.data() + sr.lo, s.uy.data() + sr.lo, s.uz.data() + sr.lo, tx, ty, tz);
-      const int a0 = std::max(p0, a), a1 = std::min(p1, first + sr.hi);
-      if (a0 < a1) {
-        const int q = a0 - a;
-        accumulate(a1 - a0, 1.0, tx + q, ty + q, tz + q, acc + a0, acc + n + a0, acc + 2 * n + a0);
+      band_products(r.hi - r.lo, ep, s.c1.data() + r.lo, s.c2.data() + r.lo, s.ux.data() + r.lo,
+                    s.uy.data() + r.lo, s.uz.data() + r.lo, tx, ty, tz);
+      if (r.a0 < r.a1) {
+        const int q = r.a0 - a;
+        band_kernels::add(r.a1 - r.a0, tx + q, ty + q, tz + q, acc + r.a0, acc + n + r.a0,
+                          acc + 2 * n + r.a0);
       }
-      const int b0 = std::max(p0, b), b1 = std::min(p1, first + o + sr.hi);
-      if (b0 < b1) {
-        const int q = b0 - b;
-        accumulate(b1 - b0, -1.0, tx + q, ty + q, tz + q, acc + b0, acc + n + b0, acc + 2 * n + b0);
+      if (r.b0 < r.b1) {
+        const int q = r.b0 - b;
+        band_kernels::subtract(r.b1 - r.b0, tx + q, ty + q, tz + q, acc + r.b0, acc + n + r.b0,
+                               acc + 2 * n + r.b0);
       }
     }
     for (int i = p0; i < p1; ++i) {

@@ -185,6 +185,19 @@ bool SpringJacobian::matches(const SparseMatrix& m) const {
          m.nonZeros() == non_zeros();
 }
 
+template <class Spring, class Block>
+void SpringJacobian::for_column_springs(int j, Spring&& spring, Block&& block) const {
+  const int end = adjacency_start_[j + 1];
+  int e = adjacency_start_[j];
+  const int blocks = column_stride_[j] / 3;
+  for (int slot = 0; slot < blocks; ++slot) {
+    if (slot == self_slot_[j]) continue;
+    const int i = neighbour_[e];
+    for (; e < end && neighbour_[e] == i; ++e) spring(i, spring_[e]);
+    block(slot);
+  }
+}
+
 template <class Column>
 void SpringJacobian::for_columns(int threads, Column&& column) const {
   const int team = parallel::team_size(threads, num_particles_, kMinColumnsPerThread);
@@ -222,28 +235,27 @@ void SpringJacobian::assemble(const Model& model, const VecX& x, const VecX& v,
     Real* dcol = dv + col_start_[3 * j];
     Real kdiag[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
     Real ddiag[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    const int end = adjacency_start_[j + 1];
-    int e = adjacency_start_[j];
-    const int blocks = stride / 3;
+    Real koff[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    Real doff[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
     SpringBlocks sb;
-    for (int slot = 0; slot < blocks; ++slot) {
-      if (slot == self_slot_[j]) continue;
-      const int i = neighbour_[e];
-      Real koff[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-      Real doff[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-      for (; e < end && neighbour_[e] == i; ++e) {
-        const int sp = spring_[e];
-        spring_blocks(px, pv, pr, 3 * j, 3 * i, s.rest_length[sp], s.ks[sp], s.kd[sp], options, sb);
-        for (int q = 0; q < 9; ++q) {
-          koff[q] -= sb.k[q];
-          doff[q] -= sb.d[q];
-          kdiag[q] += sb.k[q];
-          ddiag[q] += sb.d[q];
-        }
-      }
-      write_block(kcol, stride, slot, koff);
-      write_block(dcol, stride, slot, doff);
-    }
+    for_column_springs(
+        j,
+        [&](int i, int sp) {
+          spring_blocks(px, pv, pr, 3 * j, 3 * i, s.rest_length[sp], s.ks[sp], s.kd[sp], options,
+                        sb);
+          for (int q = 0; q < 9; ++q) {
+            koff[q] -= sb.k[q];
+            doff[q] -= sb.d[q];
+            kdiag[q] += sb.k[q];
+            ddiag[q] += sb.d[q];
+          }
+        },
+        [&](int slot) {
+          write_block(kcol, stride, slot, koff);
+          write_block(dcol, stride, slot, doff);
+          std::fill(koff, koff + 9, 0.0);
+          std::fill(doff, doff + 9, 0.0);
+        });
     write_block(kcol, stride, self_slot_[j], kdiag);
     write_block(dcol, stride, self_slot_[j], ddiag);
   });
@@ -276,29 +288,27 @@ void SpringJacobian::assemble_system(const Model& model, const VecX& x, const Ve
     Real diag[9] = {mj, 0, 0, 0, mj, 0, 0, 0, mj};
     Real kwj[3] = {0, 0, 0};
     const Real* wj = pw + 3 * j;
-    const int end = adjacency_start_[j + 1];
-    int e = adjacency_start_[j];
-    const int blocks = stride / 3;
+    Real off[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
     SpringBlocks sb;
-    for (int slot = 0; slot < blocks; ++slot) {
-      if (slot == self_slot_[j]) continue;
-      const int i = neighbour_[e];
-      const Real* wi = pw + 3 * i;
-      const Real dw[3] = {wj[0] - wi[0], wj[1] - wi[1], wj[2] - wi[2]};
-      Real off[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-      for (; e < end && neighbour_[e] == i; ++e) {
-        const int sp = spring_[e];
-        spring_blocks(px, pv, pr, 3 * j, 3 * i, s.rest_length[sp], s.ks[sp], s.kd[sp], options, sb);
-        for (int r = 0; r < 3; ++r)
-          kwj[r] += sb.k[3 * r] * dw[0] + sb.k[3 * r + 1] * dw[1] + sb.k[3 * r + 2] * dw[2];
-        for (int q = 0; q < 9; ++q) {
-          const Real ab = -alpha * sb.d[q] - beta * sb.k[q];
-          off[q] -= ab;
-          diag[q] += ab;
-        }
-      }
-      write_block(col, stride, slot, off);
-    }
+    for_column_springs(
+        j,
+        [&](int i, int sp) {
+          const Real* wi = pw + 3 * i;
+          const Real dw[3] = {wj[0] - wi[0], wj[1] - wi[1], wj[2] - wi[2]};
+          spring_blocks(px, pv, pr, 3 * j, 3 * i, s.rest_length[sp], s.ks[sp], s.kd[sp], options,
+                        sb);
+          for (int r = 0; r < 3; ++r)
+            kwj[r] += sb.k[3 * r] * dw[0] + sb.k[3 * r + 1] * dw[1] + sb.k[3 * r + 2] * dw[2];
+          for (int q = 0; q < 9; ++q) {
+            const Real ab = -alpha * sb.d[q] - beta * sb.k[q];
+            off[q] -= ab;
+            diag[q] += ab;
+          }
+        },
+        [&](int slot) {
+          write_block(col, stride, slot, off);
+          std::fill(off, off + 9, 0.0);
+        });
     write_block(col, stride, self_slot_[j], diag);
     pkw[3 * j] = kwj[0];
     pkw[3 * j + 1] = kwj[1];

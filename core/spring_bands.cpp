@@ -4,17 +4,9 @@
 #include <cmath>
 #include <map>
 
+#include <jelly/core/detail/band_kernels.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/forces.hpp>
-
-// One copy of the band loops per instruction set, chosen when the library is loaded (GCC's
-// function multi-versioning): AVX2 where the CPU has it, the x86-64 baseline (SSE2) elsewhere.
-// AVX-512 is not among them: docs/benchmarks.md ("The force loop").
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define JELLY_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define JELLY_VECTOR_CLONES
-#endif
 
 namespace jelly {
 
@@ -61,29 +53,6 @@ int band_forces(int n, BandEnds e, const Real* __restrict rest, const Real* __re
   return collapsed;
 }
 
-// a[j] += f[j] (sign > 0) or a[j] -= f[j] for the three coordinates.
-JELLY_VECTOR_CLONES
-void add_band(int n, const Real* __restrict fx, const Real* __restrict fy,
-              const Real* __restrict fz, Real* __restrict ax, Real* __restrict ay,
-              Real* __restrict az) {
-  for (int j = 0; j < n; ++j) {
-    ax[j] += fx[j];
-    ay[j] += fy[j];
-    az[j] += fz[j];
-  }
-}
-
-JELLY_VECTOR_CLONES
-void subtract_band(int n, const Real* __restrict fx, const Real* __restrict fy,
-                   const Real* __restrict fz, Real* __restrict ax, Real* __restrict ay,
-                   Real* __restrict az) {
-  for (int j = 0; j < n; ++j) {
-    ax[j] -= fx[j];
-    ay[j] -= fy[j];
-    az[j] -= fz[j];
-  }
-}
-
 // Springs per thread below which another thread costs more than it saves.
 constexpr long kMinSpringsPerThread = 8192;
 
@@ -93,6 +62,42 @@ constexpr Real kMinimumFill = 0.5;
 constexpr int kMinimumSpringsPerBand = 4;
 
 }  // namespace
+
+namespace band_kernels {
+
+JELLY_VECTOR_CLONES
+void add(int n, const Real* __restrict tx, const Real* __restrict ty, const Real* __restrict tz,
+         Real* __restrict ax, Real* __restrict ay, Real* __restrict az) {
+  for (int j = 0; j < n; ++j) {
+    ax[j] += tx[j];
+    ay[j] += ty[j];
+    az[j] += tz[j];
+  }
+}
+
+JELLY_VECTOR_CLONES
+void subtract(int n, const Real* __restrict tx, const Real* __restrict ty,
+              const Real* __restrict tz, Real* __restrict ax, Real* __restrict ay,
+              Real* __restrict az) {
+  for (int j = 0; j < n; ++j) {
+    ax[j] -= tx[j];
+    ay[j] -= ty[j];
+    az[j] -= tz[j];
+  }
+}
+
+}  // namespace band_kernels
+
+SpringBands::Band::Reach SpringBands::Band::reach(int p0, int p1) const {
+  Reach r;
+  r.lo = std::max(0, p0 - offset - first);
+  r.hi = std::min(slots(), p1 - first);
+  r.a0 = std::max(p0, first + r.lo);
+  r.a1 = std::min(p1, first + r.hi);
+  r.b0 = std::max(p0, first + offset + r.lo);
+  r.b1 = std::min(p1, first + offset + r.hi);
+  return r;
+}
 
 SpringBands::SpringBands(const Model& model)
     : particles_(model.num_particles()), springs_(model.springs.size()) {
@@ -197,25 +202,22 @@ void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& 
     Real* fz = fy + stride / 3;
     int collapsed = 0;
     for (const Band& band : bands_) {
-      const int o = band.offset, first = band.first, slots = band.slots();
-      // Slots whose a (first + slot) or b (a + o) is one of this thread's particles.
-      const int lo = std::max(0, p0 - o - first), hi = std::min(slots, p1 - first);
-      if (lo >= hi) continue;
-      const int a = first + lo, b = a + o;
+      const Band::Reach r = band.reach(p0, p1);
+      if (r.lo >= r.hi) continue;
+      const int a = band.first + r.lo, b = a + band.offset;
       const BandEnds ends{px + a, py + a, pz + a, pu + a, pv + a, pw + a,
                           px + b, py + b, pz + b, pu + b, pv + b, pw + b};
-      collapsed += band_forces(hi - lo, ends, band.rest.data() + lo, band.ks.data() + lo,
-                               band.kd.data() + lo, fx, fy, fz);
+      collapsed += band_forces(r.hi - r.lo, ends, band.rest.data() + r.lo, band.ks.data() + r.lo,
+                               band.kd.data() + r.lo, fx, fy, fz);
       // As the serial loop: + on particle a of every slot, then - on particle b.
-      const int a0 = std::max(p0, first + lo), a1 = std::min(p1, first + hi);
-      if (a0 < a1) {
-        const int k = a0 - first - lo;
-        add_band(a1 - a0, fx + k, fy + k, fz + k, ax + a0, ay + a0, az + a0);
+      if (r.a0 < r.a1) {
+        const int k = r.a0 - a;
+        band_kernels::add(r.a1 - r.a0, fx + k, fy + k, fz + k, ax + r.a0, ay + r.a0, az + r.a0);
       }
-      const int b0 = std::max(p0, first + o + lo), b1 = std::min(p1, first + o + hi);
-      if (b0 < b1) {
-        const int k = b0 - o - first - lo;
-        subtract_band(b1 - b0, fx + k, fy + k, fz + k, ax + b0, ay + b0, az + b0);
+      if (r.b0 < r.b1) {
+        const int k = r.b0 - b;
+        band_kernels::subtract(r.b1 - r.b0, fx + k, fy + k, fz + k, ax + r.b0, ay + r.b0,
+                               az + r.b0);
       }
     }
     collapsed_[part] = collapsed;

@@ -21,4 +21,16 @@ void Pose::validate(const std::string& prefix) const {
   require(std::isfinite(scale) && scale > 0, prefix + "scale", scale, "a finite scale > 0");
 }
 
+void Pose::read(JsonFields& f) {
+  scale = f.number_or("scale", scale);
+  position = f.vec3_or("position", position);
+  rotation_degrees = f.vec3_or("rotation_degrees", rotation_degrees);
+}
+
+void Pose::write(Json& j) const {
+  j["scale"] = scale;
+  j["position"] = json_of(position);
+  j["rotation_degrees"] = json_of(rotation_degrees);
+}
+
 }  // namespace jelly

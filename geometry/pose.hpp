@@ -1,6 +1,9 @@
 #pragma once
 // Where a body or mesh is placed: scaled, then rotated (degrees about x, then y, then z), then
 // moved by `position`.
+#include <string>
+
+#include <jelly/core/json.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {
@@ -14,6 +17,9 @@ struct Pose {
   Vec3 apply(const Vec3& p) const { return position + scale * (rotation() * p); }
   // Throws InputError naming `prefix`field for non-finite values or a scale <= 0.
   void validate(const std::string& prefix) const;
+  // The scene keys scale, position and rotation_degrees (each optional when read).
+  void read(JsonFields& fields);
+  void write(Json& object) const;
 };
 
 }  // namespace jelly

@@ -252,17 +252,13 @@ long TetmeshShape::estimated_springs() const { return 6L * mesh().num_tets(); }
 
 void TetmeshShape::write(Json& j) const {
   j["file"] = file;
-  j["scale"] = pose.scale;
-  j["position"] = json_of(pose.position);
-  j["rotation_degrees"] = json_of(pose.rotation_degrees);
+  pose.write(j);
 }
 
 std::unique_ptr<BodyShape> TetmeshShape::read(JsonFields& f) {
   auto s = std::make_unique<TetmeshShape>();
   s->file = f.file("file");
-  s->pose.scale = f.number_or("scale", s->pose.scale);
-  s->pose.position = f.vec3_or("position", s->pose.position);
-  s->pose.rotation_degrees = f.vec3_or("rotation_degrees", s->pose.rotation_degrees);
+  s->pose.read(f);
   s->validate(f.prefix());
   return s;
 }

@@ -10,6 +10,24 @@ Eigen::AlignedBox3d TriangleMesh::bounds() const {
   return box;
 }
 
+Real TriangleMesh::area() const {
+  Real area = 0;
+  for (const Triangle& t : triangles) {
+    const Vec3 &a = vertices[t[0]], &b = vertices[t[1]], &c = vertices[t[2]];
+    area += 0.5 * (b - a).cross(c - a).norm();
+  }
+  return area;
+}
+
+Real TriangleMesh::enclosed_volume() const {
+  Real volume = 0;
+  for (const Triangle& t : triangles) {
+    const Vec3 &a = vertices[t[0]], &b = vertices[t[1]], &c = vertices[t[2]];
+    volume += a.dot(b.cross(c)) / 6;
+  }
+  return volume;
+}
+
 void TriangleMesh::add_quad(int a, int b, int c, int d) {
   triangles.push_back({a, b, c});
   triangles.push_back({a, c, d});

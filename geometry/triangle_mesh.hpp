@@ -16,6 +16,10 @@ struct TriangleMesh {
   int num_vertices() const { return static_cast<int>(vertices.size()); }
   int num_triangles() const { return static_cast<int>(triangles.size()); }
   Eigen::AlignedBox3d bounds() const;
+  // The surface's area, and the volume it encloses (divergence theorem: the sum of
+  // a . (b x c) / 6 over the triangles; negative when they face inwards).
+  Real area() const;
+  Real enclosed_volume() const;
   // Adds a quad as two triangles a-b-c, a-c-d.
   void add_quad(int a, int b, int c, int d);
   // Appends `other`.

@@ -272,18 +272,14 @@ long VoxelizedShape::estimated_particles() const {
 void VoxelizedShape::write(Json& j) const {
   j["file"] = file;
   j["spacing"] = spacing;
-  j["scale"] = pose.scale;
-  j["position"] = json_of(pose.position);
-  j["rotation_degrees"] = json_of(pose.rotation_degrees);
+  pose.write(j);
 }
 
 std::unique_ptr<BodyShape> VoxelizedShape::read(JsonFields& f) {
   auto s = std::make_unique<VoxelizedShape>();
   s->file = f.file("file");
   s->spacing = f.number("spacing");
-  s->pose.scale = f.number_or("scale", s->pose.scale);
-  s->pose.position = f.vec3_or("position", s->pose.position);
-  s->pose.rotation_degrees = f.vec3_or("rotation_degrees", s->pose.rotation_degrees);
+  s->pose.read(f);
   s->validate(f.prefix());
   return s;
 }

@@ -10,8 +10,6 @@ namespace jelly {
 
 namespace {
 
-constexpr Real kDegree = M_PI / 180;
-
 std::uint64_t next_serial() {
   static std::atomic<std::uint64_t> counter{0};
   return ++counter;
@@ -59,13 +57,8 @@ std::shared_ptr<const MeshObstacleShape> MeshObstacleSpec::shape(const std::stri
   }
   TriangleMesh mesh = std::move(read.mesh);
   for (Vec3& v : mesh.vertices) v *= pose.scale;
-  // Area and enclosed volume (divergence theorem: sum of a . (b x c) / 6).
-  Real area = 0, volume = 0;
-  for (const Triangle& t : mesh.triangles) {
-    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
-    area += 0.5 * (b - a).cross(c - a).norm();
-    volume += a.dot(b.cross(c)) / 6;
-  }
+  const Real area = mesh.area();
+  Real volume = mesh.enclosed_volume();
   const Real size = mesh.bounds().diagonal().norm();
   require(area > 1e-12 * size * size, field, quoted(file),
           "a mesh of non-zero area (this one has " + to_text(area) + " m^2 after scaling)");
@@ -96,9 +89,7 @@ std::unique_ptr<Terrain> MeshObstacleSpec::make() const {
 
 void MeshObstacleSpec::write(Json& j) const {
   j["file"] = file;
-  j["scale"] = pose.scale;
-  j["position"] = json_of(pose.position);
-  j["rotation_degrees"] = json_of(pose.rotation_degrees);
+  pose.write(j);
   j["motion"] = motion.to_json();
   j["angular_velocity_degrees"] = json_of(angular_velocity_degrees);
 }
@@ -106,9 +97,7 @@ void MeshObstacleSpec::write(Json& j) const {
 std::unique_ptr<TerrainSpec> MeshObstacleSpec::read(JsonFields& f) {
   auto s = std::make_unique<MeshObstacleSpec>();
   s->file = f.file("file");
-  s->pose.scale = f.number_or("scale", s->pose.scale);
-  s->pose.position = f.vec3_or("position", s->pose.position);
-  s->pose.rotation_degrees = f.vec3_or("rotation_degrees", s->pose.rotation_degrees);
+  s->pose.read(f);
   if (const Json* m = f.value("motion")) s->motion = Path::read(*m, f.path("motion"));
   s->angular_velocity_degrees = f.vec3_or("angular_velocity_degrees", s->angular_velocity_degrees);
   s->validate(f.prefix());
@@ -120,28 +109,8 @@ MeshObstacle::MeshObstacle(MeshObstacleSpec spec, ContactParams contact)
   spec_.validate("obstacle.");
   contact.validate("contact.");
   shape_ = spec_.shape("obstacle.");
-  Pose rotation_only;
-  rotation_only.rotation_degrees = spec_.pose.rotation_degrees;
-  rotation0_ = rotation_only.rotation();
-  omega_ = spec_.angular_velocity_degrees * kDegree;
-}
-
-Eigen::Matrix3d MeshObstacle::rotation(Real t) const {
-  const Real angle = omega_.norm() * t;
-  if (angle == 0) return rotation0_;
-  return Eigen::AngleAxisd(angle, omega_.normalized()).toRotationMatrix() * rotation0_;
-}
-
-Vec3 MeshObstacle::position(Real t) const {
-  return spec_.motion.is_fixed() ? spec_.pose.position
-                                 : Vec3(spec_.pose.position + spec_.motion.sample(t).offset);
-}
-
-Eigen::Isometry3d MeshObstacle::pose(Real t) const {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = rotation(t);
-  pose.translation() = position(t);
-  return pose;
+  motion_ = ObstacleMotion(spec_.pose.position, spec_.pose.rotation_degrees, spec_.motion,
+                           spec_.angular_velocity_degrees);
 }
 
 MeshDistance::Query MeshObstacle::local_query(const Vec3& p, Real t) const {
@@ -170,9 +139,7 @@ Vec3 MeshObstacle::closest_point(const Vec3& p, Real t) const {
 }
 
 Vec3 MeshObstacle::surface_velocity(const Vec3& p, Real t) const {
-  Vec3 u = spec_.motion.is_fixed() ? Vec3(Vec3::Zero()) : spec_.motion.sample(t).velocity;
-  if (omega_.squaredNorm() > 0) u += omega_.cross(rotation(t) * local_query(p, t).closest);
-  return u;
+  return motion_.velocity(t, [&] { return Vec3(rotation(t) * local_query(p, t).closest); });
 }
 
 std::vector<std::pair<std::string, Real>> MeshObstacle::attributes() const {

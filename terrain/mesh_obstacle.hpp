@@ -1,9 +1,10 @@
 #pragma once
 // Obstacle kind "mesh": a static closed triangle mesh read from a file (OBJ, STL, PLY), scaled,
 // turned and placed like a voxelized body, as an exact signed distance (geometry/mesh_distance:
-// the nearest point through a tree over the triangles, the sign from the winding number). Like
-// the other obstacles it may move along a prescribed path and spin about its origin; the
-// surface velocity at a contact is the rigid motion's at the nearest surface point.
+// the nearest point through a tree over the triangles, the sign from the nearest feature's
+// angle-weighted pseudo-normal). Like the other obstacles it may move along a prescribed path
+// and spin about its origin (terrain/obstacle_motion.hpp); the surface velocity at a contact is
+// the rigid motion's at the nearest surface point.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -12,6 +13,7 @@
 #include <jelly/core/path.hpp>
 #include <jelly/geometry/mesh_distance.hpp>
 #include <jelly/geometry/pose.hpp>
+#include <jelly/terrain/obstacle_motion.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_spec.hpp>
 
@@ -69,16 +71,16 @@ class MeshObstacle final : public Terrain {
   // A closed shape: every particle may touch it (one inside is pushed out through the nearest
   // surface point).
   bool can_contact(const Vec3& /*p*/, Real /*t*/) const override { return true; }
-  Vec3 position(Real t) const override;
+  Vec3 position(Real t) const override { return motion_.position(t); }
   TriangleMesh render_mesh() const override { return shape_->distance.mesh(); }
-  Eigen::Isometry3d pose(Real t) const override;
+  Eigen::Isometry3d pose(Real t) const override { return motion_.pose(t); }
   std::vector<std::pair<std::string, Real>> attributes() const override;
 
   // The nearest surface point of p at time t (world frame).
   Vec3 closest_point(const Vec3& p, Real t) const;
   const MeshObstacleSpec& spec() const { return spec_; }
   const MeshObstacleShape& shape() const { return *shape_; }
-  Eigen::Matrix3d rotation(Real t) const;
+  Eigen::Matrix3d rotation(Real t) const { return motion_.rotation(t); }
 
  private:
   // The query in the mesh's frame; the last one per thread is kept, so that the distance, the
@@ -87,8 +89,7 @@ class MeshObstacle final : public Terrain {
 
   MeshObstacleSpec spec_;
   std::shared_ptr<const MeshObstacleShape> shape_;
-  Eigen::Matrix3d rotation0_;
-  Vec3 omega_;  // rad/s
+  ObstacleMotion motion_;
 };
 
 }  // namespace jelly

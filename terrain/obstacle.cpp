@@ -4,13 +4,10 @@
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/pose.hpp>
 
 namespace jelly {
 
 namespace {
-
-constexpr Real kDegree = M_PI / 180;
 
 Real sign_of(Real x) { return x < 0 ? -1.0 : 1.0; }
 
@@ -214,21 +211,8 @@ Obstacle::Obstacle(ObstacleSpec spec, ContactParams contact)
     : Terrain(contact), spec_(std::move(spec)) {
   spec_.validate("obstacle.");
   contact.validate("contact.");
-  Pose pose;
-  pose.rotation_degrees = spec_.rotation_degrees;
-  rotation0_ = pose.rotation();
-  omega_ = spec_.angular_velocity_degrees * kDegree;
-}
-
-Eigen::Matrix3d Obstacle::rotation(Real t) const {
-  const Real angle = omega_.norm() * t;
-  if (angle == 0) return rotation0_;
-  return Eigen::AngleAxisd(angle, omega_.normalized()).toRotationMatrix() * rotation0_;
-}
-
-Vec3 Obstacle::position(Real t) const {
-  return spec_.motion.is_fixed() ? spec_.center
-                                 : Vec3(spec_.center + spec_.motion.sample(t).offset);
+  motion_ = ObstacleMotion(spec_.center, spec_.rotation_degrees, spec_.motion,
+                           spec_.angular_velocity_degrees);
 }
 
 Real Obstacle::signed_distance(const Vec3& p, Real t) const {
@@ -241,19 +225,10 @@ Vec3 Obstacle::normal(const Vec3& p, Real t) const {
 }
 
 Vec3 Obstacle::surface_velocity(const Vec3& p, Real t) const {
-  Vec3 u = spec_.motion.is_fixed() ? Vec3(Vec3::Zero()) : spec_.motion.sample(t).velocity;
-  if (omega_.squaredNorm() > 0) {
+  return motion_.velocity(t, [&] {
     const Vec3 closest = p - signed_distance(p, t) * normal(p, t);
-    u += omega_.cross(closest - position(t));
-  }
-  return u;
-}
-
-Eigen::Isometry3d Obstacle::pose(Real t) const {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = rotation(t);
-  pose.translation() = position(t);
-  return pose;
+    return Vec3(closest - position(t));
+  });
 }
 
 }  // namespace jelly

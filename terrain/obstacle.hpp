@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include <jelly/core/path.hpp>
+#include <jelly/terrain/obstacle_motion.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_spec.hpp>
 
@@ -66,18 +67,17 @@ class Obstacle final : public Terrain {
   // A closed shape: every particle may touch it (one inside is pushed out through the nearest
   // face).
   bool can_contact(const Vec3& /*p*/, Real /*t*/) const override { return true; }
-  Vec3 position(Real t) const override;
+  Vec3 position(Real t) const override { return motion_.position(t); }
   TriangleMesh render_mesh() const override { return spec_.geometry.mesh(); }
-  Eigen::Isometry3d pose(Real t) const override;
+  Eigen::Isometry3d pose(Real t) const override { return motion_.pose(t); }
 
   const ObstacleSpec& spec() const { return spec_; }
   // The obstacle's orientation at time t (own frame -> world).
-  Eigen::Matrix3d rotation(Real t) const;
+  Eigen::Matrix3d rotation(Real t) const { return motion_.rotation(t); }
 
  private:
   ObstacleSpec spec_;
-  Eigen::Matrix3d rotation0_;
-  Vec3 omega_;  // rad/s
+  ObstacleMotion motion_;
 };
 
 }  // namespace jelly

@@ -42,8 +42,13 @@ class BandSystem {
   struct Slots {
     std::vector<Real> c1, c2, ux, uy, uz;  // [slots]
   };
+  // The threads of a pass over the slots, with band_ sized for them.
+  int team(int threads) const;
+
   const SpringBands* bands_ = nullptr;
   int num_particles_ = 0;
+  long slots_total_ = 0;        // slots of all bands
+  size_t stride_ = 0;           // per-thread buffer length: N + the largest offset
   std::vector<Slots> slots_;    // per band
   std::vector<Real> mass_;      // [N] m + the diagonal additions
   std::vector<Real> diagonal_;  // [6N] xx, yy, zz, xy, xz, yz of the spring part of A_ii

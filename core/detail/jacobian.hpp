@@ -60,9 +60,13 @@ class SpringJacobian {
   }
 
  private:
-  // Calls column(j, begin, end) for the column particles j of a static split of [0, N).
+  // Calls column(j) for the column particles j of a static split of [0, N) on up to `threads`.
   template <class Column>
   void for_columns(int threads, Column&& column) const;
+  // Walks column j's row blocks but its own: spring(i, k) for every spring k joining j to the
+  // block's particle i, then block(slot) once that block's springs are done.
+  template <class Spring, class Block>
+  void for_column_springs(int j, Spring&& spring, Block&& block) const;
 
   int num_particles_ = 0;
   std::vector<int> col_start_;      // [3N + 1]

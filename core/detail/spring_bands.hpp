@@ -27,6 +27,15 @@ class SpringBands {
     std::vector<int> spring;         // [slots]: spring index, or -1
     std::vector<Real> rest, ks, kd;  // [slots]: 0 where no spring
     int slots() const { return static_cast<int>(spring.size()); }
+
+    // For a thread that owns the particles [p0, p1): the slots [lo, hi) whose first particle
+    // (a = first + slot) or second (b = a + offset) is one of its own, and among them the
+    // particles a0..a1 that are the first ends of slots lo + (a0 - first - lo) ... and b0..b1
+    // the second ends of slots lo + (b0 - first - offset - lo) ... (empty ranges when lo >= hi).
+    struct Reach {
+      int lo, hi, a0, a1, b0, b1;
+    };
+    Reach reach(int p0, int p1) const;
   };
 
   SpringBands() = default;

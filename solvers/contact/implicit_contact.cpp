@@ -80,6 +80,26 @@ Mat3 ImplicitContact::free_projector(const Contact& c) {
   return Mat3::Identity() - c.normal * c.normal.transpose();
 }
 
+Mat3 ImplicitContact::filtered_diagonal(const Contact& c, const Mat3& d) {
+  const Mat3 sc = free_projector(c);
+  const Real viscosity = c.mode == Mode::kSlide && !c.pinned ? c.viscosity : 0.0;
+  return sc * d * sc + viscosity * sc + Mat3::Identity() - sc;
+}
+
+Vec3 ImplicitContact::prescribed_change(const Contact& c) const {
+  const Vec3 v0 = particle(v0_, c.particle);
+  if (c.pinned) return c.target_velocity - v0;
+  if (c.mode == Mode::kStick)
+    return tangential(c.surface_velocity, c.normal) + c.target_normal * c.normal - v0;
+  return (c.target_normal - v0.dot(c.normal)) * c.normal;
+}
+
+void ImplicitContact::subtract_sliding_friction(const Contact& c, VecX& rhs) const {
+  if (c.pinned || c.mode != Mode::kSlide) return;
+  const Vec3 v0 = particle(v0_, c.particle);
+  particle(rhs, c.particle) -= c.viscosity * tangential(v0 - c.surface_velocity, c.normal);
+}
+
 int ImplicitContact::penetrated_terrain(const Terrains& terrains, const Vec3& p,
                                         Real tolerance) const {
   int best = -1;
@@ -214,17 +234,8 @@ void ImplicitContact::constrain(SparseMatrix& a, const VecX& b, bool prescribe, 
   for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
     const Contact& c = contacts_[ci];
     if (!prescribe) continue;
-    const Vec3 v0 = particle(v0_, c.particle);
-    Vec3 dz;
-    if (c.pinned) {
-      dz = c.target_velocity - v0;
-    } else if (c.mode == Mode::kStick) {
-      const Vec3 u = c.surface_velocity;
-      dz = tangential(u, c.normal) + c.target_normal * c.normal - v0;
-    } else {
-      dz = (c.target_normal - v0.dot(c.normal)) * c.normal;
-      particle(rhs, c.particle) -= c.viscosity * tangential(v0 - c.surface_velocity, c.normal);
-    }
+    const Vec3 dz = prescribed_change(c);
+    subtract_sliding_friction(c, rhs);
     particle(z, c.particle) = dz;
     const BlockColumn col = block_column(a, c.particle);
     const Real* orig = saved_.data() + saved_at_[ci];
@@ -245,8 +256,7 @@ void ImplicitContact::constrain(SparseMatrix& a, const VecX& b, bool prescribe, 
       const int i = row_particle(a, col, k);
       const Mat3 block = read_block(values, col, k);
       if (i == c.particle) {  // sliding: the friction viscosity on the tangent plane (sc)
-        const Real viscosity = c.mode == Mode::kSlide ? c.viscosity : 0.0;
-        write_block(values, col, k, sc * block * sc + viscosity * sc + Mat3::Identity() - sc);
+        write_block(values, col, k, filtered_diagonal(c, block));
         continue;
       }
       const Mat3 filtered =
@@ -256,11 +266,8 @@ void ImplicitContact::constrain(SparseMatrix& a, const VecX& b, bool prescribe, 
       write_block(values, row, slot_of(a, row, c.particle), filtered.transpose());
     }
   }
-  for (const Contact& c : contacts_) {
-    const Mat3 sc = free_projector(c);
-    particle(rhs, c.particle) = sc * particle(rhs, c.particle);
-    particle(guess, c.particle) = sc * particle(guess, c.particle);
-  }
+  project(rhs);
+  project(guess);
 }
 
 void ImplicitContact::unconstrain(SparseMatrix& a) const {
@@ -287,15 +294,7 @@ bool ImplicitContact::constrain_rhs(const VecX& b, bool prescribe, const VecX* a
     bool any = false;
     if (!prescribe) return false;
     for (const Contact& c : contacts_) {
-      const Vec3 v0 = particle(v0_, c.particle);
-      Vec3 dz;
-      if (c.pinned) {
-        dz = c.target_velocity - v0;
-      } else if (c.mode == Mode::kStick) {
-        dz = tangential(c.surface_velocity, c.normal) + c.target_normal * c.normal - v0;
-      } else {
-        dz = (c.target_normal - v0.dot(c.normal)) * c.normal;
-      }
+      const Vec3 dz = prescribed_change(c);
       particle(z, c.particle) = dz;
       any = any || dz != Vec3::Zero();
     }
@@ -304,17 +303,10 @@ bool ImplicitContact::constrain_rhs(const VecX& b, bool prescribe, const VecX* a
   // rhs = S (b - C w0 - A z).
   rhs = b - *a_z;
   if (prescribe) {
-    for (const Contact& c : contacts_) {
-      if (c.pinned || c.mode != Mode::kSlide) continue;
-      const Vec3 v0 = particle(v0_, c.particle);
-      particle(rhs, c.particle) -= c.viscosity * tangential(v0 - c.surface_velocity, c.normal);
-    }
+    for (const Contact& c : contacts_) subtract_sliding_friction(c, rhs);
   }
-  for (const Contact& c : contacts_) {
-    const Mat3 sc = free_projector(c);
-    particle(rhs, c.particle) = sc * particle(rhs, c.particle);
-    particle(guess, c.particle) = sc * particle(guess, c.particle);
-  }
+  project(rhs);
+  project(guess);
   return true;
 }
 
@@ -335,13 +327,10 @@ void ImplicitContact::filter_output(const VecX& p, VecX& y) const {
 
 bool ImplicitContact::filter_diagonal_block(int i, Real block[9]) const {
   if (i < 0 || i >= static_cast<int>(slot_.size()) || slot_[i] < 0) return false;
-  const Contact& c = contacts_[slot_[i]];
-  const Mat3 sc = free_projector(c);
   Mat3 d;
   for (int r = 0; r < 3; ++r)
     for (int q = 0; q < 3; ++q) d(r, q) = block[3 * r + q];
-  const Real viscosity = c.mode == Mode::kSlide && !c.pinned ? c.viscosity : 0.0;
-  const Mat3 f = sc * d * sc + viscosity * sc + Mat3::Identity() - sc;
+  const Mat3 f = filtered_diagonal(contacts_[slot_[i]], d);
   for (int r = 0; r < 3; ++r)
     for (int q = 0; q < 3; ++q) block[3 * r + q] = f(r, q);
   return true;

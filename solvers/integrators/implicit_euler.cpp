@@ -1,6 +1,5 @@
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -8,7 +7,6 @@
 #include <jelly/core/detail/anchor_jacobian.hpp>
 #include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
@@ -66,6 +64,10 @@ struct ImplicitEuler::Impl {
   // Matrix-free block-Jacobi CG on band_ (filtered by the contacts when constrained).
   StepResult solve_matrix_free(const Model& model, const VecX& b, VecX& y, bool constrained,
                                Real t);
+  // The solve's status as a step result (naming t), a check for non-finite values, and the
+  // momentum correction of an unconstrained CG solve.
+  StepResult finish_solve(const Model& model, const LinearResult& r, const VecX& b, VecX& y,
+                          bool constrained, Real t);
   // Factorizes A (filtered by the contact constraints, if any) and solves for dv_: the
   // linearized step, repeated while the contacts' active set changes.
   StepResult linearized_solve(const Dynamics& dynamics, const State& s, Real h);
@@ -101,7 +103,6 @@ struct ImplicitEuler::Impl {
   bool matrix_free_failed_ = false;  // a collapsed spring: the assembled path from then on
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
-  std::vector<Real> inverse_blocks_;
   VecX az_, filtered_;
   int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
@@ -231,7 +232,6 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       solver_.reset();
       a_ = SparseMatrix();
       band_.emplace(*bands, model.num_particles());
-      inverse_blocks_.assign(3 * static_cast<size_t>(n), 0.0);
       az_.setZero(n);
       filtered_.setZero(n);
       size_vectors();
@@ -324,52 +324,29 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
                                                   bool constrained, Real t) {
   auto start = Clock::now();
   // Block Jacobi: the inverses of the (filtered) diagonal blocks.
-  const int np = model.num_particles();
-  std::vector<int> bad(parallel::team_size(threads_, np, 1024), np);
-  parallel::run(static_cast<int>(bad.size()), [&](int part, int parts) {
-    const parallel::Range range = parallel::split(np, part, parts);
-    for (long i = range.begin; i < range.end; ++i) {
-      Real d[9];
-      band_->diagonal_block(static_cast<int>(i), d);
-      if (constrained) contact_.filter_diagonal_block(static_cast<int>(i), d);
-      const Eigen::Matrix3d block = Eigen::Map<const Eigen::Matrix<Real, 3, 3, Eigen::RowMajor>>(d);
-      Eigen::Matrix3d inverse;
-      bool invertible = false;
-      block.computeInverseWithCheck(inverse, invertible);
-      if (!invertible || !(block(0, 0) > 0 && block(1, 1) > 0 && block(2, 2) > 0)) {
-        bad[part] = static_cast<int>(i);
+  LinearResult r = band_cg_.set_diagonal_blocks(
+      model.num_particles(),
+      [&](int i, Real d[9]) {
+        band_->diagonal_block(i, d);
+        if (constrained) contact_.filter_diagonal_block(i, d);
+      },
+      threads_);
+  factorization_seconds_ += seconds_since(start);
+  if (r.ok()) {
+    start = Clock::now();
+    const auto apply = [&](const VecX& in, VecX& out) {
+      if (!constrained) {
+        band_->multiply(in, out, threads_);
         return;
       }
-      Eigen::Map<Eigen::Matrix<Real, 3, 3, Eigen::RowMajor>> out(&inverse_blocks_[9 * i]);
-      out = inverse;
-    }
-  });
-  factorization_seconds_ += seconds_since(start);
-  const int first_bad = *std::min_element(bad.begin(), bad.end());
-  if (first_bad < np)
-    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(t) +
-                               " (not_positive_definite): CG: diagonal block " +
-                               std::to_string(first_bad + 1) + " is not positive definite");
-  start = Clock::now();
-  const auto apply = [&](const VecX& in, VecX& out) {
-    if (!constrained) {
-      band_->multiply(in, out, threads_);
-      return;
-    }
-    contact_.filter_input(in, filtered_);
-    band_->multiply(filtered_, out, threads_);
-    contact_.filter_output(in, out);
-  };
-  const LinearResult r = band_cg_.solve(apply, inverse_blocks_, b, y, options_.cg_tolerance,
-                                        options_.cg_max_iterations, threads_);
-  solve_seconds_ += seconds_since(start);
-  if (!r.ok())
-    return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(t) + " (" +
-                               std::string(linear_status_name(r.status)) + "): " + r.message);
-  if (!y.allFinite())
-    return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
-  if (r.iterations > 0 && !constrained && !anchored_) restore_momentum(model.mass, b, y);
-  return StepResult::success();
+      contact_.filter_input(in, filtered_);
+      band_->multiply(filtered_, out, threads_);
+      contact_.filter_output(in, out);
+    };
+    r = band_cg_.solve(apply, b, y, options_.cg_tolerance, options_.cg_max_iterations, threads_);
+    solve_seconds_ += seconds_since(start);
+  }
+  return finish_solve(model, r, b, y, constrained, t);
 }
 
 StepResult ImplicitEuler::Impl::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
@@ -383,6 +360,11 @@ StepResult ImplicitEuler::Impl::factorize_and_solve(const Model& model, const Ve
     r = solver_->solve(b, y);
     solve_seconds_ += seconds_since(start);
   }
+  return finish_solve(model, r, b, y, constrained, t);
+}
+
+StepResult ImplicitEuler::Impl::finish_solve(const Model& model, const LinearResult& r,
+                                             const VecX& b, VecX& y, bool constrained, Real t) {
   if (!r.ok())
     return StepResult::failure("implicit_euler: linear solve failed at t = " + to_text(t) + " (" +
                                std::string(linear_status_name(r.status)) + "): " + r.message);

@@ -165,6 +165,60 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
   return result;
 }
 
+// Particles (3x3 blocks) per thread below which another thread costs more than it saves.
+constexpr long kMinBlocksPerThread = 1024;
+
+// Block Jacobi: the inverses of A's 3x3 diagonal blocks, column-major, 9 numbers per block.
+struct BlockInverses {
+  std::vector<Real> inverse;
+  std::vector<long> bad;  // per thread: its first singular or indefinite block
+
+  // Inverts block(i, B) (B the Eigen matrix the callback fills) for i in [0, np) on a static
+  // split; a block that is singular or has a non-positive diagonal entry is a failure naming
+  // the first one.
+  template <class Block>
+  LinearResult invert(long np, int threads, Block&& block) {
+    if (inverse.size() != 9 * static_cast<size_t>(np)) inverse.assign(9 * np, 0.0);
+    bad.assign(parallel::team_size(threads, np, kMinBlocksPerThread), np);
+    parallel::run(static_cast<int>(bad.size()), [&](int part, int parts) {
+      const parallel::Range range = parallel::split(np, part, parts);
+      for (long i = range.begin; i < range.end; ++i) {
+        Eigen::Matrix3d b;
+        block(i, b);
+        Eigen::Matrix3d inv;
+        bool invertible = false;
+        b.computeInverseWithCheck(inv, invertible);
+        if (!invertible || !(b(0, 0) > 0 && b(1, 1) > 0 && b(2, 2) > 0)) {
+          bad[part] = i;
+          return;
+        }
+        std::copy(inv.data(), inv.data() + 9, &inverse[9 * i]);
+      }
+    });
+    const long first_bad = *std::min_element(bad.begin(), bad.end());
+    if (first_bad < np)
+      return LinearResult::failure(
+          LinearStatus::kNotPositiveDefinite,
+          "CG: diagonal block " + std::to_string(first_bad + 1) + " is not positive definite");
+    return {};
+  }
+
+  // z = (block diagonal of the inverses) r, on work's split of the entries.
+  void apply(CgWork& work, const VecX& r, VecX& z) const {
+    const Real* pr = r.data();
+    Real* pz = z.data();
+    work.for_entries([&](long begin, long end) {
+      const Real* inv = inverse.data() + 3 * begin;
+      for (long i = begin; i < end; i += 3, inv += 9) {
+        // Column-major 3x3 inverse times r_i.
+        pz[i] = inv[0] * pr[i] + inv[3] * pr[i + 1] + inv[6] * pr[i + 2];
+        pz[i + 1] = inv[1] * pr[i] + inv[4] * pr[i + 1] + inv[7] * pr[i + 2];
+        pz[i + 2] = inv[2] * pr[i] + inv[5] * pr[i + 1] + inv[8] * pr[i + 2];
+      }
+    });
+  }
+};
+
 struct CgSolver::Impl {
   explicit Impl(const CgOptions& o) : options_(o) {}
 
@@ -174,19 +228,13 @@ struct CgSolver::Impl {
   LinearResult run(const VecX& b, VecX& x, int max_iterations, LinearSolverCounters& counters);
   void precondition(const VecX& r, VecX& z);
   void multiply(const VecX& x, VecX& y);  // y = A x
-  template <class Body>
-  void for_entries(Body&& body) {
-    work_.threads = threads_;
-    work_.for_entries(body);
-  }
 
   bool block3_ = false;  // columns 3j, 3j + 1, 3j + 2 share one row pattern (3x3 blocks)
-  std::vector<int> diagonal_block_;     // [N]: value index of diagonal block (0, 0), when block3_
-  std::vector<double> inverse_blocks_;  // [9 N]: inverses of the 3x3 diagonal blocks
-  std::vector<long> bad_blocks_;        // per thread: its first non-positive diagonal block
-  double factor_seconds_ = 0;           // CPU time of the last refresh of the lagged factor
-  double lagged_seconds_ = 0;           // ... plus the CPU time of the solves since
-  long lagged_solves_ = 0;              // solves since the last refresh
+  std::vector<int> diagonal_block_;  // [N]: value index of diagonal block (0, 0), when block3_
+  BlockInverses blocks_;             // when block3_
+  double factor_seconds_ = 0;        // CPU time of the last refresh of the lagged factor
+  double lagged_seconds_ = 0;        // ... plus the CPU time of the solves since
+  long lagged_solves_ = 0;           // solves since the last refresh
 
   CgOptions options_;
   int threads_ = 1;
@@ -250,7 +298,6 @@ LinearResult CgSolver::Impl::analyze(const SparseMatrix& a, LinearSolverCounters
       }
       diagonal_block_.push_back(static_cast<int>(at - inner));
     }
-    inverse_blocks_.assign(block3_ ? 3 * static_cast<size_t>(n) : 0, 0.0);
   }
   ++counters.analyses;
   if (factor_) {
@@ -270,32 +317,15 @@ LinearResult CgSolver::Impl::factorize(const SparseMatrix& a, LinearSolverCounte
       const int* outer = a.outerIndexPtr();
       const Real* values = a.valuePtr();
       const long np = static_cast<long>(diagonal_block_.size());
-      std::vector<long>& bad = bad_blocks_;
-      bad.assign(parallel::team_size(threads_, np, 1024), np);
-      parallel::run(static_cast<int>(bad.size()), [&](int part, int parts) {
-        const parallel::Range range = parallel::split(np, part, parts);
-        for (long i = range.begin; i < range.end; ++i) {
-          const int base = diagonal_block_[i];
-          const int s = outer[3 * i + 1] - outer[3 * i];
-          Eigen::Matrix3d block;
-          for (int c = 0; c < 3; ++c)
-            for (int r = 0; r < 3; ++r) block(r, c) = values[base + c * s + r];
-          Eigen::Matrix3d inverse;
-          bool invertible = false;
-          block.computeInverseWithCheck(inverse, invertible);
-          if (!invertible || !(block(0, 0) > 0 && block(1, 1) > 0 && block(2, 2) > 0)) {
-            bad[part] = i;
-            return;
-          }
-          std::copy(inverse.data(), inverse.data() + 9, &inverse_blocks_[9 * i]);
-        }
+      const LinearResult r = blocks_.invert(np, threads_, [&](long i, Eigen::Matrix3d& block) {
+        const int base = diagonal_block_[i];
+        const int s = outer[3 * i + 1] - outer[3 * i];
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) block(r, c) = values[base + c * s + r];
       });
-      const long first_bad = *std::min_element(bad.begin(), bad.end());
-      if (first_bad < np) {
+      if (!r.ok()) {
         a_ = nullptr;
-        return LinearResult::failure(
-            LinearStatus::kNotPositiveDefinite,
-            "CG: diagonal block " + std::to_string(first_bad + 1) + " is not positive definite");
+        return r;
       }
       return {};
     }
@@ -343,7 +373,7 @@ void CgSolver::Impl::multiply(const VecX& x, VecX& y) {
   const Real* px = x.data();
   Real* py = y.data();
   const long np = static_cast<long>(diagonal_block_.size());
-  parallel::run(parallel::team_size(threads_, np, 1024), [&](int part, int parts) {
+  parallel::run(parallel::team_size(threads_, np, kMinBlocksPerThread), [&](int part, int parts) {
     const parallel::Range range = parallel::split(np, part, parts);
     for (long j = range.begin; j < range.end; ++j) {
       const int begin = outer[3 * j], s = outer[3 * j + 1] - begin;
@@ -369,17 +399,8 @@ void CgSolver::Impl::precondition(const VecX& r, VecX& z) {
   if (factor_) {
     factor_->solve(r, z);
   } else if (block3_) {
-    const Real* pr = r.data();
-    Real* pz = z.data();
-    for_entries([&](long begin, long end) {
-      const Real* inv = inverse_blocks_.data() + 3 * begin;
-      for (long i = begin; i < end; i += 3, inv += 9) {
-        // Column-major 3x3 inverse times r_i.
-        pz[i] = inv[0] * pr[i] + inv[3] * pr[i + 1] + inv[6] * pr[i + 2];
-        pz[i + 1] = inv[1] * pr[i] + inv[4] * pr[i + 1] + inv[7] * pr[i + 2];
-        pz[i + 2] = inv[2] * pr[i] + inv[5] * pr[i + 1] + inv[8] * pr[i + 2];
-      }
-    });
+    work_.threads = threads_;
+    blocks_.apply(work_, r, z);
   } else {
     z = inverse_diagonal_.cwiseProduct(r);
   }
@@ -430,6 +451,7 @@ LinearResult CgSolver::Impl::solve(const VecX& b, VecX& x, LinearSolverCounters&
 
 struct MatrixFreeCg::Impl {
   CgWork work;
+  BlockInverses blocks;
   LinearSolverCounters counters;
 };
 
@@ -438,28 +460,26 @@ MatrixFreeCg::~MatrixFreeCg() = default;
 
 const LinearSolverCounters& MatrixFreeCg::counters() const { return impl_->counters; }
 
-LinearResult MatrixFreeCg::solve(const Product& apply, const std::vector<Real>& inverse_blocks,
-                                 const VecX& b, VecX& x, Real tolerance, int max_iterations,
-                                 int threads) {
+LinearResult MatrixFreeCg::set_diagonal_blocks(int particles, const DiagonalBlock& block,
+                                               int threads) {
+  return impl_->blocks.invert(particles, std::max(1, threads), [&](long i, Eigen::Matrix3d& b) {
+    Real d[9];
+    block(static_cast<int>(i), d);
+    b = Eigen::Map<const Eigen::Matrix<Real, 3, 3, Eigen::RowMajor>>(d);
+  });
+}
+
+LinearResult MatrixFreeCg::solve(const Product& apply, const VecX& b, VecX& x, Real tolerance,
+                                 int max_iterations, int threads) {
   CgWork& work = impl_->work;
+  const BlockInverses& blocks = impl_->blocks;
   if (b.size() % 3 != 0 || x.size() != b.size() ||
-      inverse_blocks.size() != 3 * static_cast<size_t>(b.size()))
+      blocks.inverse.size() != 3 * static_cast<size_t>(b.size()))
     return LinearResult::failure(LinearStatus::kInvalidInput, "CG: solve: wrong vector size");
   work.resize(b.size());
   work.threads = std::max(1, threads);
   ++impl_->counters.solves;
-  const auto precondition = [&](const VecX& r, VecX& z) {
-    const Real* pr = r.data();
-    Real* pz = z.data();
-    work.for_entries([&](long begin, long end) {
-      const Real* inv = inverse_blocks.data() + 3 * begin;
-      for (long i = begin; i < end; i += 3, inv += 9) {
-        pz[i] = inv[0] * pr[i] + inv[1] * pr[i + 1] + inv[2] * pr[i + 2];
-        pz[i + 1] = inv[3] * pr[i] + inv[4] * pr[i + 1] + inv[5] * pr[i + 2];
-        pz[i + 2] = inv[6] * pr[i] + inv[7] * pr[i + 1] + inv[8] * pr[i + 2];
-      }
-    });
-  };
+  const auto precondition = [&](const VecX& r, VecX& z) { blocks.apply(work, r, z); };
   return cg_run(work, tolerance, apply, precondition, b, x, max_iterations, impl_->counters);
 }
 

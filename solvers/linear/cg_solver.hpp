@@ -52,17 +52,23 @@ class CgSolver final : public LinearSolver {
 };
 
 // Conjugate gradients on an operator given as a product function (matrix-free, e.g.
-// core/detail/band_system.hpp), preconditioned by given inverse 3x3 diagonal blocks; threaded as
-// CgSolver (the same bits for any thread count).
+// core/detail/band_system.hpp), preconditioned by the inverses of its 3x3 diagonal blocks (block
+// Jacobi, as CgSolver's); threaded as CgSolver (the same bits for any thread count).
 class MatrixFreeCg {
  public:
   using Product = std::function<void(const VecX& in, VecX& out)>;
+  // Writes the row-major 3x3 diagonal block of particle i of A into out.
+  using DiagonalBlock = std::function<void(int i, Real out[9])>;
   MatrixFreeCg();
   ~MatrixFreeCg();
-  // Solves A x = b from x with A x = apply(x); inverse_blocks[9i .. 9i + 9) is the row-major
-  // inverse of A's diagonal block i. Stops at |b - A x| <= tolerance |b|.
-  LinearResult solve(const Product& apply, const std::vector<Real>& inverse_blocks, const VecX& b,
-                     VecX& x, Real tolerance, int max_iterations, int threads);
+  // The preconditioner of the next solves: inverts the diagonal blocks of `particles` particles.
+  // A singular block or one with a non-positive diagonal entry is a kNotPositiveDefinite failure
+  // naming the first such block. No allocation once called with this size and thread count.
+  LinearResult set_diagonal_blocks(int particles, const DiagonalBlock& block, int threads);
+  // Solves A x = b from x with A x = apply(x), preconditioned by the last set_diagonal_blocks.
+  // Stops at |b - A x| <= tolerance |b|.
+  LinearResult solve(const Product& apply, const VecX& b, VecX& x, Real tolerance,
+                     int max_iterations, int threads);
   const LinearSolverCounters& counters() const;
 
  private:

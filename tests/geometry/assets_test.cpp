@@ -29,14 +29,6 @@ std::string asset(const std::string& name) {
   return std::string(JELLY_SOURCE_DIR) + "/assets/" + name;
 }
 
-Real enclosed_volume(const TriangleMesh& mesh) {
-  Real six = 0;
-  for (const Triangle& t : mesh.triangles) {
-    six += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]]));
-  }
-  return six / 6;
-}
-
 int occupied(const LatticeGrid& grid) {
   int n = 0;
   for (char c : grid.occupied) n += c;
@@ -58,7 +50,7 @@ TEST(Assets, ClosedManifoldOutwardWithTheSolidsVolumes) {
     const MeshTopology topo = mesh_topology(m.mesh);
     EXPECT_TRUE(topo.closed());
     EXPECT_TRUE(topo.manifold());
-    EXPECT_NEAR(enclosed_volume(m.mesh), c.volume, 0.02 * c.volume);  // > 0: outwards
+    EXPECT_NEAR(m.mesh.enclosed_volume(), c.volume, 0.02 * c.volume);  // > 0: outwards
     EXPECT_LT(m.mesh.num_triangles(), 6000);
   }
 }

@@ -10,26 +10,9 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 
+#include "support/temp_dir.hpp"
+
 namespace jelly::testing {
-
-// A fresh directory under the system's temporary directory, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern =
-        (std::filesystem::temp_directory_path() / "jelly-geometry-XXXXXX").string();
-    path_ = mkdtemp(pattern.data());
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
 
 inline std::string write_text(const std::string& path, const std::string& text) {
   std::ofstream(path) << text;

@@ -7,25 +7,9 @@
 #include <jelly/terrain/plane.hpp>
 
 #include "support/systems.hpp"
+#include "support/temp_dir.hpp"
 
 namespace jelly::testing {
-
-// A fresh directory under the system's temporary directory, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "jelly-io-XXXXXX").string();
-    path_ = mkdtemp(pattern.data());
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 // A small cube dropped onto the seed's 20-degree slope, with the given contact model.
 inline Simulator slope_sim(ContactModel contact_model = ContactModel::kCoulomb, int n = 3,

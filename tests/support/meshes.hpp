@@ -2,39 +2,24 @@
 // Closed meshes with known shapes for the mesh obstacle's tests (a bowl made by turning a
 // profile about the y axis), and a temporary folder to write them to.
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <jelly/geometry/mesh_io.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 
+#include "support/temp_dir.hpp"
+
 namespace jelly::testing {
 
-// A fresh directory under the system's temporary directory, removed with the object.
-class MeshDir {
+// A temporary directory to write meshes to.
+class MeshDir : public TempDir {
  public:
-  MeshDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "jelly-mesh-XXXXXX").string();
-    path_ = mkdtemp(pattern.data());
-  }
-  ~MeshDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  MeshDir(const MeshDir&) = delete;
-  MeshDir& operator=(const MeshDir&) = delete;
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
   // Writes `mesh` under `name` and returns the path.
   std::string write(const std::string& name, const TriangleMesh& mesh) const {
     write_mesh(file(name), mesh);
     return file(name);
   }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
 };
 
 // The surface swept by turning a profile (r, y) about the y axis in `segments` steps. The

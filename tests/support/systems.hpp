@@ -1,13 +1,16 @@
 #pragma once
 // Small systems with analytic answers, shared by the tests.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <Eigen/Geometry>
 
-#include <jelly/geometry/cube.hpp>
+#include <jelly/core/measures.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 
@@ -49,6 +52,29 @@ struct TwoParticleSpring {
     return -stretch * std::exp(-g * t) * (g * g / w + w) * std::sin(w * t);
   }
 };
+
+// One free particle of 1 kg at the origin, under gravity.
+inline Model single_particle() {
+  Model m;
+  m.mass = VecX::Constant(1, 1.0);
+  m.rest_position = VecX::Zero(3);
+  return m;
+}
+
+// The smallest signed distance of the simulator's particles from `terrain` (< 0: inside).
+inline Real min_distance(const Simulator& sim, const Terrain& terrain) {
+  Real d = std::numeric_limits<Real>::infinity();
+  for (int i = 0; i < sim.model().num_particles(); ++i)
+    d = std::min(d, terrain.signed_distance(particle(sim.state().x, i), sim.state().t));
+  return d;
+}
+
+// The largest particle speed of a state.
+inline Real max_speed(const State& s) {
+  Real v = 0;
+  for (int i = 0; i < s.v.size() / 3; ++i) v = std::max(v, particle(s.v, i).norm());
+  return v;
+}
 
 // A small jelly cube (n per edge) of the seed's material, corner at `origin`.
 inline CubeSpec small_cube(int n = 4, Real edge = 1, Vec3 origin = Vec3(0, 0.5, 0)) {
@@ -97,5 +123,30 @@ class Probe final : public Observer {
 };
 template <typename F>
 Probe(F) -> Probe<F>;
+
+// What a resting test looks at: the deepest any particle went into a terrain over the run, and
+// the lowest and highest height of the centre of mass once the body has settled.
+struct RestWatch {
+  RunReport report;
+  Real deepest = 0, lowest_late = 1e9, highest_late = -1e9;
+};
+
+// Runs `sim` until `until`, watching `terrain` and the centre of mass after `settled` s.
+inline RestWatch run_watching_rest(Simulator& sim, const Terrain& terrain, Real settled,
+                                   Real until) {
+  RestWatch w;
+  Probe probe([&](const Simulator& s) {
+    w.deepest = std::min(w.deepest, min_distance(s, terrain));
+    if (s.state().t > settled) {
+      const Real y = center_of_mass(s.model(), s.state()).y();
+      w.lowest_late = std::min(w.lowest_late, y);
+      w.highest_late = std::max(w.highest_late, y);
+    }
+  });
+  sim.add_observer(probe);
+  w.report = sim.run_until(until);
+  sim.remove_observer(probe);
+  return w;
+}
 
 }  // namespace jelly::testing

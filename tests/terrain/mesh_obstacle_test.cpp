@@ -13,20 +13,13 @@
 #include <jelly/terrain/obstacle.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
+#include "support/errors.hpp"
 #include "support/meshes.hpp"
 
 namespace jelly {
 namespace {
 
-template <typename F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::error_of;
 
 // A mesh obstacle and the box obstacle it should equal: a unit-cube mesh scaled by 0.5 is a box
 // of edge 0.5, turned, placed, moving and spinning like the box.

@@ -10,8 +10,12 @@
 #include <jelly/terrain/obstacle.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
+#include "support/errors.hpp"
+
 namespace jelly {
 namespace {
+
+using testing::error_of;
 
 ObstacleSpec spec_of(ObstacleShape shape) {
   ObstacleSpec s;
@@ -20,17 +24,6 @@ ObstacleSpec spec_of(ObstacleShape shape) {
   s.geometry.size = Vec3(1.0, 0.5, 2.0);
   s.geometry.height = 0.8;
   return s;
-}
-
-// The message of the InputError that `f` throws, or "" when it throws none.
-template <typename F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(Obstacle, SphereDistanceAndNormal) {

@@ -16,23 +16,9 @@
 #include <jelly/core/types.hpp>
 #include <jelly/viewer/camera.hpp>
 
+#include "support/temp_dir.hpp"
+
 namespace jelly::testing {
-
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "jelly-viewer-XXXXXX").string();
-    path_ = mkdtemp(pattern.data());
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 struct Result {
   int code = -1;

@@ -129,6 +129,15 @@ class ImplicitContact {
  private:
   // The projector onto the free directions of a contact.
   static Eigen::Matrix3d free_projector(const Contact& c);
+  // The filtered diagonal block S D S + c S + I - S of contact c's particle (c the sliding
+  // friction's viscosity on the tangent plane, 0 for a sticking or pinned contact).
+  static Eigen::Matrix3d filtered_diagonal(const Contact& c, const Eigen::Matrix3d& d);
+  // z_c: the velocity change the contact prescribes from v0 (all of it for a pin or a sticking
+  // contact, the normal part for a sliding one).
+  Vec3 prescribed_change(const Contact& c) const;
+  // rhs_c -= c (v0 - u)_t: the sliding friction's impulse at the start velocity (sliding
+  // contacts only).
+  void subtract_sliding_friction(const Contact& c, VecX& rhs) const;
   // e times the approach speed for a contact that hit its surface faster than the resting
   // speed (it bounces), else 0.
   static Real bounce_speed(const Contact& c, const Terrains& terrains);

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
@@ -15,6 +15,9 @@ namespace {
 
 using testing::cube_on_slope;
 using testing::make_sim;
+using testing::max_speed;
+using testing::min_distance;
+using testing::single_particle;
 
 // Contact is applied after each step the same way for every integrator (docs/contact.md), so
 // every registered integrator must pass the scene-level contact tests.
@@ -29,19 +32,6 @@ Real contact_dt(const std::string& integrator) {
   return integrator == "explicit_euler" ? 2.5e-4 : 1e-3;
 }
 
-Real min_distance(const Simulator& sim, const Terrain& terrain) {
-  Real d = std::numeric_limits<Real>::infinity();
-  for (int i = 0; i < sim.model().num_particles(); ++i)
-    d = std::min(d, terrain.signed_distance(particle(sim.state().x, i), sim.state().t));
-  return d;
-}
-
-Real max_speed(const State& s) {
-  Real v = 0;
-  for (int i = 0; i < s.v.size() / 3; ++i) v = std::max(v, particle(s.v, i).norm());
-  return v;
-}
-
 // A jelly dropped on the floor comes to rest on it: it never sinks below it, and in the end it
 // neither moves nor jitters.
 TEST_P(ContactEveryIntegrator, DroppedJellyComesToRest) {
@@ -49,28 +39,12 @@ TEST_P(ContactEveryIntegrator, DroppedJellyComesToRest) {
   Simulator sim = make_sim(m, rest_state(m), GetParam(), contact_dt(GetParam()), 0.01);
   sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitY()));
   const Terrain& floor = *sim.terrains()[0];
-  Real deepest = 0, lowest_late = 1e9, highest_late = -1e9;
-  testing::Probe probe([&](const Simulator& s) {
-    deepest = std::min(deepest, min_distance(s, floor));
-    if (s.state().t > 4) {
-      const Real y = center_of_mass(s.model(), s.state()).y();
-      lowest_late = std::min(lowest_late, y);
-      highest_late = std::max(highest_late, y);
-    }
-  });
-  sim.add_observer(probe);
-  ASSERT_TRUE(sim.run_until(5.0).ok());
-  EXPECT_GE(deepest, -1e-3);                    // never more than 1 mm below the floor
-  EXPECT_LT(highest_late - lowest_late, 1e-3);  // no jitter in the last second
+  const testing::RestWatch w = testing::run_watching_rest(sim, floor, 4, 5.0);
+  ASSERT_TRUE(w.report.ok());
+  EXPECT_GE(w.deepest, -1e-3);                      // never more than 1 mm below the floor
+  EXPECT_LT(w.highest_late - w.lowest_late, 1e-3);  // no jitter in the last second
   EXPECT_LT(max_speed(sim.state()), 0.02);
   EXPECT_NEAR(center_of_mass(m, sim.state()).y(), 0.5, 0.05);  // resting, slightly sagged
-}
-
-Model single_particle() {
-  Model m;
-  m.mass = VecX::Constant(1, 1.0);
-  m.rest_position = VecX::Zero(3);
-  return m;
 }
 
 // A particle dropped from 1 m bounces back to e^2 of its height.

@@ -18,30 +18,13 @@ namespace jelly {
 namespace {
 
 using testing::make_sim;
+using testing::max_speed;
+using testing::min_distance;
+using testing::single_particle;
 
 class MeshEveryIntegrator : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Registry, MeshEveryIntegrator, ::testing::ValuesIn(integrator_names()),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
-
-Model single_particle() {
-  Model m;
-  m.mass = VecX::Constant(1, 1.0);
-  m.rest_position = VecX::Zero(3);
-  return m;
-}
-
-Real min_distance(const Simulator& sim, const Terrain& terrain) {
-  Real d = std::numeric_limits<Real>::infinity();
-  for (int i = 0; i < sim.model().num_particles(); ++i)
-    d = std::min(d, terrain.signed_distance(particle(sim.state().x, i), sim.state().t));
-  return d;
-}
-
-Real max_speed(const State& s) {
-  Real v = 0;
-  for (int i = 0; i < s.v.size() / 3; ++i) v = std::max(v, particle(s.v, i).norm());
-  return v;
-}
 
 // A mesh obstacle from `mesh` written to `dir`.
 std::unique_ptr<MeshObstacle> mesh_obstacle(const testing::MeshDir& dir, const TriangleMesh& mesh,
@@ -126,19 +109,10 @@ TEST_P(MeshBowl, JellyRestsInTheBowl) {
   Simulator sim = make_sim(m, rest_state(m), GetParam(), 1e-3, 0.01);
   sim.add_terrain(mesh_obstacle(dir, testing::bowl_mesh(1.0, 0.1), Vec3::Zero(), ContactParams{}));
   const Terrain& bowl = *sim.terrains()[0];
-  Real deepest = 0, lowest_late = 1e9, highest_late = -1e9;
-  testing::Probe probe([&](const Simulator& s) {
-    deepest = std::min(deepest, min_distance(s, bowl));
-    if (s.state().t > 3) {
-      const Real y = center_of_mass(s.model(), s.state()).y();
-      lowest_late = std::min(lowest_late, y);
-      highest_late = std::max(highest_late, y);
-    }
-  });
-  sim.add_observer(probe);
-  ASSERT_TRUE(sim.run_until(4.0).ok());
-  EXPECT_GE(deepest, -1e-3);
-  EXPECT_LT(highest_late - lowest_late, 1e-3);
+  const testing::RestWatch w = testing::run_watching_rest(sim, bowl, 3, 4.0);
+  ASSERT_TRUE(w.report.ok());
+  EXPECT_GE(w.deepest, -1e-3);
+  EXPECT_LT(w.highest_late - w.lowest_late, 1e-3);
   EXPECT_LT(max_speed(sim.state()), 0.02);
   expect_at_the_bottom(center_of_mass(m, sim.state()));
 }

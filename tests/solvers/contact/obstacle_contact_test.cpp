@@ -16,6 +16,9 @@ namespace jelly {
 namespace {
 
 using testing::make_sim;
+using testing::max_speed;
+using testing::min_distance;
+using testing::single_particle;
 
 class ObstacleEveryIntegrator : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Registry, ObstacleEveryIntegrator, ::testing::ValuesIn(integrator_names()),
@@ -24,26 +27,6 @@ INSTANTIATE_TEST_SUITE_P(Registry, ObstacleEveryIntegrator, ::testing::ValuesIn(
 // As in contact_solver_test.cpp: explicit Euler needs a quarter of the step to rest quietly.
 Real contact_dt(const std::string& integrator) {
   return integrator == "explicit_euler" ? 2.5e-4 : 1e-3;
-}
-
-Model single_particle() {
-  Model m;
-  m.mass = VecX::Constant(1, 1.0);
-  m.rest_position = VecX::Zero(3);
-  return m;
-}
-
-Real min_distance(const Simulator& sim, const Terrain& terrain) {
-  Real d = std::numeric_limits<Real>::infinity();
-  for (int i = 0; i < sim.model().num_particles(); ++i)
-    d = std::min(d, terrain.signed_distance(particle(sim.state().x, i), sim.state().t));
-  return d;
-}
-
-Real max_speed(const State& s) {
-  Real v = 0;
-  for (int i = 0; i < s.v.size() / 3; ++i) v = std::max(v, particle(s.v, i).norm());
-  return v;
 }
 
 std::unique_ptr<Obstacle> sphere(Real radius, const Vec3& center, const ContactParams& c) {
@@ -118,19 +101,10 @@ TEST_P(ObstacleEveryIntegrator, JellyRestsOnABox) {
   Simulator sim = make_sim(m, rest_state(m), GetParam(), contact_dt(GetParam()), 0.01);
   sim.add_terrain(box(Vec3(3, 1, 3), Vec3(0, -0.5, 0), ContactParams{}));
   const Terrain& table = *sim.terrains()[0];
-  Real deepest = 0, lowest_late = 1e9, highest_late = -1e9;
-  testing::Probe probe([&](const Simulator& s) {
-    deepest = std::min(deepest, min_distance(s, table));
-    if (s.state().t > 4) {
-      const Real y = center_of_mass(s.model(), s.state()).y();
-      lowest_late = std::min(lowest_late, y);
-      highest_late = std::max(highest_late, y);
-    }
-  });
-  sim.add_observer(probe);
-  ASSERT_TRUE(sim.run_until(5.0).ok());
-  EXPECT_GE(deepest, -1e-3);
-  EXPECT_LT(highest_late - lowest_late, 1e-3);
+  const testing::RestWatch w = testing::run_watching_rest(sim, table, 4, 5.0);
+  ASSERT_TRUE(w.report.ok());
+  EXPECT_GE(w.deepest, -1e-3);
+  EXPECT_LT(w.highest_late - w.lowest_late, 1e-3);
   EXPECT_LT(max_speed(sim.state()), 0.02);
   EXPECT_NEAR(center_of_mass(m, sim.state()).y(), 0.5, 0.05);
 }
