@@ -180,8 +180,11 @@ Recording read(hid_t file) {
   }
 
   const std::string clock = groups.front().group() + "/position/";
-  r.time = h5::read_doubles(file, clock + "time");
-  r.step = h5::read_longs(file, clock + "step");
+  // A killed run's last frames may not read (h5::Frames): every frame series keeps the frames
+  // that do, and the frames all of them hold are kept below.
+  constexpr h5::Frames kReadable = h5::Frames::kLeadingReadable;
+  r.time = h5::read_doubles(file, clock + "time", nullptr, kReadable);
+  r.step = h5::read_longs(file, clock + "step", nullptr, kReadable);
   try {
     r.model.validate();
   } catch (const InputError& e) {
@@ -195,7 +198,7 @@ Recording read(hid_t file) {
          {std::pair{"/position/value", &r.position}, std::pair{"/velocity/value", &r.velocity}}) {
       const std::string path = groups[bi].group() + series;
       const std::vector<VecX> body_frames =
-          split_frames(h5::read_doubles(file, path, &dims), dims, count, path);
+          split_frames(h5::read_doubles(file, path, &dims, kReadable), dims, count, path);
       if (bi == 0) {
         frames->assign(body_frames.size(), VecX::Zero(static_cast<Eigen::Index>(3 * n)));
       }
@@ -216,7 +219,8 @@ Recording read(hid_t file) {
 
   h5::Handle observables = h5::open_group(file, "/observables");
   for (const std::string& name : member_names(observables.get())) {
-    const std::vector<double> v = h5::read_doubles(observables.get(), name + "/value", &dims);
+    const std::vector<double> v =
+        h5::read_doubles(observables.get(), name + "/value", &dims, kReadable);
     expect(dims.size() == 1 || (dims.size() == 2 && dims[1] == 3), "/observables/" + name,
            "not [T] or [T][3]");
     const Eigen::Index rows = static_cast<Eigen::Index>(dims[0]);

@@ -63,11 +63,38 @@ void write_attribute_raw(hid_t object, const std::string& name, hid_t file_type,
   check(H5Awrite(attribute.get(), memory_type, data), "write attribute " + name);
 }
 
+// The leading frames of a time series that read, one frame at a time, up to the first that
+// does not (a run killed mid-write can leave chunks the file's index names but never stored).
+// `dims` is shortened to the frames kept.
+template <typename T>
+void read_leading_frames(hid_t dataset, hid_t memory_type, std::vector<hsize_t>& dims,
+                         std::vector<T>& data) {
+  const hsize_t frame_values = dims[0] == 0 ? 0 : data.size() / dims[0];
+  Handle file_space(H5Dget_space(dataset), "dataspace");
+  std::vector<hsize_t> start(dims.size(), 0), count = dims;
+  count[0] = 1;
+  Handle memory_space(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr),
+                      "frame dataspace");
+  hsize_t frames = 0;
+  for (; frames < dims[0]; ++frames) {
+    start[0] = frames;
+    if (H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
+                            nullptr) < 0 ||
+        H5Dread(dataset, memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT,
+                data.data() + frames * frame_values) < 0) {
+      break;
+    }
+  }
+  H5Eclear2(H5E_DEFAULT);
+  dims[0] = frames;
+  data.resize(frames * frame_values);
+}
+
 template <typename T>
 std::vector<T> read_all(hid_t parent, const std::string& name, hid_t memory_type,
-                        std::vector<hsize_t>* dims_out) {
+                        std::vector<hsize_t>* dims_out, Frames frames = Frames::kAll) {
   Handle dataset = open_dataset(parent, name);
-  const std::vector<hsize_t> dims = dataset_dims(dataset.get());
+  std::vector<hsize_t> dims = dataset_dims(dataset.get());
   // A file can claim any shape (its chunks need not exist): refuse before allocating more than
   // kMaxReadBytes, or more than its stored bytes could hold (deflate expands at most about
   // 1032 times; jelly's files store every chunk they claim).
@@ -84,9 +111,10 @@ std::vector<T> read_all(hid_t parent, const std::string& name, hid_t memory_type
     count *= d;
   }
   std::vector<T> data(count);
-  if (count > 0) {
-    check(H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
-          "read " + name);
+  if (count > 0 &&
+      H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0) {
+    if (frames != Frames::kLeadingReadable || dims.empty()) check(-1, "read " + name);
+    read_leading_frames(dataset.get(), memory_type, dims, data);
   }
   if (dims_out != nullptr) *dims_out = dims;
   return data;
@@ -368,17 +396,18 @@ std::vector<hsize_t> dataset_dims(hid_t dataset) {
   return dims;
 }
 
-std::vector<double> read_doubles(hid_t parent, const std::string& name,
-                                 std::vector<hsize_t>* dims) {
-  return read_all<double>(parent, name, H5T_NATIVE_DOUBLE, dims);
+std::vector<double> read_doubles(hid_t parent, const std::string& name, std::vector<hsize_t>* dims,
+                                 Frames frames) {
+  return read_all<double>(parent, name, H5T_NATIVE_DOUBLE, dims, frames);
 }
 
 std::vector<int> read_ints(hid_t parent, const std::string& name, std::vector<hsize_t>* dims) {
   return read_all<int>(parent, name, H5T_NATIVE_INT, dims);
 }
 
-std::vector<long> read_longs(hid_t parent, const std::string& name, std::vector<hsize_t>* dims) {
-  return read_all<long>(parent, name, H5T_NATIVE_LONG, dims);
+std::vector<long> read_longs(hid_t parent, const std::string& name, std::vector<hsize_t>* dims,
+                             Frames frames) {
+  return read_all<long>(parent, name, H5T_NATIVE_LONG, dims, frames);
 }
 
 Series::Series(hid_t parent, const std::string& name, hid_t file_type, hid_t memory_type,

@@ -95,14 +95,19 @@ std::vector<hsize_t> dataset_dims(hid_t dataset);
 // The readers refuse a dataset larger than this, or than its stored bytes could hold (a damaged
 // file can claim any shape).
 constexpr hsize_t kMaxReadBytes = hsize_t{16} << 30;
+// What a reader does when a time series does not read whole: throw (kAll), or keep the frames
+// before the first that does not read (kLeadingReadable: a run killed while HDF5 wrote a chunk
+// can leave the last frames named in the file's index but not stored).
+enum class Frames { kAll, kLeadingReadable };
 // The whole dataset converted to double / int / long; dims receives its shape. Throws
 // std::runtime_error for a missing dataset or one of more than kMaxReadBytes (or than it stores).
 std::vector<double> read_doubles(hid_t parent, const std::string& name,
-                                 std::vector<hsize_t>* dims = nullptr);
+                                 std::vector<hsize_t>* dims = nullptr,
+                                 Frames frames = Frames::kAll);
 std::vector<int> read_ints(hid_t parent, const std::string& name,
                            std::vector<hsize_t>* dims = nullptr);
 std::vector<long> read_longs(hid_t parent, const std::string& name,
-                             std::vector<hsize_t>* dims = nullptr);
+                             std::vector<hsize_t>* dims = nullptr, Frames frames = Frames::kAll);
 
 // A dataset [T][shape...] that grows along its first (time) axis: chunked along time, optionally
 // shuffled and deflate-compressed. The handle stays open; append() extends and writes a block of

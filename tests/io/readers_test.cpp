@@ -6,6 +6,7 @@
 
 #include <hdf5.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,46 @@ class DamagedRecording : public ::testing::Test {
 TEST_F(DamagedRecording, TheUndamagedFileReads) {
   EXPECT_EQ(recording_error(path_), "");
   EXPECT_EQ(checkpoint_error(path_), "");
+}
+
+// A run killed while HDF5 wrote can leave its last chunk named in the index but not stored:
+// here the last stored chunk of the positions is overwritten so that it does not inflate. The
+// reader keeps the frames before it (the same values as undamaged) instead of refusing the file.
+TEST_F(DamagedRecording, AnUnreadableLastChunkKeepsTheFramesBeforeIt) {
+  const Recording whole = read_recording(path_);
+  haddr_t address = 0;
+  hsize_t size = 0, first_frame = 0;
+  {
+    const hid_t file = H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    const hid_t dataset = H5Dopen2(file, "/particles/jelly/position/value", H5P_DEFAULT);
+    const hid_t space = H5Dget_space(dataset);
+    hsize_t chunks = 0;
+    ASSERT_GE(H5Dget_num_chunks(dataset, space, &chunks), 0);
+    ASSERT_GE(chunks, 2u);
+    hsize_t offset[3] = {0, 0, 0};
+    unsigned mask = 0;
+    ASSERT_GE(H5Dget_chunk_info(dataset, space, chunks - 1, offset, &mask, &address, &size), 0);
+    first_frame = offset[0];
+    H5Sclose(space);
+    H5Dclose(dataset);
+    H5Fclose(file);
+  }
+  ASSERT_GT(first_frame, 0u);
+  {
+    std::FILE* f = std::fopen(path_.c_str(), "r+b");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fseek(f, static_cast<long>(address), SEEK_SET), 0);
+    const std::vector<unsigned char> garbage(size, 0xA5);
+    ASSERT_EQ(std::fwrite(garbage.data(), 1, size, f), size);
+    std::fclose(f);
+  }
+  const Recording damaged = read_recording(path_);
+  ASSERT_EQ(damaged.frames(), static_cast<int>(first_frame));
+  for (int f = 0; f < damaged.frames(); ++f) {
+    EXPECT_EQ(damaged.position[f], whole.position[f]) << "frame " << f;
+    EXPECT_EQ(damaged.velocity[f], whole.velocity[f]) << "frame " << f;
+    EXPECT_EQ(damaged.time[f], whole.time[f]) << "frame " << f;
+  }
 }
 
 TEST_F(DamagedRecording, SpringArraysOfDifferentLengths) {
