@@ -91,7 +91,9 @@ void spring_jacobian_blocks(const Model& model, const VecX& x, const VecX& v,
 // about 30 springs at the seed lattice's 26 neighbours).
 constexpr long kMinColumnsPerThread = 256;
 
-SpringJacobian::SpringJacobian(const Model& model) : num_particles_(model.num_particles()) {
+SpringJacobian::SpringJacobian(const Model& model,
+                               const std::vector<std::pair<int, int>>& extra_blocks)
+    : num_particles_(model.num_particles()), num_springs_(model.springs.size()) {
   const Springs& s = model.springs;
   const int n = num_particles_;
   for (int k = 0; k < s.size(); ++k) {
@@ -99,26 +101,37 @@ SpringJacobian::SpringJacobian(const Model& model) : num_particles_(model.num_pa
             "springs.a/b", std::to_string(s.a[k]) + ", " + std::to_string(s.b[k]),
             "two different particle indices in [0, N)");
   }
-  // Adjacency (other particle, spring) of every particle, by counting sort on the particle and
-  // then sorted per particle by (other particle, spring).
+  for (const auto& [i, j] : extra_blocks) {
+    require(i >= 0 && i < n && j >= 0 && j < n && i != j, "extra_blocks",
+            std::to_string(i) + ", " + std::to_string(j),
+            "two different particle indices in [0, N)");
+  }
+  // Adjacency (other particle, spring or -1) of every particle, by counting sort on the
+  // particle and then sorted per particle by (other particle, spring).
   adjacency_start_.assign(n + 1, 0);
   for (int k = 0; k < s.size(); ++k) {
     ++adjacency_start_[s.a[k] + 1];
     ++adjacency_start_[s.b[k] + 1];
   }
+  for (const auto& [i, j] : extra_blocks) {
+    ++adjacency_start_[i + 1];
+    ++adjacency_start_[j + 1];
+  }
   for (int j = 0; j < n; ++j) adjacency_start_[j + 1] += adjacency_start_[j];
-  neighbour_.resize(2 * static_cast<size_t>(s.size()));
+  neighbour_.resize(adjacency_start_.back());
   spring_.resize(neighbour_.size());
   {
     std::vector<int> fill(adjacency_start_.begin(), adjacency_start_.end() - 1);
-    for (int k = 0; k < s.size(); ++k) {
-      int e = fill[s.a[k]]++;
-      neighbour_[e] = s.b[k];
+    const auto add = [&](int i, int j, int k) {
+      int e = fill[i]++;
+      neighbour_[e] = j;
       spring_[e] = k;
-      e = fill[s.b[k]]++;
-      neighbour_[e] = s.a[k];
+      e = fill[j]++;
+      neighbour_[e] = i;
       spring_[e] = k;
-    }
+    };
+    for (int k = 0; k < s.size(); ++k) add(s.a[k], s.b[k], k);
+    for (const auto& [i, j] : extra_blocks) add(i, j, -1);
   }
   std::vector<std::pair<int, int>> pairs;
   column_stride_.resize(n);
@@ -193,7 +206,9 @@ void SpringJacobian::for_column_springs(int j, Spring&& spring, Block&& block) c
   for (int slot = 0; slot < blocks; ++slot) {
     if (slot == self_slot_[j]) continue;
     const int i = neighbour_[e];
-    for (; e < end && neighbour_[e] == i; ++e) spring(i, spring_[e]);
+    for (; e < end && neighbour_[e] == i; ++e) {
+      if (spring_[e] >= 0) spring(i, spring_[e]);  // an extra block has none: zero
+    }
     block(slot);
   }
 }

@@ -3,6 +3,7 @@
 // sparsity pattern, built once with a per-particle neighbour list; each assembly only refills the
 // values, column by column (a gather: every column is written by one thread, in one order, so
 // the values are the same bit for bit for any thread count; docs/threads.md).
+#include <utility>
 #include <vector>
 
 #include <jelly/core/definiteness.hpp>
@@ -32,11 +33,14 @@ class SpringJacobian {
   // Builds the pattern of the 3N x 3N matrices for the springs of `model`: one dense 3x3 block
   // per particle on the diagonal and per spring (a, b) at (a, b) and (b, a). Full storage (both
   // triangles), compressed column, sorted row indices.
-  explicit SpringJacobian(const Model& model);
+  // `extra_blocks` (i, j) add the blocks (i, j) and (j, i) to the pattern, zero after every
+  // assembly (for terms a caller adds itself, e.g. contact pairs between bodies).
+  explicit SpringJacobian(const Model& model,
+                          const std::vector<std::pair<int, int>>& extra_blocks = {});
 
   int rows() const { return 3 * num_particles_; }
   int non_zeros() const { return col_start_.back(); }
-  int num_springs() const { return static_cast<int>(neighbour_.size() / 2); }
+  int num_springs() const { return num_springs_; }
   // A matrix with this pattern and zero values (allocates; call once).
   SparseMatrix make_matrix() const;
   // True when `m` has this pattern's size (the matrices passed below must come from make_matrix).
@@ -64,11 +68,13 @@ class SpringJacobian {
   template <class Column>
   void for_columns(int threads, Column&& column) const;
   // Walks column j's row blocks but its own: spring(i, k) for every spring k joining j to the
-  // block's particle i, then block(slot) once that block's springs are done.
+  // block's particle i, then block(slot) once that block's springs are done (an extra block's
+  // has none).
   template <class Spring, class Block>
   void for_column_springs(int j, Spring&& spring, Block&& block) const;
 
   int num_particles_ = 0;
+  int num_springs_ = 0;
   std::vector<int> col_start_;      // [3N + 1]
   std::vector<int> column_stride_;  // [N]: distance between columns 3j and 3j + 1 of particle j
   std::vector<int> diagonal_;       // [3N]: value index of entry (i, i)
@@ -77,7 +83,7 @@ class SpringJacobian {
   // blocks of column j are its distinct neighbours and j itself (at self_slot_[j]), in order.
   std::vector<int> adjacency_start_;  // [N + 1]
   std::vector<int> neighbour_;        // [2M]
-  std::vector<int> spring_;           // [2M]
+  std::vector<int> spring_;           // [2M]: the spring, or -1 for an extra block
   std::vector<int> self_slot_;        // [N]
 };
 

@@ -285,6 +285,24 @@ TEST(BandSystem, ProductsEqualTheAssembledMatrix) {
                                beta, w, kw, 1));
 }
 
+// Extra blocks (pairs without a spring) are in the pattern and zero after every assembly.
+TEST(SpringJacobian, ExtraBlocksAreZero) {
+  const Model model = cube_model(2400, 120);
+  const State s = random_state(model, 9);
+  const int far = model.num_particles() - 1;  // opposite corners: no spring joins them
+  SpringJacobian plain(model), extended(model, {{0, far}});
+  EXPECT_EQ(extended.non_zeros(), plain.non_zeros() + 18);
+  SparseMatrix a = plain.make_matrix(), b = extended.make_matrix();
+  const VecX w = VecX::Random(model.num_dofs());
+  VecX kwa(model.num_dofs()), kwb(model.num_dofs());
+  plain.assemble_system(model, s.x, s.v, JacobianOptions{}, 0.01, 1e-4, a, w, kwa);
+  std::fill(b.valuePtr(), b.valuePtr() + b.nonZeros(), 1.0);
+  extended.assemble_system(model, s.x, s.v, JacobianOptions{}, 0.01, 1e-4, b, w, kwb);
+  EXPECT_EQ(Dense(a), Dense(b));
+  EXPECT_TRUE(kwa == kwb);
+  EXPECT_EQ(b.coeff(0, 3 * far), 0.0);
+}
+
 TEST(SpringJacobian, DefinitenessNamesRoundTrip) {
   for (DefinitenessFix f :
        {DefinitenessFix::kClampCompressed, DefinitenessFix::kProjectPsd, DefinitenessFix::kNone}) {
