@@ -11,22 +11,26 @@
 namespace jelly {
 
 class SpringBands;  // core/detail/spring_bands.hpp: the Simulator's vectorised force loop
+class BodyContact;  // solvers/contact/body_contact.hpp
 
 class Dynamics {
  public:
   // `terrains` (may be null) is for integrators that resolve contact inside their step;
   // `bands` (may be null), built for `model`, evaluates the spring forces faster; `anchors`
   // (may be null) are added to the forces, and implicit integrators add their Jacobian;
-  // `threads` (>= 1) is how many threads the force loop and the integrators' own loops may use.
+  // `threads` (>= 1) is how many threads the force loop and the integrators' own loops may use;
+  // `body_contact` (may be null: no contact between bodies) is for integrators that resolve it
+  // inside their step (Integrator::resolves_body_contact()).
   Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains = nullptr,
            const SpringBands* bands = nullptr, const AnchorSprings* anchors = nullptr,
-           int threads = 1)
+           int threads = 1, BodyContact* body_contact = nullptr)
       : model_(&model),
         contacts_(&contacts),
         terrains_(terrains),
         bands_(bands),
         anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr),
         threads_(threads > 1 ? threads : 1),
+        body_contact_(body_contact),
         in_evaluation_contact_(terrains != nullptr &&
                                ContactSolver::has_in_evaluation_contact(*terrains)) {}
 
@@ -52,6 +56,9 @@ class Dynamics {
   const Terrains* terrains() const { return terrains_; }
   // The vectorised force loop's bands (core/detail/spring_bands.hpp), or null.
   const SpringBands* bands() const { return bands_; }
+  // The contact between bodies (and within a body) the Simulator resolves after the step unless
+  // the integrator resolves it inside; null when there is none.
+  BodyContact* body_contact() const { return body_contact_; }
   // The anchor springs, or null when there are none.
   const AnchorSprings* anchors() const { return anchors_; }
   long force_evaluations() const { return evaluations_; }
@@ -65,6 +72,7 @@ class Dynamics {
   const SpringBands* bands_;
   const AnchorSprings* anchors_;
   int threads_;
+  BodyContact* body_contact_;
   bool in_evaluation_contact_;
   mutable long evaluations_ = 0;
 };

@@ -207,14 +207,17 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
 
 StepResult Simulator::step() {
   const int threads = parallel::resolve_threads(options_.threads);
-  const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_, threads);
+  const bool bodies = body_contact_.active(model_);
+  const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_, threads,
+                          bodies ? &body_contact_ : nullptr);
   before_.x = state_.x;
   before_.v = state_.v;
   StepResult result = integrator_->step(dynamics, state_, options_.dt);
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
   // Bodies first, then the terrains: a terrain has the last word on where a particle may be.
-  if (body_contact_.active(model_)) body_contact_.resolve(model_, before_, state_, options_.dt);
+  if (bodies && !integrator_->resolves_body_contact())
+    body_contact_.resolve(model_, before_, state_, options_.dt);
   resolve_contact_after_step(*integrator_, contacts_, model_, terrains_, before_, state_,
                              options_.dt, threads);
   if (!model_.pins.empty()) model_.pins.apply(state_.t, state_.x, state_.v);

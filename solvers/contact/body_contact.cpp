@@ -141,6 +141,28 @@ void BodyContact::check_no_overlap(const Model& model, const VecX& x, Real toler
   }
 }
 
+const std::vector<BroadPhase::Pair>& BodyContact::find_candidates(const Model& model,
+                                                                 const VecX& x, const VecX& pad,
+                                                                 Real margin) {
+  const auto t0 = std::chrono::steady_clock::now();
+  prepare(model);
+  padded_ = (1 + margin) * radius_ + pad;
+  for (int i = 0; i < padded_.size(); ++i) {
+    if (!(radius_[i] > 0)) padded_[i] = 0;
+  }
+  broad_.find_pairs(x, padded_, candidates_);
+  filter(model);
+  stats_.broad_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return contacts_;
+}
+
+void BodyContact::record_step(const std::vector<BroadPhase::Pair>& pairs, double narrow_seconds) {
+  contacts_ = pairs;
+  stats_.pairs += static_cast<long>(pairs.size());
+  stats_.narrow_seconds += narrow_seconds;
+  ++stats_.steps;
+}
+
 void BodyContact::resolve(const Model& model, const State& before, State& state, Real h) {
   contacts_.clear();
   if (!active(model)) return;

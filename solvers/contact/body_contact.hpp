@@ -58,6 +58,20 @@ class BodyContact {
   const std::vector<BroadPhase::Pair>& pairs() const { return contacts_; }
   const Stats& stats() const { return stats_; }
 
+  // For an integrator that resolves body contact inside its step (implicit_euler,
+  // solvers/contact/detail/implicit_body_contact.hpp): the filtered pairs (as resolve() keeps
+  // them) whose spheres overlap at `x` when each radius r is grown to r (1 + margin) + pad[i]
+  // (pad: the distance the particle may travel in the step). The time counts as broad phase.
+  const std::vector<BroadPhase::Pair>& find_candidates(const Model& model, const VecX& x,
+                                                       const VecX& pad, Real margin);
+  // Ends a step whose contacts the integrator resolved: `pairs` in contact at its end (what
+  // pairs() returns), `narrow_seconds` of the integrator's contact work.
+  void record_step(const std::vector<BroadPhase::Pair>& pairs, double narrow_seconds);
+  // Per particle (after find_candidates() on the model): contact radius, inverse mass (0 for
+  // pins).
+  Real radius(int i) const { return radius_[i]; }
+  Real inverse_mass(int i) const { return inverse_mass_[i]; }
+
   // Throws InputError naming both bodies when two bodies' particles overlap in `x` (closer than
   // their radii sum less `tolerance` relative), and for self-contact two particles of one body
   // that no spring joins.
@@ -75,7 +89,7 @@ class BodyContact {
   BroadPhase broad_;
   const Model* prepared_for_ = nullptr;
   int prepared_particles_ = -1, prepared_springs_ = -1;
-  VecX radius_, inverse_mass_;
+  VecX radius_, inverse_mass_, padded_;
   std::vector<int> body_;
   std::vector<int> neighbour_start_, neighbours_;  // CSR, sorted
   std::vector<BroadPhase::Pair> candidates_, contacts_;

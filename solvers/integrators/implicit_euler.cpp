@@ -8,6 +8,8 @@
 #include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/detail/implicit_body_contact.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>
@@ -39,6 +41,13 @@ void restore_momentum(const VecX& mass, const VecX& b, VecX& y) {
   for (Eigen::Index i = 0; i < np; ++i) y.segment<3>(3 * i) += shift;
 }
 
+// Whether a matrix of dense 3x3 blocks (full storage, sorted rows) holds block (i, j).
+bool has_block(const SparseMatrix& a, int i, int j) {
+  const int* outer = a.outerIndexPtr();
+  const int* rows = a.innerIndexPtr();
+  return std::binary_search(rows + outer[3 * j], rows + outer[3 * j + 1], 3 * i);
+}
+
 }  // namespace
 
 ImplicitLinearSolver auto_linear_solver(int dofs) {
@@ -51,6 +60,14 @@ struct ImplicitEuler::Impl {
   bool resolves_contact() const {
     return options_.contact == ImplicitContactMode::kImplicit && terrains_seen_;
   }
+  bool resolves_body_contact() const {
+    return options_.contact == ImplicitContactMode::kImplicit && bodies_seen_;
+  }
+  // Makes the matrix pattern hold the blocks of every candidate pair of bodies_ (the union of
+  // the candidates seen so far; a new symbolic analysis only when a pair is new).
+  StepResult ensure_pattern(const Model& model);
+  // a_ and b_ = the saved assembly plus the active pairs' terms (saves the assembly first).
+  void refresh_pair_terms();
   void add_statistics(Statistics& s) const;
   StepResult step(const Dynamics& dynamics, State& state, Real h);
   StepResult prepare(const Dynamics& dynamics, Real h);
@@ -107,6 +124,14 @@ struct ImplicitEuler::Impl {
   int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
+  ImplicitBodyContact bodies_;
+  BodyContact* body_contact_ = nullptr;    // of the current step (null: none, or after_step)
+  bool bodies_active_ = false;             // the current step has candidate pairs
+  bool bodies_seen_ = false;               // the last step's Dynamics had body contact
+  bool base_saved_ = false;                // base_values_ / b_base_ hold this step's assembly
+  std::vector<std::pair<int, int>> extra_blocks_;  // pair blocks in jacobian_'s pattern
+  std::vector<Real> base_values_;
+  VecX b_base_;
   const Terrains* contact_terrains_ = nullptr;  // the terrains contact_ resolves this step
   bool contact_active_ = false;                 // the current step constrains contacts
   bool terrains_seen_ = true;                   // the last step's Dynamics had terrains
@@ -130,6 +155,8 @@ ImplicitEuler::ImplicitEuler(ImplicitEulerOptions options)
 ImplicitEuler::~ImplicitEuler() = default;
 
 bool ImplicitEuler::resolves_contact() const { return impl_->resolves_contact(); }
+
+bool ImplicitEuler::resolves_body_contact() const { return impl_->resolves_body_contact(); }
 
 int ImplicitEuler::contacts_resolved() const {
   return impl_->contact_active_ ? impl_->contact_.count() : 0;
@@ -176,14 +203,24 @@ void ImplicitEuler::Impl::add_statistics(Statistics& s) const {
     s["contact_not_converged"] = static_cast<double>(cc.not_converged);
     s["contact_restitution_limited"] = static_cast<double>(cc.restitution_limited);
   }
+  if (resolves_body_contact()) {
+    const ImplicitBodyContact::Counters& bc = bodies_.counters();
+    s["body_contact_extra_solves"] = static_cast<double>(bc.extra_solves);
+    s["body_contact_restitution_limited"] = static_cast<double>(bc.restitution_limited);
+  }
 }
 
 std::vector<Real> ImplicitEuler::internal_state() const {
-  // [size of the warm start dv (0 if none), dv..., the contact set]
+  // [size of the warm start dv (0 if none), dv..., (with contact pairs of bodies: -(1 + their
+  // number of values), the pairs...), the contact set]
   const Impl& m = *impl_;
   std::vector<Real> out;
   out.push_back(m.have_dv_ ? static_cast<Real>(m.dv_.size()) : 0.0);
   if (m.have_dv_) out.insert(out.end(), m.dv_.data(), m.dv_.data() + m.dv_.size());
+  if (m.bodies_.saved_size() > 0) {
+    out.push_back(-1.0 - static_cast<Real>(m.bodies_.saved_size()));
+    m.bodies_.save(out);
+  }
   m.contact_.save(out);
   return out;
 }
@@ -193,6 +230,7 @@ void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
   if (data.empty()) {
     m.have_dv_ = false;
     m.contact_.restore(nullptr, 0);
+    m.bodies_.restore(nullptr, 0);
     return;
   }
   const Real n = data[0];
@@ -203,7 +241,20 @@ void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
   const int rows = m.jacobian_ ? m.jacobian_->rows() : m.band_ ? m.band_->rows() : -1;
   m.have_dv_ = size > 0 && (rows < 0 || static_cast<int>(size) == rows);
   if (m.have_dv_) m.dv_ = Eigen::Map<const VecX>(data.data() + 1, static_cast<Eigen::Index>(size));
-  m.contact_.restore(data.data() + 1 + size, data.size() - 1 - size);
+  size_t at = 1 + size;
+  size_t pairs = 0;
+  if (at < data.size() && data[at] < 0) {
+    const Real count = -1 - data[at];
+    require(count >= 0 && count == std::floor(count) &&
+                at + 1 + count <= static_cast<Real>(data.size()),
+            "integrator state (body contact pairs)", data[at],
+            "the size of a saved implicit_euler state");
+    pairs = static_cast<size_t>(count);
+    ++at;
+  }
+  m.bodies_.restore(data.data() + at, pairs);
+  at += pairs;
+  m.contact_.restore(data.data() + at, data.size() - at);
 }
 
 StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
@@ -216,7 +267,9 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
   const bool matrix_free =
       kind == ImplicitLinearSolver::kCg &&
       (automatic || options_.cg_preconditioner == CgPreconditionerKind::kJacobi) &&
-      bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_;
+      bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_ &&
+      // Contact pairs between bodies add blocks off the springs' bands: the assembled matrix.
+      !(options_.contact == ImplicitContactMode::kImplicit && dynamics.body_contact() != nullptr);
   const auto size_vectors = [&] {
     for (VecX* w : {&f_, &kw_, &b_, &v1_, &x1_, &g_, &delta_, &rhs_, &z_})
       if (w->size() != n) w->setZero(n);
@@ -246,6 +299,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
     const auto start = Clock::now();
     matrix_free_ = false;
     band_.reset();
+    extra_blocks_.clear();
     jacobian_.emplace(model);
     a_ = jacobian_->make_matrix();
     CholmodOptions cholmod;
@@ -349,6 +403,40 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
   return finish_solve(model, r, b, y, constrained, t);
 }
 
+StepResult ImplicitEuler::Impl::ensure_pattern(const Model& model) {
+  const std::vector<ImplicitBodyContact::Pair>& pairs = bodies_.pairs();
+  const bool complete = std::all_of(pairs.begin(), pairs.end(), [&](const auto& p) {
+    return has_block(a_, p.i, p.j);
+  });
+  if (complete) return StepResult::success();
+  const auto start = Clock::now();
+  // The union of the candidates so far, unless it grew much larger than the current ones.
+  if (extra_blocks_.size() > 4 * pairs.size() + 1024) extra_blocks_.clear();
+  for (const auto& p : pairs) extra_blocks_.emplace_back(p.i, p.j);
+  std::sort(extra_blocks_.begin(), extra_blocks_.end());
+  extra_blocks_.erase(std::unique(extra_blocks_.begin(), extra_blocks_.end()), extra_blocks_.end());
+  jacobian_.emplace(model, extra_blocks_);
+  a_ = jacobian_->make_matrix();
+  const LinearResult r = solver_->analyze(a_);
+  factorization_seconds_ += seconds_since(start);
+  if (!r.ok()) return StepResult::failure("implicit_euler: " + r.message);
+  return StepResult::success();
+}
+
+void ImplicitEuler::Impl::refresh_pair_terms() {
+  Real* values = a_.valuePtr();
+  const size_t nnz = static_cast<size_t>(a_.nonZeros());
+  if (!base_saved_) {
+    base_values_.assign(values, values + nnz);
+    b_base_ = b_;
+    base_saved_ = true;
+  } else {
+    std::copy(base_values_.begin(), base_values_.end(), values);
+    b_ = b_base_;
+  }
+  bodies_.add_terms(a_, &b_);
+}
+
 StepResult ImplicitEuler::Impl::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
                                                     bool constrained, Real t) {
   if (matrix_free_) return solve_matrix_free(model, b, y, constrained, t);
@@ -386,9 +474,19 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   if (!have_dv_) {  // first guess for CG: the explicit step h M^-1 f; later the last dv
     for (int i = 0; i < np; ++i) dv_.segment<3>(3 * i) = (h / m[i]) * f_.segment<3>(3 * i);
   }
+  // Contact between bodies: the candidate pairs, and their blocks in the pattern.
+  body_contact_ =
+      options_.contact == ImplicitContactMode::kImplicit ? dynamics.body_contact() : nullptr;
+  bodies_seen_ = body_contact_ != nullptr;
+  bodies_active_ = body_contact_ != nullptr && bodies_.begin_step(model, *body_contact_, s, f_, h);
+  base_saved_ = false;
+  if (bodies_active_) {
+    if (StepResult r = ensure_pattern(model); !r.ok) return r;
+  }
   anchored_ = dynamics.anchors() != nullptr;
   if (StepResult r = assemble(dynamics, s.x, s.v, s.t + h, h); !r.ok) return r;
   b_ = h * (f_ + h * kw_);
+  if (bodies_active_ && bodies_.any_active()) refresh_pair_terms();
   assembly_seconds_ += seconds_since(start);
   terrains_seen_ = dynamics.terrains() != nullptr;
   // The terrains whose contact this solve resolves (none with contact = "after_step"); pinned
@@ -409,9 +507,17 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     }
     if (constrained) dv_ += z_;
     ++newton_iterations_;
-    if (!contact_active_) break;
+    if (!contact_active_ && !bodies_active_) break;
     const bool last = round >= options_.contact_iterations;
-    if (!update_contacts(*terrains, b_, !last) || last) break;
+    const bool terrain_changed = contact_active_ && update_contacts(*terrains, b_, !last);
+    const bool pairs_changed = bodies_active_ && bodies_.update(dv_, !last);
+    if (last || (!terrain_changed && !pairs_changed)) break;
+    if (pairs_changed) {
+      // The terrains' filter is undone (update() did it if their set changed) before the
+      // pairs' terms change.
+      if (constrained && !terrain_changed) contact_.unconstrain(a_);
+      refresh_pair_terms();
+    }
   }
   have_dv_ = true;
   return StepResult::success();
@@ -434,6 +540,7 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
     for (int i = 0; i < np; ++i)
       g_.segment<3>(3 * i) =
           m[i] * (v1_.segment<3>(3 * i) - s.v.segment<3>(3 * i)) - h * f_.segment<3>(3 * i);
+    if (bodies_active_) bodies_.subtract_impulses(v1_, g_);
     if (constrained) {
       contact_.subtract_friction(v1_, g_);
       contact_.project(g_);
@@ -451,6 +558,7 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
     delta_.setZero();
     const auto start = Clock::now();
     if (StepResult r = assemble(dynamics, x1_, v1_, s.t + h, h); !r.ok) return r;
+    if (bodies_active_) bodies_.add_terms(a_, nullptr);
     assembly_seconds_ += seconds_since(start);
     if (constrained) constrain(g_, false, delta_);
     if (StepResult r =
@@ -480,6 +588,11 @@ StepResult ImplicitEuler::Impl::step(const Dynamics& dynamics, State& s, Real h)
   s.x += h * s.v;
   s.t += h;
   if (contact_active_) contact_.finish(dynamics.model(), *contact_terrains_, s);
+  if (bodies_active_) {
+    bodies_.finish(dynamics.model(), s, *body_contact_);
+  } else if (body_contact_ != nullptr) {
+    body_contact_->record_step({}, 0.0);
+  }
   return StepResult::success();
 }
 

@@ -26,6 +26,9 @@ class ImplicitEuler final : public Integrator {
   // With contact = "implicit", unless the last step's Dynamics carried no terrains (then the
   // caller's resolve after the step must handle them all).
   bool resolves_contact() const override;
+  // With contact = "implicit" and contact between bodies (Dynamics::body_contact()): the pairs
+  // are part of the solve (docs/contact.md).
+  bool resolves_body_contact() const override;
   int contacts_resolved() const override;
   // steps, symbolic_analyses, numeric_factorizations, linear_solves, cg_iterations,
   // newton_iterations, newton_not_converged, assembly_seconds, factorization_seconds,

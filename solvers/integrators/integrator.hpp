@@ -45,6 +45,9 @@ class Integrator {
   // True when do_step() already applied the contact of the coulomb terrains (inside its solve);
   // the Simulator then applies only the seed model's contact after the step.
   virtual bool resolves_contact() const { return false; }
+  // True when do_step() resolved the contact between bodies (Dynamics::body_contact()) inside
+  // its solve; the Simulator then does not resolve it after the step.
+  virtual bool resolves_body_contact() const { return false; }
   // When resolves_contact(): the particles in coulomb contact at the end of the last step.
   virtual int contacts_resolved() const { return 0; }
   // What the next steps depend on besides the state (warm starts, contact sets), as numbers a

@@ -118,12 +118,14 @@ class BodiesEveryIntegrator : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Registry, BodiesEveryIntegrator, ::testing::ValuesIn(integrator_names()),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
-TEST_P(BodiesEveryIntegrator, TwoFreeCubesCollideConserveMomentumAndSeparate) {
+// Two free cubes thrown at each other; returns |L1 - L0| / |L0|.
+Real collide_two_cubes(const std::string& integrator, Real dt) {
+  SCOPED_TRACE(integrator + " at dt = " + std::to_string(dt));
   const Model model = two_cubes(0.3);
   State s = rest_state(model);
   for (int i = 0; i < model.num_particles(); ++i)
     particle(s.v, i) = i < 64 ? Vec3(1.5, 0, 0) : Vec3(-1, 0, 0.1);
-  Simulator sim = make_sim(model, s, GetParam(), 1e-3);
+  Simulator sim = make_sim(model, s, integrator, dt);
   BodyContactParams params;
   params.friction = params.static_friction = 0;
   params.restitution = 0.5;
@@ -133,53 +135,83 @@ TEST_P(BodiesEveryIntegrator, TwoFreeCubesCollideConserveMomentumAndSeparate) {
   testing::Probe probe(
       [&](const Simulator& sm) { touching_steps += sm.body_contact().pairs().empty() ? 0 : 1; });
   sim.add_observer(probe);
-  ASSERT_TRUE(sim.run_until(0.5).ok());
+  EXPECT_TRUE(sim.run_until(0.5).ok());
   const Vec3 p1 = linear_momentum(model, sim.state()), l1 = angular_momentum(model, sim.state());
   EXPECT_GT(touching_steps, 0);
   EXPECT_TRUE(sim.body_contact().pairs().empty());  // apart again
   EXPECT_LT((p1 - p0).norm(), 1e-9 * p0.norm());
-  if (GetParam() == "symplectic_euler") {
-    EXPECT_LT((l1 - l0).norm(), 1e-9 * l0.norm());
-  }
   // They bounced: the left cube now moves slower than the centre of mass (0.25 m/s).
   Vec3 left = Vec3::Zero();
   for (int i = 0; i < 64; ++i) left += model.mass[i] * particle(sim.state().v, i);
   EXPECT_LT(left.x() / model.mass.head(64).sum(), 0.25);  // centre-of-mass speed 0.25 m/s
+  // Apart: no particle of one cube within the sum of the radii of one of the other.
+  Real closest = 1e9;
+  for (int i = 0; i < 64; ++i)
+    for (int j = 64; j < 128; ++j)
+      closest = std::min(closest, (particle(sim.state().x, j) - particle(sim.state().x, i)).norm());
+  EXPECT_GT(closest, 0.1);
+  return (l1 - l0).norm() / l0.norm();
 }
 
-// A cube dropped onto another resting on the floor (3 particles per edge, radius 0.15 m): the
-// stack comes to rest with no particle of one cube closer to one of the other than the sum of
-// their radii less 1 %, the upper cube on the lower one. Returns the upper cube's height.
-Real stack_rest_height(const std::string& integrator, Real dt) {
+TEST_P(BodiesEveryIntegrator, TwoFreeCubesCollideConserveMomentumAndSeparate) {
+  const Real angular = collide_two_cubes(GetParam(), 1e-3);
+  if (GetParam() == "symplectic_euler") {
+    EXPECT_LT(angular, 1e-9);
+  }
+}
+
+// implicit_euler with the pairs inside its solve, at its large steps.
+TEST(BodyContact, ImplicitEulerTwoFreeCubesCollideAtLargeSteps) {
+  for (const Real dt : {1.0 / 60, 1.0 / 30}) collide_two_cubes("implicit_euler", dt);
+}
+
+// Cubes dropped onto each other onto the floor (3 particles per edge, radius 0.15 m; the second
+// 0.4 m above the first, the third, if any, 0.4 m above the second, each shifted sideways by
+// `shift`): the stack comes to rest with no particle of one cube closer to one of another than
+// the sum of their radii less 1 % (at every step, and at the end), every cube on the one below.
+// Returns the top cube's height.
+Real stack_rest_height(const std::string& integrator, Real dt, int cubes = 2, Real shift = 0) {
+  SCOPED_TRACE(integrator + " at dt = " + std::to_string(dt));
   Model model;
-  const CubeSpec low = testing::small_cube(3, 0.6, Vec3(-0.3, 0.001, -0.3));
-  const CubeSpec high = testing::small_cube(3, 0.6, Vec3(-0.3, 1.0, -0.3));
-  model.add_body("low", low.shape().build(low.material(), "low."));
-  model.add_body("high", high.shape().build(high.material(), "high."));
+  for (int c = 0; c < cubes; ++c) {
+    const CubeSpec cube = testing::small_cube(3, 0.6, Vec3(-0.3 + c * shift, 0.001 + c, -0.3));
+    model.add_body("cube" + std::to_string(c),
+                   cube.shape().build(cube.material(), "c" + std::to_string(c) + "."));
+  }
   Simulator sim = make_sim(model, rest_state(model), integrator, dt);
   sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitY()));
   sim.check_no_overlap();
-  EXPECT_TRUE(sim.run_until(3.0).ok());
   const int n = 27;
   const Real r = model.bodies[0].radius;
   EXPECT_EQ(r, 0.15);
-  Real closest = 1e9;
-  for (int i = 0; i < n; ++i)
-    for (int j = n; j < 2 * n; ++j)
-      closest = std::min(closest, (particle(sim.state().x, j) - particle(sim.state().x, i)).norm());
-  EXPECT_GT(closest, 2 * r * 0.99) << integrator;
+  const auto closest = [&](const VecX& x) {
+    Real d = 1e9;
+    for (int a = 0; a < cubes * n; ++a)
+      for (int b = (a / n + 1) * n; b < cubes * n; ++b)
+        d = std::min(d, (particle(x, b) - particle(x, a)).norm());
+    return d;
+  };
+  Real closest_ever = 1e9;
+  testing::Probe probe([&](const Simulator& sm) {
+    closest_ever = std::min(closest_ever, closest(sm.state().x));
+  });
+  sim.add_observer(probe);
+  EXPECT_TRUE(sim.run_until(3.0).ok());
+  EXPECT_GT(closest(sim.state().x), 2 * r * 0.99);
+  EXPECT_GT(closest_ever, 2 * r * 0.99);
   Real fastest = 0;
   for (int i = 0; i < model.num_particles(); ++i)
     fastest = std::max(fastest, particle(sim.state().v, i).norm());
-  EXPECT_LT(fastest, 0.05) << integrator;
-  Real low_top = -1e9, high_bottom = 1e9, high_y = 0;
-  for (int i = 0; i < n; ++i) low_top = std::max(low_top, sim.state().x[3 * i + 1]);
-  for (int j = n; j < 2 * n; ++j) {
-    high_bottom = std::min(high_bottom, sim.state().x[3 * j + 1]);
-    high_y += sim.state().x[3 * j + 1] / n;
+  EXPECT_LT(fastest, 0.05);
+  Real top_y = 0;
+  for (int c = 1; c < cubes; ++c) {
+    Real low_top = -1e9, high_bottom = 1e9;
+    for (int i = (c - 1) * n; i < c * n; ++i) low_top = std::max(low_top, sim.state().x[3 * i + 1]);
+    for (int j = c * n; j < (c + 1) * n; ++j) high_bottom = std::min(high_bottom, sim.state().x[3 * j + 1]);
+    EXPECT_NEAR(high_bottom - low_top, 2 * r, 0.01 * r) << "cube " << c;  // resting on it
   }
-  EXPECT_NEAR(high_bottom - low_top, 2 * r, 0.01 * r) << integrator;  // resting on it
-  return high_y;
+  for (int j = (cubes - 1) * n; j < cubes * n; ++j) top_y += sim.state().x[3 * j + 1] / n;
+  return top_y;
 }
 
 Real stable_dt(const std::string& integrator) {
@@ -193,11 +225,15 @@ TEST_P(BodiesEveryIntegrator, StackComesToRestWithoutOverlap) {
   EXPECT_NEAR(y, 1.2, 0.05) << GetParam();
 }
 
-// implicit_euler at 1/60 s with the contact after its step: the stack rests without overlap.
-// (At 1/30 s the after-step response cannot hold the upper cube: docs/contact.md.)
-TEST(BodyContact, ImplicitEulerStackAtASixtiethOfASecond) {
-  const Real y = stack_rest_height("implicit_euler", 1.0 / 60);
-  EXPECT_NEAR(y, 1.2, 0.1);
+// implicit_euler at 1/60 and 1/30 s with the pairs inside its solve: two and three cubes, in a
+// column and shifted sideways by a third of a lattice spacing, rest on each other without
+// overlap.
+TEST(BodyContact, ImplicitEulerStackAtLargeSteps) {
+  for (const Real dt : {1.0 / 60, 1.0 / 30}) {
+    EXPECT_NEAR(stack_rest_height("implicit_euler", dt), 1.2, 0.1);
+    EXPECT_NEAR(stack_rest_height("implicit_euler", dt, 3), 2.1, 0.15);
+    EXPECT_NEAR(stack_rest_height("implicit_euler", dt, 3, 0.1), 2.1, 0.15);
+  }
 }
 
 // Self-contact never acts between particles that a spring joins: a cube at rest, even squeezed,
