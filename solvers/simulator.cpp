@@ -59,7 +59,6 @@ void Simulator::set_threads(int threads) {
   options_.threads = threads;
 }
 
-
 Observer::~Observer() {
   // forget() edits lists_ of this observer too: iterate over a copy.
   const std::vector<ObserverList*> lists = lists_;

@@ -141,9 +141,8 @@ void BodyContact::check_no_overlap(const Model& model, const VecX& x, Real toler
   }
 }
 
-const std::vector<BroadPhase::Pair>& BodyContact::find_candidates(const Model& model,
-                                                                 const VecX& x, const VecX& pad,
-                                                                 Real margin) {
+const std::vector<BroadPhase::Pair>& BodyContact::find_candidates(const Model& model, const VecX& x,
+                                                                  const VecX& pad, Real margin) {
   const auto t0 = std::chrono::steady_clock::now();
   prepare(model);
   padded_ = (1 + margin) * radius_ + pad;
@@ -152,7 +151,8 @@ const std::vector<BroadPhase::Pair>& BodyContact::find_candidates(const Model& m
   }
   broad_.find_pairs(x, padded_, candidates_);
   filter(model);
-  stats_.broad_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats_.broad_seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return contacts_;
 }
 

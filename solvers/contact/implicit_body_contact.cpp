@@ -15,10 +15,12 @@ namespace {
 using Mat3 = Eigen::Matrix3d;
 using Clock = std::chrono::steady_clock;
 
-// A carried pair whose explicit prediction ends at most this far apart stays active; a candidate
-// whose end gap a solve makes smaller than -this becomes active.
-constexpr Real kTouchTolerance = 1e-6;        // m
-constexpr Real kPenetrationTolerance = 1e-9;  // m
+// A carried pair whose explicit prediction ends at most this far apart stays active.
+constexpr Real kTouchTolerance = 1e-6;  // m
+// A candidate whose end gap a solve makes smaller than -this fraction of r_i + r_j becomes
+// active and the step solves again; a shallower overlap is left to the next step (whose
+// prediction makes the pair active), which saves most of those solves.
+constexpr Real kPenetrationTolerance = 1e-3;
 // A sliding pair whose friction viscosity reaches this many times its reduced mass has all but
 // stopped sliding: it sticks (as for the terrains).
 constexpr Real kStickViscosity = 100;
@@ -79,21 +81,25 @@ bool ImplicitBodyContact::begin_step(const Model& model, BodyContact& contact, c
     p.i = i;
     p.j = j;
     p.normal = d / dist;
-    p.gap0 = dist - (contact.radius(i) + contact.radius(j));
+    p.reach = contact.radius(i) + contact.radius(j);
+    p.gap0 = dist - p.reach;
     p.mass = 1 / (wi + wj);
     p.approach = -(particle(v0_, j) - particle(v0_, i)).dot(p.normal);
     // The explicit prediction of the relative velocity.
-    const Vec3 w1 = particle(v0_, j) + (h / model.mass[j]) * particle(f, j) -
-                    particle(v0_, i) - (h / model.mass[i]) * particle(f, i);
+    const Vec3 w1 = particle(v0_, j) + (h / model.mass[j]) * particle(f, j) - particle(v0_, i) -
+                    (h / model.mass[i]) * particle(f, i);
     const Real predicted_gap = p.gap0 + h * p.normal.dot(w1);
-    const auto old = std::lower_bound(
-        carried_.begin(), carried_.end(), std::make_pair(i, j),
-        [](const Carried& c, const std::pair<int, int>& k) { return std::make_pair(c.i, c.j) < k; });
+    const auto old = std::lower_bound(carried_.begin(), carried_.end(), std::make_pair(i, j),
+                                      [](const Carried& c, const std::pair<int, int>& k) {
+                                        return std::make_pair(c.i, c.j) < k;
+                                      });
     const bool was_active = old != carried_.end() && old->i == i && old->j == j;
+    p.kappa = kStiffness;
     if (was_active && predicted_gap <= kTouchTolerance) {
       p.active = true;
       p.mode = old->mode;
       p.viscosity = old->viscosity;
+      p.kappa = old->kappa;
     } else if (predicted_gap < 0) {
       p.active = true;
       // Stick or slide as a lone pair would: the normal velocity change the contact needs
@@ -115,13 +121,13 @@ bool ImplicitBodyContact::begin_step(const Model& model, BodyContact& contact, c
 Mat3 ImplicitBodyContact::block(const Pair& p) const {
   const Mat3 nn = p.normal * p.normal.transpose();
   const Real c = p.mode == Mode::kStick ? stick_viscosity(p) : p.viscosity;
-  return (kStiffness * p.mass) * nn + c * (Mat3::Identity() - nn);
+  return (p.kappa * p.mass) * nn + c * (Mat3::Identity() - nn);
 }
 
 Vec3 ImplicitBodyContact::impulse(const Pair& p, const Vec3& w1) const {
   const Real c = p.mode == Mode::kStick ? stick_viscosity(p) : p.viscosity;
   const Real gap1 = p.gap0 + h_ * p.normal.dot(w1);
-  return (-(kStiffness * p.mass / h_) * gap1) * p.normal - c * tangential(w1, p.normal);
+  return (-(p.kappa * p.mass / h_) * gap1) * p.normal - c * tangential(w1, p.normal);
 }
 
 void ImplicitBodyContact::add_terms(SparseMatrix& a, VecX* b) const {
@@ -154,11 +160,10 @@ bool ImplicitBodyContact::update(const VecX& dv, bool commit) {
   bool changed = false;
   const Real mu = params_.friction, mu_s = params_.static_friction;
   for (Pair& p : pairs_) {
-    const Vec3 w1 = particle(v0_, p.j) + particle(dv, p.j) - particle(v0_, p.i) -
-                    particle(dv, p.i);
+    const Vec3 w1 = particle(v0_, p.j) + particle(dv, p.j) - particle(v0_, p.i) - particle(dv, p.i);
     if (!p.active) {
       const Real gap1 = p.gap0 + h_ * p.normal.dot(w1);
-      if (gap1 >= -kPenetrationTolerance) continue;
+      if (gap1 >= -kPenetrationTolerance * p.reach) continue;
       changed = true;
       if (!commit) continue;
       p.active = true;
@@ -175,9 +180,17 @@ bool ImplicitBodyContact::update(const VecX& dv, bool commit) {
     const Vec3 q = impulse(p, w1);
     const Real pn = q.dot(p.normal);
     p.normal_impulse = pn;
+    p.release = false;
     if (pn < 0) {  // the spring would pull: let go
-      changed = true;
-      if (commit) p.active = false;
+      // A pair that touched at the start of the step (gap0 <= 0) is pulled only by the little
+      // its spring is stretched at the end: it is held for this step and let go at the next,
+      // without another solve. Otherwise solve again without it.
+      if (p.gap0 <= 0) {
+        p.release = true;
+      } else {
+        changed = true;
+        if (commit) p.active = false;
+      }
       continue;
     }
     // Friction, for the next solve or step (a change of it alone is no reason to solve again).
@@ -213,9 +226,9 @@ void ImplicitBodyContact::finish(const Model& model, State& s1, BodyContact& con
   resolved_.clear();
   carried_.clear();
   for (const Pair& p : pairs_) {
-    if (!p.active) continue;
+    if (!p.active || p.release) continue;
     resolved_.emplace_back(p.i, p.j);
-    carried_.push_back({p.i, p.j, p.mode, p.viscosity});
+    carried_.push_back({p.i, p.j, p.mode, p.viscosity, p.kappa});
   }
   std::sort(carried_.begin(), carried_.end(), [](const Carried& a, const Carried& b) {
     return std::make_pair(a.i, a.j) < std::make_pair(b.i, b.j);
@@ -269,19 +282,20 @@ void ImplicitBodyContact::save(std::vector<Real>& out) const {
     out.push_back(c.j);
     out.push_back(c.mode == Mode::kSlide ? 1 : 0);
     out.push_back(c.viscosity);
+    out.push_back(c.kappa);
   }
 }
 
 void ImplicitBodyContact::restore(const Real* data, size_t size) {
   require(size % kSavedPerPair == 0, "integrator state (body contact pairs)", size,
-          "4 numbers per pair");
+          "5 numbers per pair");
   carried_.clear();
   for (size_t k = 0; k < size; k += kSavedPerPair) {
     require(data[k] >= 0 && data[k] == std::floor(data[k]) && data[k + 1] > data[k] &&
                 data[k + 1] == std::floor(data[k + 1]),
             "integrator state (body contact pair)", data[k], "two particle indices i < j");
     carried_.push_back({static_cast<int>(data[k]), static_cast<int>(data[k + 1]),
-                        data[k + 2] != 0 ? Mode::kSlide : Mode::kStick, data[k + 3]});
+                        data[k + 2] != 0 ? Mode::kSlide : Mode::kStick, data[k + 3], data[k + 4]});
   }
   std::sort(carried_.begin(), carried_.end(), [](const Carried& a, const Carried& b) {
     return std::make_pair(a.i, a.j) < std::make_pair(b.i, b.j);

@@ -125,10 +125,10 @@ struct ImplicitEuler::Impl {
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
   ImplicitBodyContact bodies_;
-  BodyContact* body_contact_ = nullptr;    // of the current step (null: none, or after_step)
-  bool bodies_active_ = false;             // the current step has candidate pairs
-  bool bodies_seen_ = false;               // the last step's Dynamics had body contact
-  bool base_saved_ = false;                // base_values_ / b_base_ hold this step's assembly
+  BodyContact* body_contact_ = nullptr;  // of the current step (null: none, or after_step)
+  bool bodies_active_ = false;           // the current step has candidate pairs
+  bool bodies_seen_ = false;             // the last step's Dynamics had body contact
+  bool base_saved_ = false;              // base_values_ / b_base_ hold this step's assembly
   std::vector<std::pair<int, int>> extra_blocks_;  // pair blocks in jacobian_'s pattern
   std::vector<Real> base_values_;
   VecX b_base_;
@@ -405,9 +405,8 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
 
 StepResult ImplicitEuler::Impl::ensure_pattern(const Model& model) {
   const std::vector<ImplicitBodyContact::Pair>& pairs = bodies_.pairs();
-  const bool complete = std::all_of(pairs.begin(), pairs.end(), [&](const auto& p) {
-    return has_block(a_, p.i, p.j);
-  });
+  const bool complete = std::all_of(pairs.begin(), pairs.end(),
+                                    [&](const auto& p) { return has_block(a_, p.i, p.j); });
   if (complete) return StepResult::success();
   const auto start = Clock::now();
   // The union of the candidates so far, unless it grew much larger than the current ones.

@@ -46,15 +46,18 @@ class ImplicitBodyContact {
   enum class Mode { kStick, kSlide };
 
   struct Pair {
-    int i = 0, j = 0;        // particles, i < j
+    int i = 0, j = 0;             // particles, i < j
     Vec3 normal = Vec3::UnitY();  // from x_i0 to x_j0
-    Real gap0 = 0;           // |x_j0 - x_i0| - (r_i + r_j)
-    Real mass = 0;           // reduced mass (a pinned partner is infinitely heavy)
-    Real approach = 0;       // -(w0 . n) at the start of the step
+    Real reach = 0;               // r_i + r_j
+    Real gap0 = 0;                // |x_j0 - x_i0| - reach
+    Real mass = 0;                // reduced mass (a pinned partner is infinitely heavy)
+    Real approach = 0;            // -(w0 . n) at the start of the step
     bool active = false;
+    bool release = false;  // held for this step (pulled without a new solve), free at the next
     Mode mode = Mode::kStick;
-    Real viscosity = 0;      // sliding friction c
-    Real normal_impulse = 0; // p_n of the last solve
+    Real viscosity = 0;       // sliding friction c
+    Real kappa = 0;           // h^2 k = kappa mass (kStiffness; kept per pair for a later policy)
+    Real normal_impulse = 0;  // p_n of the last solve
   };
 
   struct Counters {
@@ -68,8 +71,7 @@ class ImplicitBodyContact {
   // Starts a step of size h from s0 with forces f(x0, v0): the candidate pairs and the active
   // set (last step's active pairs that the explicit prediction x0 + h (v0 + h f / m) keeps
   // touching, and the pairs it makes overlap). Returns whether there is a candidate.
-  bool begin_step(const Model& model, BodyContact& contact, const State& s0, const VecX& f,
-                  Real h);
+  bool begin_step(const Model& model, BodyContact& contact, const State& s0, const VecX& f, Real h);
   const std::vector<Pair>& pairs() const { return pairs_; }
   bool any_active() const { return active_ > 0; }
 
@@ -88,7 +90,7 @@ class ImplicitBodyContact {
   // The active pairs' (i, j, mode, viscosity), appended to `out`, and back.
   void save(std::vector<Real>& out) const;
   void restore(const Real* data, size_t size);
-  static constexpr size_t kSavedPerPair = 4;
+  static constexpr size_t kSavedPerPair = 5;
   size_t saved_size() const;
 
   const Counters& counters() const { return counters_; }
@@ -110,6 +112,7 @@ class ImplicitBodyContact {
     int i, j;
     Mode mode;
     Real viscosity;
+    Real kappa;
   };
   std::vector<Carried> carried_;
   std::vector<BroadPhase::Pair> resolved_;
