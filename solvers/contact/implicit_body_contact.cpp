@@ -21,6 +21,11 @@ constexpr Real kTouchTolerance = 1e-6;  // m
 // active and the step solves again; a shallower overlap is left to the next step (whose
 // prediction makes the pair active), which saves most of those solves.
 constexpr Real kPenetrationTolerance = 1e-3;
+// The largest overlap, as a fraction of r_i + r_j, a step may end with: deeper ones (the pair
+// spring's compliance under a whole body's momentum at a landing) are projected out after the
+// solve. Resting loads compress a pair far less.
+constexpr Real kLargestOverlap = 5e-3;
+constexpr int kProjectionPasses = 4;
 // A sliding pair whose friction viscosity reaches this many times its reduced mass has all but
 // stopped sliding: it sticks (as for the terrains).
 constexpr Real kStickViscosity = 100;
@@ -233,6 +238,35 @@ void ImplicitBodyContact::finish(const Model& model, State& s1, BodyContact& con
   std::sort(carried_.begin(), carried_.end(), [](const Carried& a, const Carried& b) {
     return std::make_pair(a.i, a.j) < std::make_pair(b.i, b.j);
   });
+  // Safety net: overlaps deeper than kLargestOverlap are projected back to it along the line of
+  // centres, weighted by inverse mass; the lever the projection adds would change the angular
+  // momentum by a n x (v_j - v_i), which a tangential impulse takes back exactly (as in
+  // BodyContact::resolve).
+  for (int pass = 0; pass < kProjectionPasses; ++pass) {
+    bool any_projected = false;
+    for (const Pair& p : pairs_) {
+      auto xi = particle(s1.x, p.i);
+      auto xj = particle(s1.x, p.j);
+      const Vec3 d = xj - xi;
+      const Real dist = d.norm();
+      const Real overlap = (1 - kLargestOverlap) * p.reach - dist;
+      if (overlap <= 0 || !(dist > 0)) continue;
+      any_projected = true;
+      ++counters_.projected;
+      const Vec3 n = d / dist;
+      const Real wi = contact.inverse_mass(p.i), wj = contact.inverse_mass(p.j);
+      const Real a = overlap / (wi + wj);
+      xi -= (a * wi) * n;
+      xj += (a * wj) * n;
+      auto vi = particle(s1.v, p.i);
+      auto vj = particle(s1.v, p.j);
+      const Vec3 rel = vj - vi;
+      const Vec3 q = (-a / (dist + overlap)) * tangential(rel, n);
+      vi -= wi * q;
+      vj += wj * q;
+    }
+    if (!any_projected) break;
+  }
   // Restitution: e times the approach at the start of the step, along the end-of-step line of
   // centres, for the active pairs that approached faster than the resting speed.
   const Real e = params_.restitution;
