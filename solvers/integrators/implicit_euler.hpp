@@ -33,7 +33,9 @@ class ImplicitEuler final : public Integrator {
   // steps, symbolic_analyses, numeric_factorizations, linear_solves, cg_iterations,
   // newton_iterations, newton_not_converged, assembly_seconds, factorization_seconds,
   // solve_seconds, and for contact inside the solve contact_extra_solves,
-  // contact_not_converged, contact_restitution_limited.
+  // contact_not_converged, contact_restitution_limited, and with contact between bodies inside
+  // the solve body_contact_extra_solves, body_contact_projected,
+  // body_contact_restitution_limited.
   Statistics statistics() const override;
   // The CG warm start and the contact set (a lagged CHOLMOD preconditioner is not kept: it is
   // rebuilt, so only the backends without one restart bit for bit).
