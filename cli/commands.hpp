@@ -19,6 +19,7 @@ struct RunArgs {
   bool quiet = false;             // --quiet: no progress bar
   bool overwrite = false;         // --overwrite: replace an existing -o file once complete
   int threads = -1;               // --threads: -1 = the scene's `threads`, 0 = all cores
+  bool strict = false;  // --strict: a step that missed the solver's tolerance fails the run
 };
 
 // jelly run: load the scene with its overrides, simulate, record, summarise.

@@ -69,6 +69,9 @@ int main(int argc, char** argv) {
                   "Start from the last checkpoint of this HDF5 file (same scene)")
       ->check(kNonEmpty);
   run->add_flag("-q,--quiet", run_args.quiet, "No progress bar");
+  run->add_flag("--strict", run_args.strict,
+                "Exit 3 when steps missed the solver's own tolerance (status "
+                "completed_with_warnings; without --strict a warning and exit 0)");
   run->add_option("--threads", run_args.threads,
                   "Threads for the force loop, the solves and contact (default: the scene's "
                   "`threads`, 0 = all cores; the results are the same for any number)")

@@ -181,6 +181,14 @@ int run_command(const RunArgs& args) {
     std::fprintf(stderr, "%s\n", message.c_str());
     return kExitRunFailed;
   }
+  if (report.has_warnings()) {
+    if (args.strict) {
+      std::fprintf(stderr, "error: the run missed its solver's tolerance (--strict): %s\n",
+                   report.reason.c_str());
+      return kExitRunFailed;
+    }
+    std::fprintf(stderr, "warning: %s (--strict makes this an error)\n", report.reason.c_str());
+  }
   return kExitOk;
 }
 

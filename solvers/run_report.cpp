@@ -8,6 +8,8 @@ std::string_view run_status_name(RunStatus status) {
   switch (status) {
     case RunStatus::kCompleted:
       return "completed";
+    case RunStatus::kCompletedWithWarnings:
+      return "completed_with_warnings";
     case RunStatus::kDiverged:
       return "diverged";
     case RunStatus::kSolverFailed:

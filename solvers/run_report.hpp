@@ -9,6 +9,7 @@ namespace jelly {
 
 enum class RunStatus {
   kCompleted,     // reached the requested time
+  kCompletedWithWarnings,  // reached it, but some steps missed the solver's own tolerance
   kDiverged,      // NaN, Inf or runaway speed: the divergence guard stopped the run
   kSolverFailed,  // the integrator returned a failure (e.g. a matrix not positive definite)
 };
@@ -18,12 +19,19 @@ struct RunReport {
   RunStatus status = RunStatus::kCompleted;
   Real t = 0;          // simulated time reached
   long steps = 0;      // steps taken in this run
-  std::string reason;  // why the run stopped early; empty when completed
+  // Why the run stopped early, or for kCompletedWithWarnings which tolerances how many steps
+  // missed ("implicit_euler: Newton did not converge (...) on 111 of 180 steps"); empty when
+  // completed.
+  std::string reason;
   double wall_seconds = 0;
   long force_evaluations = 0;
   Statistics statistics;  // the integrator's counters
 
-  bool ok() const { return status == RunStatus::kCompleted; }
+  // Reached the requested time (with or without warnings).
+  bool ok() const {
+    return status == RunStatus::kCompleted || status == RunStatus::kCompletedWithWarnings;
+  }
+  bool has_warnings() const { return status == RunStatus::kCompletedWithWarnings; }
   // One line: status, time, steps, wall time (and the reason when it stopped early).
   std::string brief() const;
 };

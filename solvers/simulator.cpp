@@ -204,6 +204,23 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
   frames_ = 0;
 }
 
+namespace {
+// The steps of this run that missed a tolerance of the integrator (the counts since `before`)
+// make it kCompletedWithWarnings, each kind named with its count in the reason.
+void warn_of_tolerance_misses(const std::vector<ToleranceMiss>& before,
+                              const std::vector<ToleranceMiss>& after, RunReport& report) {
+  for (std::size_t i = 0; i < after.size(); ++i) {
+    const long earlier = i < before.size() && before[i].what == after[i].what ? before[i].steps : 0;
+    const long missed = after[i].steps - earlier;
+    if (missed <= 0) continue;
+    report.status = RunStatus::kCompletedWithWarnings;
+    if (!report.reason.empty()) report.reason += "; ";
+    report.reason += after[i].what + " on " + std::to_string(missed) + " of " +
+                     std::to_string(report.steps) + " steps";
+  }
+}
+}  // namespace
+
 StepResult Simulator::step() {
   const int threads = parallel::resolve_threads(options_.threads);
   const bool bodies = body_contact_.active(model_);
@@ -245,6 +262,7 @@ RunReport Simulator::run_until(Real t_end) {
   const auto start = std::chrono::steady_clock::now();
   const long evaluations_before = force_evaluations_;
   RunReport report;
+  const std::vector<ToleranceMiss> misses_before = integrator_->tolerance_misses();
   if (frames_ == 0) emit_frame();
   const Real dt = options_.dt;
   while (state_.t < t_end - 0.5 * dt) {
@@ -263,6 +281,8 @@ RunReport Simulator::run_until(Real t_end) {
     if (options_.output_interval == 0 || state_.t >= next_output_ - 1e-9 * dt) emit_frame();
   }
   report.t = state_.t;
+  if (report.status == RunStatus::kCompleted)
+    warn_of_tolerance_misses(misses_before, integrator_->tolerance_misses(), report);
   report.force_evaluations = force_evaluations_ - evaluations_before;
   report.statistics = integrator_->statistics();
   if (body_contact_.active(model_)) {

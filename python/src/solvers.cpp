@@ -231,7 +231,7 @@ void bind_solvers(py::module_& m) {
       });
 
   py::class_<RunReport>(m, "RunReport",
-                        "How a run ended: status \"completed\", \"diverged\" or \"solver_failed\" "
+                        "How a run ended: status \"completed\", \"completed_with_warnings\", \"diverged\" or \"solver_failed\" "
                         "(a diverged run returns its report, it does not raise).")
       .def_property_readonly(
           "status", [](const RunReport& r) { return std::string(run_status_name(r.status)); },

@@ -183,6 +183,15 @@ StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
   return impl_->step(dynamics, s, h);
 }
 
+std::vector<ToleranceMiss> ImplicitEuler::tolerance_misses() const {
+  const ImplicitEulerOptions& o = impl_->options_;
+  if (o.newton_iterations <= 1) return {};
+  return {{"implicit_euler: Newton did not converge within integrator.options.newton_iterations = " +
+               std::to_string(o.newton_iterations) + " (newton_tolerance = " +
+               to_text(o.newton_tolerance) + ")",
+           impl_->newton_not_converged_}};
+}
+
 void ImplicitEuler::Impl::add_statistics(Statistics& s) const {
   LinearSolverCounters c = solver_ ? solver_->counters() : LinearSolverCounters{};
   const LinearSolverCounters& mf = band_cg_.counters();

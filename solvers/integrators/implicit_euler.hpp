@@ -37,6 +37,9 @@ class ImplicitEuler final : public Integrator {
   // the solve body_contact_extra_solves, body_contact_projected,
   // body_contact_restitution_limited.
   Statistics statistics() const override;
+  // With newton_iterations > 1: the steps whose Newton iterations stopped at the limit above
+  // newton_tolerance.
+  std::vector<ToleranceMiss> tolerance_misses() const override;
   // The CG warm start and the contact set (a lagged CHOLMOD preconditioner is not kept: it is
   // rebuilt, so only the backends without one restart bit for bit).
   std::vector<Real> internal_state() const override;

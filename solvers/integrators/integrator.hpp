@@ -14,6 +14,14 @@ namespace jelly {
 // Named counters and timings an integrator reports (summary, HDF5 attributes).
 using Statistics = std::map<std::string, double>;
 
+// A kind of step that ended without meeting the method's own tolerance (e.g. Newton stopped at
+// its iteration limit above its tolerance), counted over the integrator's life: the Simulator
+// turns the ones of a run into a warning status (RunStatus::kCompletedWithWarnings).
+struct ToleranceMiss {
+  std::string what;  // "implicit_euler: Newton did not converge (newton_iterations = 5, ...)"
+  long steps = 0;    // steps that missed it
+};
+
 // A recoverable numerical failure is a returned status, not an exception.
 struct StepResult {
   bool ok = true;
@@ -59,6 +67,9 @@ class Integrator {
   virtual void restore_internal_state(const std::vector<Real>& data);
   // Counters of this integrator (steps, and whatever the method adds).
   virtual Statistics statistics() const;
+  // The tolerances the method can miss without failing the step, each with the number of steps
+  // that missed it so far (empty for methods without an iteration limit below a tolerance).
+  virtual std::vector<ToleranceMiss> tolerance_misses() const { return {}; }
 
   long steps() const { return steps_; }
 

@@ -66,6 +66,14 @@ int ProjectiveDynamics::contacts_resolved() const {
   return contact_active_ ? contact_->count() : 0;
 }
 
+std::vector<ToleranceMiss> ProjectiveDynamics::tolerance_misses() const {
+  if (options_.tolerance == 0) return {};
+  return {{"projective_dynamics: the residual stayed above integrator.options.tolerance = " +
+               to_text(options_.tolerance) + " after iterations = " +
+               std::to_string(options_.iterations),
+           not_converged_}};
+}
+
 Statistics ProjectiveDynamics::statistics() const {
   Statistics s = Integrator::statistics();
   s["symbolic_analyses"] = static_cast<double>(analyses_);

@@ -40,6 +40,8 @@ class ProjectiveDynamics final : public Integrator {
   // solves), not_converged (steps that ended above the tolerance), chebyshev_rho,
   // factorization_seconds, solve_seconds, contact_restitution_limited.
   Statistics statistics() const override;
+  // With a tolerance > 0: the steps that used all iterations and ended above it.
+  std::vector<ToleranceMiss> tolerance_misses() const override;
   // The measured Chebyshev spectral radius (empty when none was measured).
   std::vector<Real> internal_state() const override;
   void restore_internal_state(const std::vector<Real>& data) override;

@@ -325,5 +325,76 @@ TEST(ExitCodes, AFullDiskExitsOneWithASummaryAndAClearMessage) {
   EXPECT_EQ(std::count(stderr_text.begin(), stderr_text.end(), '\n'), 1) << stderr_text;
 }
 
+
+// ---- Silent numerical failure ----
+
+// The number after `key = ` in the summary's statistics line, or -1.
+long statistic(const std::string& summary, const std::string& key) {
+  const std::size_t at = summary.find(key + " = ");
+  return at == std::string::npos ? -1 : std::stol(summary.substr(at + key.size() + 3));
+}
+
+// The seed slope at 1/60 s with Newton cut to 5 iterations: the seed contact's impulses keep
+// Newton above its tolerance on many steps (issue 16: 111 of 180 on the 10x10x10 cube).
+const std::string kShortNewton =
+    "run " + kSmallSlope +
+    " --integrator implicit_euler --dt 0.0166667 --duration 3 -q"
+    " --set integrator.options.newton_iterations=5";
+
+TEST(SilentNumericalFailure, NewtonStoppedAboveItsToleranceIsAWarningCountedInTheSummary) {
+  const std::string file = temp_path(".h5");
+  const Result r = jelly(kShortNewton + " -o " + quoted(file));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const long missed = statistic(r.out, "newton_not_converged");
+  ASSERT_GT(missed, 0) << r.out;
+  const std::string what =
+      "implicit_euler: Newton did not converge within integrator.options.newton_iterations = 5 "
+      "(newton_tolerance = ";
+  const std::string count = "on " + std::to_string(missed) + " of 180 steps";
+  EXPECT_THAT(r.out, StartsWith("jelly run: completed_with_warnings at t = "));
+  EXPECT_THAT(r.out, HasSubstr(what));
+  EXPECT_THAT(r.out, HasSubstr(count));
+  EXPECT_THAT(r.err, AllOf(StartsWith("warning: " + what), HasSubstr(count),
+                           HasSubstr("(--strict makes this an error)")));
+  // The recording says so too (run_status, run_reason).
+  const Result info = jelly("info " + quoted(file));
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_THAT(info.out, HasSubstr("status:        completed_with_warnings at t = "));
+  EXPECT_THAT(info.out, HasSubstr(count));
+}
+
+TEST(SilentNumericalFailure, StrictMakesAMissedToleranceExitThree) {
+  const Result r = jelly(kShortNewton + " --strict");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_THAT(r.out, StartsWith("jelly run: completed_with_warnings"));
+  EXPECT_THAT(r.err, StartsWith("error: the run missed its solver's tolerance (--strict): "
+                                "implicit_euler: Newton did not converge"));
+}
+
+TEST(SilentNumericalFailure, ARunThatMetItsToleranceIsCompletedEvenWithStrict) {
+  // Free fall above the slope (0.2 s): Newton converges in every step.
+  const Result r = jelly("run " + kSmallSlope +
+                         " --integrator implicit_euler --dt 0.0166667 --duration 0.2 -q --strict"
+                         " --set integrator.options.newton_iterations=20");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(statistic(r.out, "newton_not_converged"), 0) << r.out;
+  EXPECT_THAT(r.out, StartsWith("jelly run: completed at t = "));
+  EXPECT_EQ(r.err, "");
+}
+
+TEST(SilentNumericalFailure, ProjectiveDynamicsAboveItsToleranceIsAWarning) {
+  const Result r = jelly("run " + kSmallSlope +
+                         " --integrator projective_dynamics --dt 0.0166667 --duration 0.5 -q"
+                         " --set integrator.options.iterations=2"
+                         " --set integrator.options.tolerance=1e-12");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const long missed = statistic(r.out, "not_converged");
+  ASSERT_GT(missed, 0) << r.out;
+  EXPECT_THAT(r.out, StartsWith("jelly run: completed_with_warnings"));
+  EXPECT_THAT(r.err, HasSubstr("projective_dynamics: the residual stayed above "
+                               "integrator.options.tolerance = 1e-12 after iterations = 2 on " +
+                               std::to_string(missed) + " of 30 steps"));
+}
+
 }  // namespace
 }  // namespace jelly
