@@ -170,8 +170,12 @@ void bind_solvers(py::module_& m) {
       .def_readwrite("method", &ArkodeOptions::method,
                      "An ARKODE Butcher table name; empty = default.")
       .def_readwrite("max_step", &ArkodeOptions::max_step, "Largest internal step (s); 0 = dt.")
-      .def_readwrite("linear_solver", &ArkodeOptions::linear_solver,
-                     "arkode_dirk: \"schur\" or \"klu\".")
+      .def_property("linear_solver",
+                    choice_getter(&ArkodeOptions::linear_solver, arkode_linear_solvers),
+                    choice_setter(&ArkodeOptions::linear_solver, arkode_linear_solvers,
+                                  "linear_solver"),
+                    "arkode_dirk: \"auto\" (= \"cg\"), \"cg\", \"jacobi\", \"gmres\", "
+                    "\"schur\" or \"klu\".")
       .def_readwrite("max_steps", &ArkodeOptions::max_steps,
                      "Internal steps per contact interval.");
 
@@ -235,7 +239,7 @@ void bind_solvers(py::module_& m) {
                         "(a diverged run returns its report, it does not raise).")
       .def_property_readonly(
           "status", [](const RunReport& r) { return std::string(run_status_name(r.status)); },
-          "\"completed\", \"diverged\" or \"solver_failed\".")
+          "\"completed\", \"completed_with_warnings\", \"diverged\" or \"solver_failed\".")
       .def_property_readonly("ok", &RunReport::ok, "True when completed.")
       .def_readonly("t", &RunReport::t, "Simulated time reached (s).")
       .def_readonly("steps", &RunReport::steps, "Steps taken in this run.")

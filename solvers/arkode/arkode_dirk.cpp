@@ -25,17 +25,19 @@ constexpr int kInterpolantDegree = 3;
 
 // "auto": the matrix-free Schur CG, the fastest in every measurement of docs/arkode.md
 // ("Iterative Newton solves").
-std::string resolve_linear_solver(const std::string& name) { return name == "auto" ? "cg" : name; }
+ArkodeLinearSolver resolve_linear_solver(ArkodeLinearSolver kind) {
+  return kind == ArkodeLinearSolver::kAuto ? ArkodeLinearSolver::kCg : kind;
+}
 
 class DirkDriver final : public arkode::Driver {
  public:
-  DirkDriver(const ArkodeOptions& options, std::string method, std::string linear_solver)
+  DirkDriver(const ArkodeOptions& options, std::string method, ArkodeLinearSolver linear_solver)
       : Driver("arkode_dirk", arkode::kArkStepApi, options),
         method_(std::move(method)),
-        linear_solver_kind_(std::move(linear_solver)) {
+        linear_solver_kind_(linear_solver) {
     data_.owner = this;
   }
-  const std::string& linear_solver_kind() const { return linear_solver_kind_; }
+  ArkodeLinearSolver linear_solver_kind() const { return linear_solver_kind_; }
   // ARKODE's memory refers to the linear solver and matrix: free it first.
   ~DirkDriver() override { memory_.reset(); }
 
@@ -50,21 +52,21 @@ class DirkDriver final : public arkode::Driver {
     int flag = ARKStepSetErrHandlerFn(m, arkode::keep_error, &data_);
     if (flag >= 0) flag = ARKStepSetTableName(m, method_.c_str(), "ARKODE_ERK_NONE");
     if (flag < 0) return flag;
-    if (linear_solver_kind_ == "gmres") {
+    if (linear_solver_kind_ == ArkodeLinearSolver::kGmres) {
       linear_solver_.reset(SUNLinSol_SPGMR(y0, SUN_PREC_RIGHT, kGmresMaxKrylov, context_.get()));
       if (!linear_solver_) return ARK_MEM_FAIL;
       flag = ARKStepSetLinearSolver(m, linear_solver_.get(), nullptr);
       if (flag >= 0)
         flag = ARKStepSetPreconditioner(m, &DirkDriver::preconditioner_setup,
                                         &DirkDriver::preconditioner_solve);
-    } else if (linear_solver_kind_ == "jacobi" || linear_solver_kind_ == "cg") {
+    } else if (linear_solver_kind_ == ArkodeLinearSolver::kJacobi || linear_solver_kind_ == ArkodeLinearSolver::kCg) {
       linear_solver_ = arkode::make_iterative_solver(context_.get(), m, &data_,
-                                                     linear_solver_kind_ == "cg"
+                                                     linear_solver_kind_ == ArkodeLinearSolver::kCg
                                                          ? arkode::IterativeMode::kCg
                                                          : arkode::IterativeMode::kJacobi);
       if (!linear_solver_) return ARK_MEM_FAIL;
       flag = arkode::attach_schur_solver(m, linear_solver_.get());
-    } else if (linear_solver_kind_ == "klu") {
+    } else if (linear_solver_kind_ == ArkodeLinearSolver::kKlu) {
       const sunindextype n = N_VGetLength(y0) / 2;
       const Model& model = data_.dynamics->model();
       schur_ = std::make_unique<arkode::SchurSystem>(model);  // K, D on their fixed pattern
@@ -88,7 +90,7 @@ class DirkDriver final : public arkode::Driver {
     // them after one iteration: on the damped oscillator the global error then stayed near
     // 1e-5 for every rtol from 1e-4 to 1e-8 (docs/arkode.md). The Schur solver refines its
     // solution to the current gamma instead; for KLU a 1% bound restores the accuracy.
-    if (flag >= 0 && linear_solver_kind_ == "klu")
+    if (flag >= 0 && linear_solver_kind_ == ArkodeLinearSolver::kKlu)
       flag = ARKStepSetDeltaGammaMax(m, kDeltaGammaMax);
     // Newton starts from the interpolant of the last step (ARKODE's "maximum order" predictor)
     // rather than from y_n: on a spinning cube of stiff springs the trivial predictor made 86%
@@ -108,7 +110,7 @@ class DirkDriver final : public arkode::Driver {
   bool interpolates() const override { return true; }
 
   std::string failure_detail() const override {
-    if (linear_solver_kind_ != "schur" || !linear_solver_) return {};
+    if (linear_solver_kind_ != ArkodeLinearSolver::kSchur || !linear_solver_) return {};
     const std::string& why = arkode::schur_error(linear_solver_.get());
     return why.empty() ? why : "Schur solve: " + why;
   }
@@ -121,8 +123,8 @@ class DirkDriver final : public arkode::Driver {
     ARKStepGetNumNonlinSolvIters(m, &c.newton_iterations);
     ARKStepGetNumNonlinSolvConvFails(m, &c.newton_failures);
     ARKStepGetNumLinSolvSetups(m, &c.linear_setups);
-    if (linear_solver_kind_ == "klu") ARKStepGetNumJacEvals(m, &c.jacobian_evaluations);
-    if (linear_solver_kind_ == "gmres") {
+    if (linear_solver_kind_ == ArkodeLinearSolver::kKlu) ARKStepGetNumJacEvals(m, &c.jacobian_evaluations);
+    if (linear_solver_kind_ == ArkodeLinearSolver::kGmres) {
       ARKStepGetNumLinIters(m, &c.linear_iterations);
       ARKStepGetNumLinConvFails(m, &c.linear_failures);
       ARKStepGetNumLinRhsEvals(m, &c.linear_rhs_evaluations);
@@ -134,18 +136,18 @@ class DirkDriver final : public arkode::Driver {
     s["newton_iterations"] = static_cast<double>(total().newton_iterations);
     s["newton_convergence_failures"] = static_cast<double>(total().newton_failures);
     s["linear_setups"] = static_cast<double>(total().linear_setups);
-    if (linear_solver_kind_ == "klu") {
+    if (linear_solver_kind_ == ArkodeLinearSolver::kKlu) {
       s["jacobian_evaluations"] = static_cast<double>(total().jacobian_evaluations);
-    } else if (linear_solver_kind_ == "gmres") {
+    } else if (linear_solver_kind_ == ArkodeLinearSolver::kGmres) {
       s["krylov_iterations"] = static_cast<double>(total().linear_iterations);
       s["krylov_failures"] = static_cast<double>(total().linear_failures);
       s["jv_rhs_evaluations"] = static_cast<double>(total().linear_rhs_evaluations);
       s["preconditioner_setups"] = static_cast<double>(preconditioner_.linearizations());
-    } else if (linear_solver_kind_ == "jacobi" || linear_solver_kind_ == "cg") {
+    } else if (linear_solver_kind_ == ArkodeLinearSolver::kJacobi || linear_solver_kind_ == ArkodeLinearSolver::kCg) {
       if (linear_solver_) {
         const arkode::IterativeStatistics& i = arkode::iterative_statistics(linear_solver_.get());
         s["linearizations"] = static_cast<double>(i.setups);
-        if (linear_solver_kind_ == "cg") {
+        if (linear_solver_kind_ == ArkodeLinearSolver::kCg) {
           s["cg_iterations"] = static_cast<double>(i.iterations);
           s["cg_failures"] = static_cast<double>(i.failures);
         }
@@ -210,7 +212,7 @@ class DirkDriver final : public arkode::Driver {
 
   // ARKLsPrecSetupFn ("gmres"): the diagonal blocks of K and D at y, unless ARKODE says the
   // last ones will do (jok).
-  static int preconditioner_setup(realtype /*t*/, N_Vector y, N_Vector /*fy*/, booleantype jok,
+  static int preconditioner_setup(realtype t, N_Vector y, N_Vector /*fy*/, booleantype jok,
                                   booleantype* jcur, realtype /*gamma*/, void* user_data) {
     auto& data = *static_cast<arkode::RhsData*>(user_data);
     auto& self = *static_cast<DirkDriver*>(data.owner);
@@ -223,7 +225,7 @@ class DirkDriver final : public arkode::Driver {
     const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
     data.x = yy.head(n);
     data.v = yy.tail(n);
-    self.preconditioner_.linearize(model, data.x, data.v, data.dynamics->anchors());
+    self.preconditioner_.linearize(model, data.x, data.v, data.dynamics->anchors(), t);
     *jcur = SUNTRUE;
     return 0;
   }
@@ -242,7 +244,7 @@ class DirkDriver final : public arkode::Driver {
   }
 
   std::string method_;
-  std::string linear_solver_kind_;  // "schur", "klu", "cg", "gmres", "jacobi" (auto resolved)
+  ArkodeLinearSolver linear_solver_kind_;  // kAuto resolved
   arkode::SpringOperator preconditioner_;               // gmres: the block Jacobi
   std::unique_ptr<arkode::SchurSystem> schur_;          // klu: the K, D assembly
   std::vector<sunindextype> column_start_, row_index_;  // klu: the pattern of J
@@ -255,15 +257,15 @@ class DirkDriver final : public arkode::Driver {
 ArkodeDirk::ArkodeDirk(const ArkodeOptions& options) {
   options.validate("ArkodeOptions.");
   const std::string method = options.method.empty() ? kDefaultMethod : options.method;
-  ARKodeButcherTable table = ARKodeButcherTable_LoadDIRKByName(method.c_str());
+  const int id = arkode_method_id(arkode_dirk_methods(), method, kDefaultMethod);
+  ARKodeButcherTable table = ARKodeButcherTable_LoadDIRK(static_cast<ARKODE_DIRKTableID>(id));
   const bool embedded = table != nullptr && table->d != nullptr;
   if (table != nullptr) {
     order_ = table->q;
     ARKodeButcherTable_Free(table);
   }
   require(embedded, "integrator.options.method", method,
-          "the name of an ARKODE diagonally implicit Runge-Kutta table with an embedding, e.g. "
-          "ARKODE_ARK324L2SA_DIRK_4_2_3, ARKODE_SDIRK_5_3_4, ARKODE_KVAERNO_7_4_5");
+          "a diagonally implicit table of ARKODE with an embedding");
   driver_ =
       std::make_unique<DirkDriver>(options, method, resolve_linear_solver(options.linear_solver));
 }

@@ -39,7 +39,8 @@ class ErkDriver final : public arkode::Driver {
 ArkodeErk::ArkodeErk(const ArkodeOptions& options) {
   options.validate("ArkodeOptions.");
   const std::string method = options.method.empty() ? kDefaultMethod : options.method;
-  ARKodeButcherTable table = ARKodeButcherTable_LoadERKByName(method.c_str());
+  const int id = arkode_method_id(arkode_erk_methods(), method, kDefaultMethod);
+  ARKodeButcherTable table = ARKodeButcherTable_LoadERK(static_cast<ARKODE_ERKTableID>(id));
   const bool embedded = table != nullptr && table->d != nullptr;
   if (table != nullptr) {
     order_ = table->q;
@@ -47,8 +48,7 @@ ArkodeErk::ArkodeErk(const ArkodeOptions& options) {
     ARKodeButcherTable_Free(table);
   }
   require(embedded, "integrator.options.method", method,
-          "the name of an ARKODE explicit Runge-Kutta table with an embedding, e.g. "
-          "ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_BOGACKI_SHAMPINE_4_2_3, ARKODE_VERNER_8_5_6");
+          "an explicit table of ARKODE with an embedding");
   driver_ = std::make_unique<ErkDriver>(options, method);
 }
 

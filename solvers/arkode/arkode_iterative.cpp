@@ -6,6 +6,7 @@
 #include <arkode/arkode_arkstep.h>
 
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
 
 namespace jelly::arkode {
@@ -28,7 +29,7 @@ inline void pack(const Real* b, Real* out) {
 }  // namespace
 
 void SpringOperator::linearize(const Model& model, const VecX& x, const VecX& v,
-                               const AnchorSprings* anchors) {
+                               const AnchorSprings* anchors, Real t) {
   spring_jacobian_blocks(model, x, v, JacobianOptions{}, k_blocks_, d_blocks_);
   const Springs& s = model.springs;
   const size_t blocks = 9 * static_cast<size_t>(model.num_particles());
@@ -59,6 +60,22 @@ void SpringOperator::linearize(const Model& model, const VecX& x, const VecX& v,
       }
     }
   }
+  // Wind drag: d(f)/d(v) = -drag I on its particles.
+  dragged_.clear();
+  drag_.clear();
+  if (!model.external_forces.empty()) {
+    damping_.setZero(model.num_particles());
+    add_external_damping(model.external_forces, t, damping_);
+    for (int i = 0; i < model.num_particles(); ++i) {
+      if (damping_[i] == 0) continue;
+      dragged_.push_back(i);
+      drag_.push_back(damping_[i]);
+      for (int c = 0; c < 3; ++c) d_diagonal_[9 * static_cast<size_t>(i) + 4 * c] -= damping_[i];
+    }
+  }
+  pinned_ = model.pins.particles;
+  is_pinned_.assign(static_cast<size_t>(model.num_particles()), 0);
+  for (const int p : pinned_) is_pinned_[static_cast<size_t>(p)] = 1;
   s_.resize(6 * static_cast<size_t>(s.size()));
   s_inverse_.resize(blocks);
   constraints_.clear();
@@ -90,7 +107,9 @@ void SpringOperator::set_gamma(const Model& model, Real gamma) {
                             gamma * Block(&d_diagonal_[9 * static_cast<size_t>(i)]) -
                             g2 * Block(&k_diagonal_[9 * static_cast<size_t>(i)]);
     const int c = constraint_of_[static_cast<size_t>(i)];
-    if (c >= 0) {
+    if (is_pinned_[static_cast<size_t>(i)]) {
+      block.setIdentity();  // P = 0: the velocity change is prescribed
+    } else if (c >= 0) {
       // P S_ii P + n n^T.
       const Vec3& n = constraints_[static_cast<size_t>(c)].normal;
       const Eigen::Matrix3d p = Eigen::Matrix3d::Identity() - n * n.transpose();
@@ -141,6 +160,8 @@ void SpringOperator::multiply_s(const Model& model, const VecX& p, VecX& out) co
   for (const AnchorSpring& a : anchors_)
     out.segment<3>(3 * a.particle) +=
         (gamma_ * a.damping + gamma_ * gamma_ * a.stiffness) * p.segment<3>(3 * a.particle);
+  for (size_t k = 0; k < dragged_.size(); ++k)
+    out.segment<3>(3 * dragged_[k]) += gamma_ * drag_[k] * p.segment<3>(3 * dragged_[k]);
 }
 
 void SpringOperator::multiply_k(const Model& model, const Real* p, VecX& out) const {
@@ -154,10 +175,20 @@ void SpringOperator::filter(VecX& r) const {
     auto ri = r.segment<3>(3 * c.particle);
     ri -= c.normal.dot(ri) * c.normal;
   }
+  for (const int p : pinned_) r.segment<3>(3 * p).setZero();
+}
+
+void SpringOperator::prescribed(const Real* bv, VecX& z) const {
+  z.setZero();
+  for (const Constraint& k : constraints_) {
+    const Eigen::Map<const Vec3> b(bv + 3 * k.particle);
+    z.segment<3>(3 * k.particle) = k.normal.dot(b) * k.normal;
+  }
+  for (const int p : pinned_) z.segment<3>(3 * p) = Eigen::Map<const Vec3>(bv + 3 * p);
 }
 
 void SpringOperator::multiply_filtered(const Model& model, const VecX& y, VecX& out) {
-  if (constraints_.empty()) {
+  if (!filters()) {
     multiply_s(model, y, out);
     return;
   }
@@ -171,6 +202,7 @@ void SpringOperator::multiply_filtered(const Model& model, const VecX& y, VecX& 
     // The normal component passes through; the friction damps the tangential one.
     out.segment<3>(3 * c.particle) += yn * c.normal + gamma_ * c.damping * (yi - yn * c.normal);
   }
+  for (const int p : pinned_) out.segment<3>(3 * p) = y.segment<3>(3 * p);
 }
 
 void SpringOperator::precondition(const VecX& r, VecX& z) const {
@@ -189,7 +221,9 @@ void SpringOperator::block_jacobi(const Model& model, const Real* r, Real* z) co
     Eigen::Vector3d rhs = model.mass[i] * rv + gamma_ * (Block(&k_diagonal_[at]) * rx);
     Eigen::Vector3d dv;
     const int c = constraint_of_[static_cast<size_t>(i)];
-    if (c < 0) {
+    if (is_pinned_[static_cast<size_t>(i)]) {
+      dv = rv;  // the pinned particle's velocity change is prescribed
+    } else if (c < 0) {
       dv = Block(&s_inverse_[at]) * rhs;
     } else {
       // dv = y + z, z = n (n.rv), (P S_ii P + n n^T) y = P (rhs - S_ii z).
@@ -253,7 +287,9 @@ int setup(SUNLinearSolver s, SUNMatrix /*unused*/) {
   const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
   c.x = yy.head(n);
   c.v = yy.tail(n);
-  c.op.linearize(model, c.x, c.v, c.data->dynamics->anchors());
+  realtype t = 0;
+  ARKStepGetCurrentTime(c.arkode_memory, &t);
+  c.op.linearize(model, c.x, c.v, c.data->dynamics->anchors(), t);
   // The seed contacts whose force pushes into the surface at this iterate (see SpringOperator).
   const auto& seed = c.data->dynamics->contacts().seed_contacts();
   if (!seed.empty()) {
@@ -347,14 +383,10 @@ int solve(SUNLinearSolver s, SUNMatrix /*unused*/, N_Vector x, N_Vector b, realt
   for (int i = 0; i < model.num_particles(); ++i)
     for (int k = 0; k < 3; ++k)
       c.rhs[3 * i + k] = gamma * c.rhs[3 * i + k] + model.mass[i] * bb[n + 3 * i + k];
-  const bool filtered = !c.op.constraints().empty();
+  const bool filtered = c.op.filters();
   if (filtered) {
     ensure_size(c.prescribed, n);
-    c.prescribed.setZero();
-    for (const SpringOperator::Constraint& k : c.op.constraints()) {
-      const Eigen::Map<const Vec3> bv(bb + n + 3 * k.particle);
-      c.prescribed.segment<3>(3 * k.particle) = k.normal.dot(bv) * k.normal;
-    }
+    c.op.prescribed(bb + n, c.prescribed);
     c.op.multiply_s(model, c.prescribed, c.q);
     c.rhs -= c.q;
     c.op.filter(c.rhs);

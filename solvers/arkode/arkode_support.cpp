@@ -188,6 +188,12 @@ StepResult Driver::advance(const Dynamics& dynamics, State& state, Real h) {
   state.x = y.head(n);
   state.v = y.tail(n);
   state.t = t_end;
+  // Pinned particles end on their paths (as Integrator::step leaves them): the next interval
+  // then starts from the state kept here, without a restart. ARKODE's own values for them
+  // differ at most by its tolerance (their accelerations are the paths', and the iterative
+  // Newton solves prescribe their velocity changes).
+  const Pins& pins = dynamics.model().pins;
+  if (!pins.empty()) pins.apply(state.t, state.x, state.v);
   last_x_ = state.x;
   last_v_ = state.v;
   last_t_ = state.t;

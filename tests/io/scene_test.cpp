@@ -491,7 +491,8 @@ TEST(SceneIntegratorOptions, ImplicitAndArkodeOptionsRoundTrip) {
       parse_scene(kGood, {"integrator.name=arkode_dirk", "integrator.options.rtol=1e-4",
                           "integrator.options.linear_solver=klu"});
   EXPECT_EQ(arkode.integrator.options.arkode.rtol, 1e-4);
-  EXPECT_EQ(parse_scene(scene_to_json(arkode)).integrator.options.arkode.linear_solver, "klu");
+  EXPECT_EQ(parse_scene(scene_to_json(arkode)).integrator.options.arkode.linear_solver,
+            ArkodeLinearSolver::kKlu);
   EXPECT_NO_THROW(make_simulator(arkode));
 }
 

@@ -29,6 +29,10 @@ namespace jelly::arkode {
 // dv = y + z, P = I - n n^T on those particles and I elsewhere, z_i = n (n.bv_i). Their
 // friction -mu N v_t is a tangential damper of coefficient c = mu N: S_ii gains gamma c P
 // (its dependence on N through the forces is left out: the Newton iteration absorbs it).
+//
+// Pinned particles follow their paths: their acceleration does not depend on the state, so
+// their rows of J are [0, I; 0, 0] and the Newton system prescribes dv_i = bv_i. They are
+// filtered the same way with P_i = 0 (z_i = bv_i). Wind drag adds -drag I to D's diagonal.
 class SpringOperator {
  public:
   struct Constraint {
@@ -36,9 +40,11 @@ class SpringOperator {
     Vec3 normal;
     Real damping;  // mu N of the friction -mu N v_t (N/(m/s))
   };
-  // `anchors` (may be null): their diagonal Jacobians -k I, -c I are added.
+  // `anchors` (may be null): their diagonal Jacobians -k I, -c I are added; the wind drag of
+  // the model's external forces active at time t: -drag I on D's diagonal; the model's pins
+  // (always) as above.
   void linearize(const Model& model, const VecX& x, const VecX& v,
-                 const AnchorSprings* anchors = nullptr);
+                 const AnchorSprings* anchors = nullptr, Real t = 0);
   // The particles whose normal acceleration the seed contact cancels (see above); call after
   // linearize(), before set_gamma().
   void set_constraints(std::vector<Constraint> constraints);
@@ -50,10 +56,15 @@ class SpringOperator {
   void set_gamma(const Model& model, Real gamma);
   // out = S p (size 3N), for the last set_gamma (without the filter).
   void multiply_s(const Model& model, const VecX& p, VecX& out) const;
-  // out = (P S P + I - P) y, the filtered operator (= S y without constraints).
+  // out = (P S P + I - P) y, the filtered operator (= S y without constraints or pins).
   void multiply_filtered(const Model& model, const VecX& y, VecX& out);
-  // r = P r (the constrained particles' normal components removed).
+  // r = P r (the constrained particles' normal components and the pinned particles' removed).
   void filter(VecX& r) const;
+  // True when some particle is filtered (seed constraints or pins).
+  bool filters() const { return !constraints_.empty() || !pinned_.empty(); }
+  // z = the prescribed velocity change: n (n.bv_i) for a seed constraint, bv_i for a pin, 0
+  // elsewhere (`bv` size 3N).
+  void prescribed(const Real* bv, VecX& z) const;
   // out = K p (size 3N).
   void multiply_k(const Model& model, const Real* p, VecX& out) const;
   // z = diag^-1 r with the 3x3 diagonal blocks of the filtered operator (size 3N).
@@ -72,6 +83,11 @@ class SpringOperator {
   std::vector<Real> s_inverse_;   // [9N] inverses of the filtered diagonal blocks
   std::vector<Constraint> constraints_;
   AnchorSprings anchors_;                  // copies of the anchors' particle, k and c
+  std::vector<int> pinned_;                // the model's pinned particles
+  std::vector<char> is_pinned_;            // [N]
+  std::vector<int> dragged_;               // particles with wind drag at the linearization
+  std::vector<Real> drag_;                 // their drag (N s/m)
+  VecX damping_;                           // workspace of linearize()
   std::vector<int> constraint_of_;         // [N] index into constraints_, or -1
   std::vector<Real> k_blocks_, d_blocks_;  // workspace of linearize()
   VecX filtered_;                          // workspace of multiply_filtered()

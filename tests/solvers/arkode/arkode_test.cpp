@@ -50,7 +50,7 @@ ArkodeRun oscillator_run(const std::string& name, Real rtol,
   ArkodeOptions o;
   o.rtol = rtol;
   o.atol = rtol * 1e-2;  // |x| ~ 1 m, |v| ~ 1 m/s: the relative test dominates
-  o.linear_solver = linear_solver;
+  o.linear_solver = value_of(arkode_linear_solvers(), linear_solver, "linear_solver");
   Simulator sim = make_arkode_sim(sys.model(), sys.initial(), name, o, 0.1);
   EXPECT_TRUE(sim.run_until(2.0).ok());
   const State& s = sim.state();
@@ -196,6 +196,71 @@ TEST(Arkode, EveryLinearSolverAgreesWithSchur) {
   EXPECT_EQ(automatic.stats.count("cg_iterations"), 1u);
 }
 
+// A particle on a damped spring hanging from a pinned particle (no gravity): x1(t) is the
+// one-mass oscillator's, omega0^2 = ks / m, decay kd / (2 m). The iterative Newton solves
+// prescribe the pinned particle's velocity change, so ARKODE keeps it where the pin holds it and
+// nothing restarts ARKODE (before, every interval restarted it: the pinned particle had moved
+// within the Newton tolerance and the Simulator put it back).
+TEST(Arkode, DirkHonoursPinsInsideItsNewtonSolves) {
+  const Real m = 1, ks = 100, kd = 2, l0 = 1, stretch = 0.1;
+  Model model;
+  model.mass = VecX::Constant(2, m);
+  model.rest_position = VecX::Zero(6);
+  model.rest_position[3] = l0;
+  model.springs.add(0, 1, l0, {ks, kd}, SpringType::kStructural);
+  model.gravity.setZero();
+  model.pins.add_fixed(0, Vec3::Zero());
+  State s = rest_state(model);
+  s.x[3] = l0 + stretch;
+  const Real g = kd / (2 * m), w = std::sqrt(ks / m - g * g);
+  for (const std::string solver : {"cg", "jacobi", "gmres"}) {
+    SCOPED_TRACE(solver);
+    ArkodeOptions o;
+    o.linear_solver = value_of(arkode_linear_solvers(), solver, "linear_solver");
+    Simulator sim = make_arkode_sim(model, s, "arkode_dirk", o, 0.05);
+    ASSERT_TRUE(sim.run_until(2.0).ok());
+    const Real t = sim.state().t;
+    const Real expected = l0 + stretch * std::exp(-g * t) * (std::cos(w * t) + g / w * std::sin(w * t));
+    EXPECT_NEAR(sim.state().x[3], expected, 1e-5);
+    EXPECT_EQ(Vec3(particle(sim.state().x, 0)), Vec3::Zero());
+    const Statistics stats = sim.integrator().statistics();
+    EXPECT_EQ(stats.at("arkode_resets"), 0);
+    EXPECT_EQ(stats.at("newton_convergence_failures"), 0);
+  }
+}
+
+// A particle falling in wind of drag c (N s/m) and air velocity w: m v' = m g + c (w - v), so
+// v(t) = v_inf (1 - exp(-c t / m)) from rest, terminal velocity v_inf = w + m g / c. With a
+// stiff drag (c / m = 1000 1/s) and 1/60 s intervals the DIRK's steps are far longer than the
+// drag's time constant: Newton converges only with the drag in its matrix (without it each
+// iteration amplified the error by about gamma c / m).
+TEST(Arkode, DirkReachesTheWindsTerminalVelocity) {
+  const Real m = 0.01, c = 10;
+  Model model;
+  model.mass = VecX::Constant(1, m);
+  model.rest_position = VecX::Zero(3);
+  ExternalForce wind;
+  wind.kind = ExternalForceKind::kWind;
+  wind.particles = {0};
+  wind.vector = Vec3(3, 0, 0);
+  wind.drag = c;
+  model.external_forces = {wind};
+  const Vec3 terminal = wind.vector + m * model.gravity / c;
+  for (const std::string solver : {"cg", "jacobi", "gmres"}) {
+    SCOPED_TRACE(solver);
+    ArkodeOptions o;
+    o.linear_solver = value_of(arkode_linear_solvers(), solver, "linear_solver");
+    Simulator sim = make_arkode_sim(model, rest_state(model), "arkode_dirk", o, 1.0 / 60);
+    ASSERT_TRUE(sim.run_until(1.0).ok());
+    const Real t = sim.state().t;
+    const Vec3 expected = terminal * (1 - std::exp(-c * t / m));
+    EXPECT_LT((Vec3(particle(sim.state().v, 0)) - expected).norm(), 1e-6 * terminal.norm());
+    const Statistics stats = sim.integrator().statistics();
+    EXPECT_EQ(stats.at("newton_convergence_failures"), 0);
+    EXPECT_LT(stats.at("arkode_steps"), 200);
+  }
+}
+
 // The matrix-free operator of the iterative solvers against dense matrices assembled by
 // SpringJacobian: S = M - g D - g^2 K, K p, the filtered operator of a seed contact and the
 // block-Jacobi solves.
@@ -289,8 +354,6 @@ TEST(Arkode, BadOptionsNameTheField) {
     expect_input_error(name, with([](auto& o) { o.max_step = -1; }), "integrator.options.max_step");
     expect_input_error(name, with([](auto& o) { o.max_steps = 0; }),
                        "integrator.options.max_steps");
-    expect_input_error(name, with([](auto& o) { o.linear_solver = "lu"; }),
-                       "integrator.options.linear_solver");
     expect_input_error(name, with([](auto& o) { o.method = "ARKODE_NO_SUCH_TABLE"; }),
                        "integrator.options.method");
   }
@@ -307,6 +370,54 @@ TEST(Arkode, BadOptionsNameTheField) {
   EXPECT_EQ(ArkodeErk(o).order(), 3);
   o.method = "ARKODE_SDIRK_5_3_4";
   EXPECT_EQ(ArkodeDirk(o).order(), 4);
+}
+
+// The named choices are tables (core/enum_names.hpp): every method of the tables builds its
+// integrator with the order its name ends with, an unknown name is refused with the table's
+// names, and the scene's linear_solver is read and written through its table (default "auto").
+TEST(Arkode, MethodsAndLinearSolversAreTables) {
+  for (const auto& [table, name] : {std::pair{&arkode_erk_methods(), "arkode_erk"},
+                                    std::pair{&arkode_dirk_methods(), "arkode_dirk"}}) {
+    for (const EnumName<int>& method : *table) {
+      SCOPED_TRACE(method.name);
+      IntegratorOptions options;
+      options.arkode.method = std::string(method.name);
+      const auto integrator = make_integrator(name, options);
+      EXPECT_EQ(integrator->order(), method.name.back() - '0');
+    }
+  }
+  IntegratorOptions options;
+  options.arkode.method = "ARKODE_NO_SUCH_TABLE";
+  try {
+    make_integrator("arkode_dirk", options);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("integrator.options.method = \"ARKODE_NO_SUCH_TABLE\" is "
+                                         "invalid: one of \"ARKODE_SDIRK_2_1_2\", "),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(ArkodeOptions{}.linear_solver, ArkodeLinearSolver::kAuto);
+  EXPECT_EQ(ArkodeOptions{}.to_json()["linear_solver"], "auto");
+  for (const EnumName<ArkodeLinearSolver>& solver : arkode_linear_solvers()) {
+    Json options = Json::object();
+    options["linear_solver"] = std::string(solver.name);
+    JsonFields fields(options, "integrator.options");
+    EXPECT_EQ(ArkodeOptions::read(fields).linear_solver, solver.value);
+  }
+  Json bad = Json::object();
+  bad["linear_solver"] = "lu";
+  JsonFields fields(bad, "integrator.options");
+  try {
+    ArkodeOptions::read(fields);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("integrator.options.linear_solver = \"lu\" is invalid: "
+                                         "one of \"auto\", \"cg\", \"jacobi\", \"gmres\", "
+                                         "\"schur\", \"klu\""),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // A failure inside ARKODE is a returned status with SUNDIALS' flag name and message.
