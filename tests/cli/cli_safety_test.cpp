@@ -354,7 +354,8 @@ TEST(SilentNumericalFailure, NewtonStoppedAboveItsToleranceIsAWarningCountedInTh
   EXPECT_THAT(r.out, StartsWith("jelly run: completed_with_warnings at t = "));
   EXPECT_THAT(r.out, HasSubstr(what));
   EXPECT_THAT(r.out, HasSubstr(count));
-  EXPECT_THAT(r.err, AllOf(StartsWith("warning: " + what), HasSubstr(count),
+  // (after the warning that the seed rules are crossed within a step at 1/60 s)
+  EXPECT_THAT(r.err, AllOf(HasSubstr("\nwarning: " + what), HasSubstr(count),
                            HasSubstr("(--strict makes this an error)")));
   // The recording says so too (run_status, run_reason).
   const Result info = jelly("info " + quoted(file));
@@ -367,8 +368,8 @@ TEST(SilentNumericalFailure, StrictMakesAMissedToleranceExitThree) {
   const Result r = jelly(kShortNewton + " --strict");
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_THAT(r.out, StartsWith("jelly run: completed_with_warnings"));
-  EXPECT_THAT(r.err, StartsWith("error: the run missed its solver's tolerance (--strict): "
-                                "implicit_euler: Newton did not converge"));
+  EXPECT_THAT(r.err, HasSubstr("\nerror: the run missed its solver's tolerance (--strict): "
+                               "implicit_euler: Newton did not converge"));
 }
 
 TEST(SilentNumericalFailure, ARunThatMetItsToleranceIsCompletedEvenWithStrict) {
@@ -379,7 +380,7 @@ TEST(SilentNumericalFailure, ARunThatMetItsToleranceIsCompletedEvenWithStrict) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(statistic(r.out, "newton_not_converged"), 0) << r.out;
   EXPECT_THAT(r.out, StartsWith("jelly run: completed at t = "));
-  EXPECT_EQ(r.err, "");
+  EXPECT_THAT(r.err, Not(HasSubstr("Newton")));
 }
 
 TEST(SilentNumericalFailure, ProjectiveDynamicsAboveItsToleranceIsAWarning) {
