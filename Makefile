@@ -26,18 +26,24 @@ test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
 # AddressSanitizer + UndefinedBehaviorSanitizer over the whole test suite, built with clang in
-# its own directory; there the fuzz targets are libFuzzer programs and ctest fuzzes each for
-# JELLY_FUZZ_SECONDS (docs/fuzzing.md). Any sanitizer report fails the test that caused it.
+# its own directory (-O1, no debug information, no Python module: cmake/JellySanitize.cmake);
+# there the fuzz targets are libFuzzer programs and ctest fuzzes each for JELLY_FUZZ_SECONDS
+# (docs/fuzzing.md). Any sanitizer report fails the test that caused it. CI (.ci/run) passes
+# SANITIZE_CMAKE_FLAGS and SANITIZE_CTEST_FLAGS to leave out what adds build time and no coverage.
 SANITIZE_BUILD ?= build-sanitize
+SANITIZE_CMAKE_FLAGS ?=
+SANITIZE_CTEST_FLAGS ?=
 SANITIZE_ENV = ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:strict_string_checks=1 \
 	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/fuzz/lsan.supp:print_suppressions=0 \
 	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
+test-sanitize: DEPS_FLAGS = --tests
 test-sanitize: deps
 	CC=clang CXX=clang++ cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Release \
-	  -DJELLY_SANITIZE=ON -DJELLY_FUZZ=ON $(LAUNCHER)
+	  -DJELLY_SANITIZE=ON -DJELLY_FUZZ=ON $(SANITIZE_CMAKE_FLAGS) $(LAUNCHER)
 	cmake --build $(SANITIZE_BUILD) -j $(JOBS)
-	$(SANITIZE_ENV) ctest --test-dir $(SANITIZE_BUILD) --output-on-failure -j $(JOBS)
+	$(SANITIZE_ENV) ctest --test-dir $(SANITIZE_BUILD) --output-on-failure -j $(JOBS) \
+	  $(SANITIZE_CTEST_FLAGS)
 
 # 3 s of the seed slope with RK4 (a few seconds of wall time), then the plots when
 # scripts/plot.py is there, and the video (jelly render; exit 2 = built without the viewer).
