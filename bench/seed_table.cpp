@@ -134,7 +134,8 @@ Table seed_claims(const Table& seed) {
               seed.text(r, "scene") != scene)
             continue;
           const std::string& name = seed.text(r, "integrator");
-          const bool stable = seed.text(r, "status") == "completed";
+          const std::string& status = seed.text(r, "status");
+          const bool stable = status == "completed" || status == "completed_with_warnings";
           if (kReportMethods.count(name)) {
             seen.insert(name);
             if (stable) survivors.insert(name);
