@@ -12,6 +12,12 @@
 
 #include "fuzz/h5_mutation.hpp"
 
+// libFuzzer calls it once before the first input (replay_main.cpp does too).
+extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
+  jelly::fuzz::prepare_pristine();
+  return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace jelly;
   fuzz::FuzzInput in(data, size);

@@ -292,6 +292,8 @@ void set_attribute(hid_t file, const std::string& object, const std::string& nam
 
 const Scene& pristine_scene(int which) { return pristine(which).scene; }
 
+void prepare_pristine() { (void)pristine(0); }
+
 Mutated mutated_recording(FuzzInput& in, bool checkpoint_focus) {
   Mutated m;
   m.which = static_cast<int>(in.pick(kPristineCount));

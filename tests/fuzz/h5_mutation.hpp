@@ -16,6 +16,10 @@ namespace jelly::fuzz {
 // coulomb contact inside its solve (a checkpoint with integrator state).
 constexpr int kPristineCount = 2;
 const Scene& pristine_scene(int which);
+// Makes the pristine recordings (simulations of 0.2 s, seconds under the sanitizers on a loaded
+// machine). The HDF5 targets call it from LLVMFuzzerInitialize, so that the time is not charged
+// to the first input: it ran into libFuzzer's -timeout=20 in a 10-minute run (docs/fuzzing.md).
+void prepare_pristine();
 
 struct Mutated {
   std::string path;  // a scratch copy, rewritten by the next call
