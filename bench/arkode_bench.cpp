@@ -24,8 +24,8 @@ int main(int argc, char** argv) {
     if (argc > 5) options.arkode.rtol = std::atof(argv[5]);
     if (argc > 6) options.arkode.atol = std::atof(argv[6]);
     if (argc > 7)
-      options.arkode.linear_solver = jelly::value_of(jelly::arkode_linear_solvers(), argv[7],
-                                                     "linear_solver (argument 7)");
+      options.arkode.linear_solver =
+          jelly::value_of(jelly::arkode_linear_solvers(), argv[7], "linear_solver (argument 7)");
     const jelly::Model model = jelly::build_cube(jelly::CubeSpec{});
     jelly::SimulatorOptions sim_options;
     sim_options.dt = std::atof(argv[3]);

@@ -170,12 +170,11 @@ void bind_solvers(py::module_& m) {
       .def_readwrite("method", &ArkodeOptions::method,
                      "An ARKODE Butcher table name; empty = default.")
       .def_readwrite("max_step", &ArkodeOptions::max_step, "Largest internal step (s); 0 = dt.")
-      .def_property("linear_solver",
-                    choice_getter(&ArkodeOptions::linear_solver, arkode_linear_solvers),
-                    choice_setter(&ArkodeOptions::linear_solver, arkode_linear_solvers,
-                                  "linear_solver"),
-                    "arkode_dirk: \"auto\" (= \"cg\"), \"cg\", \"jacobi\", \"gmres\", "
-                    "\"schur\" or \"klu\".")
+      .def_property(
+          "linear_solver", choice_getter(&ArkodeOptions::linear_solver, arkode_linear_solvers),
+          choice_setter(&ArkodeOptions::linear_solver, arkode_linear_solvers, "linear_solver"),
+          "arkode_dirk: \"auto\" (= \"cg\"), \"cg\", \"jacobi\", \"gmres\", "
+          "\"schur\" or \"klu\".")
       .def_readwrite("max_steps", &ArkodeOptions::max_steps,
                      "Internal steps per contact interval.");
 
@@ -235,7 +234,8 @@ void bind_solvers(py::module_& m) {
       });
 
   py::class_<RunReport>(m, "RunReport",
-                        "How a run ended: status \"completed\", \"completed_with_warnings\", \"diverged\" or \"solver_failed\" "
+                        "How a run ended: status \"completed\", \"completed_with_warnings\", "
+                        "\"diverged\" or \"solver_failed\" "
                         "(a diverged run returns its report, it does not raise).")
       .def_property_readonly(
           "status", [](const RunReport& r) { return std::string(run_status_name(r.status)); },

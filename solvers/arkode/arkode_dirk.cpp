@@ -59,7 +59,8 @@ class DirkDriver final : public arkode::Driver {
       if (flag >= 0)
         flag = ARKStepSetPreconditioner(m, &DirkDriver::preconditioner_setup,
                                         &DirkDriver::preconditioner_solve);
-    } else if (linear_solver_kind_ == ArkodeLinearSolver::kJacobi || linear_solver_kind_ == ArkodeLinearSolver::kCg) {
+    } else if (linear_solver_kind_ == ArkodeLinearSolver::kJacobi ||
+               linear_solver_kind_ == ArkodeLinearSolver::kCg) {
       linear_solver_ = arkode::make_iterative_solver(context_.get(), m, &data_,
                                                      linear_solver_kind_ == ArkodeLinearSolver::kCg
                                                          ? arkode::IterativeMode::kCg
@@ -123,7 +124,8 @@ class DirkDriver final : public arkode::Driver {
     ARKStepGetNumNonlinSolvIters(m, &c.newton_iterations);
     ARKStepGetNumNonlinSolvConvFails(m, &c.newton_failures);
     ARKStepGetNumLinSolvSetups(m, &c.linear_setups);
-    if (linear_solver_kind_ == ArkodeLinearSolver::kKlu) ARKStepGetNumJacEvals(m, &c.jacobian_evaluations);
+    if (linear_solver_kind_ == ArkodeLinearSolver::kKlu)
+      ARKStepGetNumJacEvals(m, &c.jacobian_evaluations);
     if (linear_solver_kind_ == ArkodeLinearSolver::kGmres) {
       ARKStepGetNumLinIters(m, &c.linear_iterations);
       ARKStepGetNumLinConvFails(m, &c.linear_failures);
@@ -143,7 +145,8 @@ class DirkDriver final : public arkode::Driver {
       s["krylov_failures"] = static_cast<double>(total().linear_failures);
       s["jv_rhs_evaluations"] = static_cast<double>(total().linear_rhs_evaluations);
       s["preconditioner_setups"] = static_cast<double>(preconditioner_.linearizations());
-    } else if (linear_solver_kind_ == ArkodeLinearSolver::kJacobi || linear_solver_kind_ == ArkodeLinearSolver::kCg) {
+    } else if (linear_solver_kind_ == ArkodeLinearSolver::kJacobi ||
+               linear_solver_kind_ == ArkodeLinearSolver::kCg) {
       if (linear_solver_) {
         const arkode::IterativeStatistics& i = arkode::iterative_statistics(linear_solver_.get());
         s["linearizations"] = static_cast<double>(i.setups);
@@ -244,7 +247,7 @@ class DirkDriver final : public arkode::Driver {
   }
 
   std::string method_;
-  ArkodeLinearSolver linear_solver_kind_;  // kAuto resolved
+  ArkodeLinearSolver linear_solver_kind_;               // kAuto resolved
   arkode::SpringOperator preconditioner_;               // gmres: the block Jacobi
   std::unique_ptr<arkode::SchurSystem> schur_;          // klu: the K, D assembly
   std::vector<sunindextype> column_start_, row_index_;  // klu: the pattern of J

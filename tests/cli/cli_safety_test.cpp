@@ -325,7 +325,6 @@ TEST(ExitCodes, AFullDiskExitsOneWithASummaryAndAClearMessage) {
   EXPECT_EQ(std::count(stderr_text.begin(), stderr_text.end(), '\n'), 1) << stderr_text;
 }
 
-
 // ---- Silent numerical failure ----
 
 // The number after `key = ` in the summary's statistics line, or -1.
@@ -334,12 +333,13 @@ long statistic(const std::string& summary, const std::string& key) {
   return at == std::string::npos ? -1 : std::stol(summary.substr(at + key.size() + 3));
 }
 
-// The seed slope at 1/60 s with Newton cut to 5 iterations: the seed contact's impulses keep
-// Newton above its tolerance on many steps (issue 16: 111 of 180 on the 10x10x10 cube).
+// The slope (coulomb contact, inside the solve) at 1/60 s with Newton cut to 5 iterations:
+// Newton ends above its tolerance on some of the 180 steps (32 when this was written; issue 16
+// found 111 of 180 on the seed slope, which now diverges with Newton at 1/60 s).
 const std::string kShortNewton =
     "run " + kSmallSlope +
     " --integrator implicit_euler --dt 0.0166667 --duration 3 -q"
-    " --set integrator.options.newton_iterations=5";
+    " --set integrator.options.newton_iterations=5 --set terrains[0].contact.model=coulomb";
 
 TEST(SilentNumericalFailure, NewtonStoppedAboveItsToleranceIsAWarningCountedInTheSummary) {
   const std::string file = temp_path(".h5");
@@ -354,8 +354,7 @@ TEST(SilentNumericalFailure, NewtonStoppedAboveItsToleranceIsAWarningCountedInTh
   EXPECT_THAT(r.out, StartsWith("jelly run: completed_with_warnings at t = "));
   EXPECT_THAT(r.out, HasSubstr(what));
   EXPECT_THAT(r.out, HasSubstr(count));
-  // (after the warning that the seed rules are crossed within a step at 1/60 s)
-  EXPECT_THAT(r.err, AllOf(HasSubstr("\nwarning: " + what), HasSubstr(count),
+  EXPECT_THAT(r.err, AllOf(StartsWith("warning: " + what), HasSubstr(count),
                            HasSubstr("(--strict makes this an error)")));
   // The recording says so too (run_status, run_reason).
   const Result info = jelly("info " + quoted(file));
@@ -368,19 +367,20 @@ TEST(SilentNumericalFailure, StrictMakesAMissedToleranceExitThree) {
   const Result r = jelly(kShortNewton + " --strict");
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_THAT(r.out, StartsWith("jelly run: completed_with_warnings"));
-  EXPECT_THAT(r.err, HasSubstr("\nerror: the run missed its solver's tolerance (--strict): "
-                               "implicit_euler: Newton did not converge"));
+  EXPECT_THAT(r.err, StartsWith("error: the run missed its solver's tolerance (--strict): "
+                                "implicit_euler: Newton did not converge"));
 }
 
 TEST(SilentNumericalFailure, ARunThatMetItsToleranceIsCompletedEvenWithStrict) {
   // Free fall above the slope (0.2 s): Newton converges in every step.
   const Result r = jelly("run " + kSmallSlope +
                          " --integrator implicit_euler --dt 0.0166667 --duration 0.2 -q --strict"
-                         " --set integrator.options.newton_iterations=20");
+                         " --set integrator.options.newton_iterations=20"
+                         " --set terrains[0].contact.model=coulomb");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(statistic(r.out, "newton_not_converged"), 0) << r.out;
   EXPECT_THAT(r.out, StartsWith("jelly run: completed at t = "));
-  EXPECT_THAT(r.err, Not(HasSubstr("Newton")));
+  EXPECT_EQ(r.err, "");
 }
 
 TEST(SilentNumericalFailure, ProjectiveDynamicsAboveItsToleranceIsAWarning) {

@@ -7,9 +7,9 @@
 #include <Eigen/Dense>
 
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/arkode/arkode_dirk.hpp>
 #include <jelly/solvers/arkode/arkode_erk.hpp>
 #include <jelly/solvers/arkode/detail/arkode_iterative.hpp>
@@ -220,7 +220,8 @@ TEST(Arkode, DirkHonoursPinsInsideItsNewtonSolves) {
     Simulator sim = make_arkode_sim(model, s, "arkode_dirk", o, 0.05);
     ASSERT_TRUE(sim.run_until(2.0).ok());
     const Real t = sim.state().t;
-    const Real expected = l0 + stretch * std::exp(-g * t) * (std::cos(w * t) + g / w * std::sin(w * t));
+    const Real expected =
+        l0 + stretch * std::exp(-g * t) * (std::cos(w * t) + g / w * std::sin(w * t));
     EXPECT_NEAR(sim.state().x[3], expected, 1e-5);
     EXPECT_EQ(Vec3(particle(sim.state().x, 0)), Vec3::Zero());
     const Statistics stats = sim.integrator().statistics();
