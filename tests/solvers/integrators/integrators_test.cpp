@@ -65,7 +65,10 @@ TEST_P(EveryIntegrator, FreeFallOfTheCube) {
     } else {
       EXPECT_NEAR(error, euler_error, 1e-9) << "particle " << i;
     }
-    EXPECT_LT((Vec3(particle(sim.state().v, i)) - (v0 + model.gravity * t)).norm(), 1e-9);
+    // arkode_dirk's default Newton solves (matrix-free CG, inexact Newton) stop at ARKODE's
+    // tolerance: its velocities are exact to about 1e-8 (rtol 1e-6), the others' to rounding.
+    const Real v_tolerance = GetParam() == "arkode_dirk" ? 2e-8 : 1e-9;
+    EXPECT_LT((Vec3(particle(sim.state().v, i)) - (v0 + model.gravity * t)).norm(), v_tolerance);
   }
 }
 
