@@ -27,8 +27,9 @@ if [ "${1:-}" = "--tests" ]; then
   # pvpython (python3-paraview, only recommended by paraview). About 120 MB to download.
   packages+=(paraview python3-paraview)
   # `make test-sanitize` (CI runs it): clang with AddressSanitizer, UndefinedBehaviorSanitizer and
-  # libFuzzer (libclang-rt-dev), llvm-symbolizer for the reports' stack traces (llvm)
-  packages+=(clang libclang-rt-dev llvm)
+  # libFuzzer (libclang-rt-dev), OpenMP for clang (libomp-dev), llvm-symbolizer for the reports'
+  # stack traces (llvm)
+  packages+=(clang libclang-rt-dev libomp-dev llvm)
 elif [ $# -gt 0 ]; then
   echo "usage: $0 [--tests]" >&2
   exit 2

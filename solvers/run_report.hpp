@@ -8,17 +8,17 @@
 namespace jelly {
 
 enum class RunStatus {
-  kCompleted,     // reached the requested time
+  kCompleted,              // reached the requested time
   kCompletedWithWarnings,  // reached it, but some steps missed the solver's own tolerance
-  kDiverged,      // NaN, Inf or runaway speed: the divergence guard stopped the run
+  kDiverged,               // NaN, Inf or runaway speed: the divergence guard stopped the run
   kSolverFailed,  // the integrator returned a failure (e.g. a matrix not positive definite)
 };
 std::string_view run_status_name(RunStatus status);
 
 struct RunReport {
   RunStatus status = RunStatus::kCompleted;
-  Real t = 0;          // simulated time reached
-  long steps = 0;      // steps taken in this run
+  Real t = 0;      // simulated time reached
+  long steps = 0;  // steps taken in this run
   // Why the run stopped early, or for kCompletedWithWarnings which tolerances how many steps
   // missed ("implicit_euler: Newton did not converge (...) on 111 of 180 steps"); empty when
   // completed.

@@ -35,7 +35,7 @@ struct ArkodeOptions {
   std::string method;
   Real max_step = 0;  // s, largest internal step; 0 = the contact interval dt
   ArkodeLinearSolver linear_solver = ArkodeLinearSolver::kAuto;  // arkode_dirk only
-  long max_steps = 100000;              // internal steps per contact interval, > 0
+  long max_steps = 100000;  // internal steps per contact interval, > 0
 
   // Throws InputError "<prefix><field> = <value> is invalid: ..." for the first invalid field
   // (prefix e.g. "integrator.options."). The method name is checked by the integrator using it

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <jelly/core/errors.hpp>
@@ -120,6 +121,9 @@ bool ImplicitBodyContact::begin_step(const Model& model, BodyContact& contact, c
     pairs_.push_back(p);
   }
   seconds_ = std::chrono::duration<double>(Clock::now() - start).count();
+  // Without a candidate no finish() follows: the pairs carried from an earlier contact are over
+  // (they must not count as active when the bodies meet again).
+  if (pairs_.empty()) carried_.clear();
   return !pairs_.empty();
 }
 
@@ -184,7 +188,6 @@ bool ImplicitBodyContact::update(const VecX& dv, bool commit) {
     }
     const Vec3 q = impulse(p, w1);
     const Real pn = q.dot(p.normal);
-    p.normal_impulse = pn;
     p.release = false;
     if (pn < 0) {  // the spring would pull: let go
       // A pair that touched at the start of the step (gap0 <= 0) is pulled only by the little
@@ -221,6 +224,8 @@ bool ImplicitBodyContact::update(const VecX& dv, bool commit) {
     active_ = static_cast<int>(
         std::count_if(pairs_.begin(), pairs_.end(), [](const Pair& p) { return p.active; }));
     ++counters_.extra_solves;
+  } else if (changed) {
+    ++counters_.not_converged;  // the last solve's set stays
   }
   seconds_ += std::chrono::duration<double>(Clock::now() - start).count();
   return changed;
@@ -324,12 +329,20 @@ void ImplicitBodyContact::restore(const Real* data, size_t size) {
   require(size % kSavedPerPair == 0, "integrator state (body contact pairs)", size,
           "5 numbers per pair");
   carried_.clear();
+  constexpr Real kMaxIndex = std::numeric_limits<int>::max();
   for (size_t k = 0; k < size; k += kSavedPerPair) {
-    require(data[k] >= 0 && data[k] == std::floor(data[k]) && data[k + 1] > data[k] &&
-                data[k + 1] == std::floor(data[k + 1]),
-            "integrator state (body contact pair)", data[k], "two particle indices i < j");
-    carried_.push_back({static_cast<int>(data[k]), static_cast<int>(data[k + 1]),
-                        data[k + 2] != 0 ? Mode::kSlide : Mode::kStick, data[k + 3], data[k + 4]});
+    const Real i = data[k], j = data[k + 1], mode = data[k + 2], viscosity = data[k + 3],
+               kappa = data[k + 4];
+    require(i >= 0 && i == std::floor(i) && j > i && j == std::floor(j) && j <= kMaxIndex,
+            "integrator state (body contact pair)", i, "two particle indices 0 <= i < j");
+    require(mode == 0 || mode == 1, "integrator state (body contact pair mode)", mode,
+            "0 (stick) or 1 (slide)");
+    require(std::isfinite(viscosity) && viscosity >= 0,
+            "integrator state (body contact pair viscosity)", viscosity, "a finite value >= 0");
+    require(std::isfinite(kappa) && kappa > 0, "integrator state (body contact pair stiffness)",
+            kappa, "a finite value > 0");
+    carried_.push_back({static_cast<int>(i), static_cast<int>(j),
+                        mode != 0 ? Mode::kSlide : Mode::kStick, viscosity, kappa});
   }
   std::sort(carried_.begin(), carried_.end(), [](const Carried& a, const Carried& b) {
     return std::make_pair(a.i, a.j) < std::make_pair(b.i, b.j);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
@@ -362,8 +363,13 @@ void ImplicitContact::restore(const Real* data, size_t size) {
   contacts_.clear();
   for (size_t i = 0; i < size; i += kSavedPerContact) {
     Contact c;
-    require(data[i] >= 0 && data[i] == std::floor(data[i]) && data[i + 1] >= 0,
+    constexpr Real kMaxIndex = std::numeric_limits<int>::max();
+    require(data[i] >= 0 && data[i] == std::floor(data[i]) && data[i] <= kMaxIndex &&
+                data[i + 1] >= 0 && data[i + 1] == std::floor(data[i + 1]) &&
+                data[i + 1] <= kMaxIndex,
             "integrator state (contact particle)", data[i], "a particle and a terrain index");
+    require(std::isfinite(data[i + 3]) && data[i + 3] >= 0, "integrator state (contact viscosity)",
+            data[i + 3], "a finite value >= 0");
     c.particle = static_cast<int>(data[i]);
     c.terrain = static_cast<int>(data[i + 1]);
     c.mode = data[i + 2] != 0 ? Mode::kSlide : Mode::kStick;

@@ -226,6 +226,7 @@ void ImplicitEuler::Impl::add_statistics(Statistics& s) const {
   if (resolves_body_contact()) {
     const ImplicitBodyContact::Counters& bc = bodies_.counters();
     s["body_contact_extra_solves"] = static_cast<double>(bc.extra_solves);
+    s["body_contact_not_converged"] = static_cast<double>(bc.not_converged);
     s["body_contact_restitution_limited"] = static_cast<double>(bc.restitution_limited);
     s["body_contact_projected"] = static_cast<double>(bc.projected);
   }

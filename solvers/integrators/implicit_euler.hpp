@@ -34,14 +34,15 @@ class ImplicitEuler final : public Integrator {
   // newton_iterations, newton_not_converged, assembly_seconds, factorization_seconds,
   // solve_seconds, and for contact inside the solve contact_extra_solves,
   // contact_not_converged, contact_restitution_limited, and with contact between bodies inside
-  // the solve body_contact_extra_solves, body_contact_projected,
+  // the solve body_contact_extra_solves, body_contact_not_converged, body_contact_projected,
   // body_contact_restitution_limited.
   Statistics statistics() const override;
   // With newton_iterations > 1: the steps whose Newton iterations stopped at the limit above
   // newton_tolerance.
   std::vector<ToleranceMiss> tolerance_misses() const override;
-  // The CG warm start and the contact set (a lagged CHOLMOD preconditioner is not kept: it is
-  // rebuilt, so only the backends without one restart bit for bit).
+  // The CG warm start, the active contact pairs between bodies (with their friction state) and
+  // the terrain contact set (a lagged CHOLMOD preconditioner is not kept: it is rebuilt, so only
+  // the backends without one restart bit for bit).
   std::vector<Real> internal_state() const override;
   void restore_internal_state(const std::vector<Real>& data) override;
 

@@ -21,19 +21,20 @@
 // + c P_t: symmetric positive semi-definite, so the matrix stays SPD for every linear solver.
 // The pattern of the (i, j) blocks is the integrator's business (ImplicitEuler keeps the union
 // of the candidates in its SpringJacobian, re-analysing only when a new pair appears).
-// Active set, as for the terrains: a candidate whose end gap the solve makes negative becomes
-// active, an active pair whose spring would pull (g1 > 0) is released, solving again while that
-// changes. Stick -> slide when the tangential impulse leaves the cone mu_s p_n; slide -> stick
-// when the viscosity reaches 100 m_ij. All impulses are equal and opposite (linear momentum is
-// conserved exactly by an exact solve) and act along the start-of-step line of centres or
-// across it: the normal ones change no angular momentum (backward Euler changes L by
-// sum x0 x impulse), friction does. Restitution after the solve: a pair that approached faster
-// than the resting speed at the start of the step and is in contact at its end gets e times that
-// approach along its end-of-step line of centres (no torque), scaled down if needed so that the
-// total energy does not grow over the step. Before that, a safety net: an overlap deeper than
-// 0.5 % of r_i + r_j at the end of the step (the pair springs' compliance under a whole body's
-// momentum at a landing at 1/30 s) is projected back to 0.5 % along the line of centres, with
-// the angular momentum of the projection's lever taken back (as BodyContact::resolve does).
+// Active set, as for the terrains: a candidate whose end gap the solve makes overlap by more than
+// 0.1 % of r_i + r_j becomes active (a shallower overlap is left to the next step's prediction), an
+// active pair whose spring would pull (g1 > 0) is released, solving again while that changes. Stick
+// -> slide when the tangential impulse leaves the cone mu_s p_n; slide -> stick when the viscosity
+// reaches 100 m_ij. All impulses are equal and opposite (linear momentum is conserved exactly by an
+// exact solve) and act along the start-of-step line of centres or across it: the normal ones change
+// no angular momentum (backward Euler changes L by sum x0 x impulse), friction does. Restitution
+// after the solve: a pair that approached faster than the resting speed at the start of the step
+// and is in contact at its end gets e times that approach along its end-of-step line of centres (no
+// torque), scaled down if needed so that the total energy does not grow over the step. Before that,
+// a safety net: an overlap deeper than 0.5 % of r_i + r_j at the end of the step (the pair springs'
+// compliance under a whole body's momentum at a landing at 1/30 s) is projected back to 0.5 % along
+// the line of centres, with the angular momentum of the projection's lever taken back (as
+// BodyContact::resolve does).
 #include <utility>
 #include <vector>
 
@@ -58,13 +59,13 @@ class ImplicitBodyContact {
     bool active = false;
     bool release = false;  // held for this step (pulled without a new solve), free at the next
     Mode mode = Mode::kStick;
-    Real viscosity = 0;       // sliding friction c
-    Real kappa = 0;           // h^2 k = kappa mass (kStiffness; kept per pair for a later policy)
-    Real normal_impulse = 0;  // p_n of the last solve
+    Real viscosity = 0;  // sliding friction c
+    Real kappa = 0;      // h^2 k = kappa mass (kStiffness; kept per pair for a later policy)
   };
 
   struct Counters {
     long extra_solves = 0;         // solves caused by changes of the active pairs
+    long not_converged = 0;        // steps that ended with the active pairs still changing
     long restitution_limited = 0;  // steps whose bounce the energy bound reduced
     long projected = 0;            // overlaps deeper than 0.5 % projected after the solve
   };
@@ -91,7 +92,8 @@ class ImplicitBodyContact {
   // step's start), statistics into `contact`.
   void finish(const Model& model, State& s1, BodyContact& contact);
 
-  // The active pairs' (i, j, mode, viscosity), appended to `out`, and back.
+  // The active pairs' (i, j, mode, viscosity, kappa), appended to `out`, and back (restore
+  // throws InputError for values no save could have written).
   void save(std::vector<Real>& out) const;
   void restore(const Real* data, size_t size);
   static constexpr size_t kSavedPerPair = 5;

@@ -1,6 +1,7 @@
 // Contact between bodies and within a body: the broad phase finds exactly the pairs of a brute
 // force search; the response conserves momentum; two free cubes collide and separate, a stack
 // comes to rest without overlap for every integrator; spring neighbours never collide.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -281,6 +282,84 @@ TEST(BodyContact, ImplicitEulerRestartsBitForBit) {
   ASSERT_TRUE(b.run_until(1.2).ok());
   EXPECT_EQ(a.state().x, b.state().x);
   EXPECT_EQ(a.state().v, b.state().v);
+}
+
+// The body pairs' part of implicit_euler's saved state: [warm start size, warm start..., -(1 +
+// number of values), values...]; returns the index of the first value, or -1 when there is none.
+long body_pairs_at(const std::vector<Real>& state) {
+  if (state.empty()) return -1;
+  const size_t at = 1 + static_cast<size_t>(state[0]);
+  return at < state.size() && state[at] < 0 ? static_cast<long>(at + 1) : -1;
+}
+
+// A checkpoint whose body pairs no run could have saved (an index beyond int, a mode other than
+// 0 or 1, a NaN or negative friction viscosity or stiffness) is an InputError naming the value,
+// not undefined behaviour or a silent run.
+// Two 27-particle cubes, the second 1 m above the first, and implicit_euler at 1/60 s over a
+// floor.
+Model stacked_cubes() {
+  Model model;
+  for (int c = 0; c < 2; ++c) {
+    const CubeSpec cube = testing::small_cube(3, 0.6, Vec3(-0.3, 0.001 + c, -0.3));
+    model.add_body("cube" + std::to_string(c),
+                   cube.shape().build(cube.material(), "c" + std::to_string(c) + "."));
+  }
+  return model;
+}
+
+Simulator make_stack_sim(const Model& model) {
+  Simulator sim(model, rest_state(model), make_integrator("implicit_euler", {}),
+                SimulatorOptions{1.0 / 60, 0, {}});
+  sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitY()));
+  return sim;
+}
+
+TEST(BodyContact, ImplicitEulerRefusesDamagedContactPairs) {
+  const Model model = stacked_cubes();
+  const auto make = [&] { return make_stack_sim(model); };
+  Simulator a = make();
+  ASSERT_TRUE(a.run_until(0.8).ok());
+  const SimulatorSnapshot good = a.snapshot();
+  const long at = body_pairs_at(good.integrator_state);
+  ASSERT_GE(at, 0) << "the cubes should touch at 0.8 s";
+  struct Damage {
+    int offset;  // i, j, mode, viscosity, kappa
+    Real value;
+    const char* field;
+  };
+  for (const Damage& d :
+       {Damage{0, -1.0, "body contact pair"}, Damage{1, 1e300, "body contact pair"},
+        Damage{2, 2.0, "mode"}, Damage{3, -1.0, "viscosity"}, Damage{3, std::nan(""), "viscosity"},
+        Damage{4, 0.0, "stiffness"}, Damage{4, std::nan(""), "stiffness"}}) {
+    SimulatorSnapshot bad = good;
+    bad.integrator_state[at + d.offset] = d.value;
+    Simulator b = make();
+    try {
+      b.restore(bad);
+      ADD_FAILURE() << "accepted " << d.value << " at offset " << d.offset;
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), ::testing::HasSubstr(d.field));
+    }
+  }
+}
+
+// Pairs end with the contact: a run restored from a snapshot with touching pairs, but with the
+// upper cube moved 10 m up, finds no candidate in its next step, and its saved state then holds
+// no pair (a stale one would count as touching, with its old friction state, when the bodies
+// meet again).
+TEST(BodyContact, ImplicitEulerForgetsPairsOnceApart) {
+  const Model model = stacked_cubes();
+  Simulator a = make_stack_sim(model);
+  ASSERT_TRUE(a.run_until(0.8).ok());
+  SimulatorSnapshot apart = a.snapshot();
+  ASSERT_GE(body_pairs_at(apart.integrator_state), 0) << "the cubes should touch at 0.8 s";
+  for (int i = 27; i < 54; ++i) apart.state.x[3 * i + 1] += 10;
+  apart.state.v.setZero();
+  Simulator b = make_stack_sim(model);
+  b.restore(apart);
+  ASSERT_TRUE(b.run_until(0.8 + 2.0 / 60).ok());
+  EXPECT_TRUE(b.body_contact().pairs().empty());
+  EXPECT_EQ(body_pairs_at(b.snapshot().integrator_state), -1);
 }
 
 // Self-contact never acts between particles that a spring joins: a cube at rest, even squeezed,

@@ -4,8 +4,8 @@
 #include <random>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 #include "support/systems.hpp"
