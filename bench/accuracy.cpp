@@ -165,7 +165,9 @@ Table convergence_orders(const Table& accuracy, const Table& reference) {
     if (!points.count(name)) names.push_back(name);
     auto& list = points[name];
     const Real error = accuracy.number(r, "error");
-    if (accuracy.text(r, "status") == "completed" && std::isfinite(error) && error > floor &&
+    const std::string& status = accuracy.text(r, "status");
+    const bool completed = status == "completed" || status == "completed_with_warnings";
+    if (completed && std::isfinite(error) && error > floor &&
         error > 0) {
       list.emplace_back(accuracy.number(r, "dt"), error);
     }

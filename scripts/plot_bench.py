@@ -19,6 +19,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+# A run that completed, also when its solver missed its own tolerance on some steps.
+COMPLETED = ("completed", "completed_with_warnings")
+
 
 def read_table(path):
     """Rows of a jelly-bench CSV as dicts (numbers converted), and its metadata."""
@@ -92,7 +95,7 @@ def plot_work_precision(rows, meta, out):
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     names = sorted({r["integrator"] for r in rows})
     for i, name in enumerate(names):
-        sel = [r for r in rows if r["integrator"] == name and r["status"] == "completed"
+        sel = [r for r in rows if r["integrator"] == name and r["status"] in COMPLETED
                and finite(r["error"]) and r["error"] > 0]
         sel.sort(key=lambda r: r["dt"])
         if not sel:
@@ -125,7 +128,7 @@ def plot_speed(rows, meta, out):
     for name, threads in keys:
         i = names.index(name)
         sel = sorted((r for r in rows if r["integrator"] == name and r.get("threads", 1) == threads
-                      and r["status"] == "completed"), key=lambda r: r["springs"])
+                      and r["status"] in COMPLETED), key=lambda r: r["springs"])
         if not sel:
             continue
         label = name if len(counts) == 1 else "%s, %d threads" % (name, threads)

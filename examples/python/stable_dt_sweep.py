@@ -61,7 +61,7 @@ def main():
     for (name, ks), group in table.groupby(["integrator.name", "ks"], sort=False):
         stable = math.nan
         for dt, status in sorted(zip(group["integrator.dt"], group["status"])):
-            if status != "completed":
+            if status not in ("completed", "completed_with_warnings"):
                 break
             stable = dt
         rows.append({"integrator": name, "ks": ks, "dt_stable": stable})

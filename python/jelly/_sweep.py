@@ -81,9 +81,9 @@ def sweep(scene: Scene, parameters: Mapping[str, Sequence[Any]], client: Any = N
     DataFrame (also written to out_dir/summary.csv).
 
     Each run is recorded to out_dir/run_NNNN.h5 (out_dir=None: no files, no CSV). Columns: run,
-    one per path, status ("completed", "diverged", "solver_failed"), reason, t_end (time
-    reached), t_diverged (NaN unless diverged), steps, final_energy (total energy at the end, J;
-    NaN if not finite), wall_seconds (of the whole task on its worker), file.
+    one per path, status ("completed", "completed_with_warnings", "diverged", "solver_failed"),
+    reason, t_end (time reached), t_diverged (NaN unless diverged), steps, final_energy (total
+    energy at the end, J; NaN if not finite), wall_seconds (of the whole task on its worker), file.
 
     client: None starts a LocalCluster of n_workers (default: the number of cores, at most the
     number of runs) single-threaded worker processes and closes it afterwards; pass a

@@ -159,8 +159,8 @@ namespace {
 
 // Counts its frames and finishes; `log` (optional) records its name per frame.
 struct Counter final : Observer {
-  explicit Counter(std::string name = "", std::vector<std::string>* log = nullptr)
-      : name(std::move(name)), log(log) {}
+  explicit Counter(std::string counter_name = "", std::vector<std::string>* frame_log = nullptr)
+      : name(std::move(counter_name)), log(frame_log) {}
   void on_frame(const Simulator& /*sim*/) override {
     ++frames;
     if (log) log->push_back(name);

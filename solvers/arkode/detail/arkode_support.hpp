@@ -144,6 +144,12 @@ class Driver {
   Real last_h_ = 0;             // ARKODE's last internal step
   Counters total_, seen_;
   long resets_ = 0;
+  // Pinned particles: the largest distance of ARKODE's own values from their paths at an
+  // interval's end, in units of the error test's weight (rtol |value| + atol), and the restarts
+  // that put ARKODE back on the paths when that exceeded 1.
+  Real pin_drift_ = 0;
+  long pin_resyncs_ = 0;
+  bool pin_resync_ = false;
 };
 
 }  // namespace jelly::arkode

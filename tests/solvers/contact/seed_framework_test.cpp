@@ -91,7 +91,7 @@ TEST(SeedFramework, SymplecticEulerFrictionUsesTheNormalForce) {
 
 // Away from the zone the model changes nothing: the same run as without terrain contact.
 TEST(SeedFramework, InactiveOutsideTheZone) {
-  for (const std::string& name : {"explicit_euler", "midpoint", "rk4", "symplectic_euler"}) {
+  for (const std::string name : {"explicit_euler", "midpoint", "rk4", "symplectic_euler"}) {
     Simulator framework = particle_over_floor(name, ContactModel::kSeedFramework, 1, -1, 1e-3);
     Simulator coulomb = particle_over_floor(name, ContactModel::kCoulomb, 1, -1, 1e-3);
     ASSERT_TRUE(framework.run_until(0.1).ok());
@@ -104,7 +104,7 @@ TEST(SeedFramework, InactiveOutsideTheZone) {
 // A jelly dropped with the framework's rules lands and stays above the floor within a few
 // epsilons, for every explicit integrator.
 TEST(SeedFramework, JellyLandsWithEveryExplicitIntegrator) {
-  for (const std::string& name : {"explicit_euler", "midpoint", "rk4", "symplectic_euler"}) {
+  for (const std::string name : {"explicit_euler", "midpoint", "rk4", "symplectic_euler"}) {
     const Model m = build_cube(testing::small_cube(3, 1.0, Vec3(0, 0.3, 0)));
     Simulator sim = testing::make_sim(m, rest_state(m), name, 2.5e-4, 0.01);
     ContactParams contact;
