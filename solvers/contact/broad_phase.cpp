@@ -113,20 +113,23 @@ void BroadPhase::find_pairs_dense(const VecX& x, const VecX& radius, const Eigen
     for (int a = 0; a < 3; ++a) xs_[3 * s + a] = x[3 * i + a];
     rs_[s] = radius[i];
   }
+  // Each pair once: particle s meets the particles after it in the sorted order, which lie in
+  // its own row of cells (from s + 1) and in the 4 rows after it (dz = 0, dy = 1 and dz = 1,
+  // dy = -1..1); the 4 rows before hold none.
+  constexpr int kRows = 5;
+  const int row_offset[kRows] = {0, nx, nxy - nx, nxy, nxy + nx};
   for (int s = 0; s < n; ++s) {
     const int c = bucket_[sorted_[s]];
     const Real px = xs_[3 * s], py = xs_[3 * s + 1], pz = xs_[3 * s + 2], r = rs_[s];
-    for (int dz = -1; dz <= 1; ++dz) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        const int row = c + dy * nx + dz * nxy;  // cells row - 1 .. row + 1 are contiguous
-        const int end = start_[row + 2];
-        for (int t = std::max(start_[row - 1], s + 1); t < end; ++t) {
-          const Real ex = xs_[3 * t] - px, ey = xs_[3 * t + 1] - py, ez = xs_[3 * t + 2] - pz;
-          const Real reach = r + rs_[t];
-          if (ex * ex + ey * ey + ez * ez < reach * reach) {
-            const int i = sorted_[s], j = sorted_[t];
-            pairs.emplace_back(std::min(i, j), std::max(i, j));
-          }
+    for (int k = 0; k < kRows; ++k) {
+      const int row = c + row_offset[k];  // cells row - 1 .. row + 1 are contiguous
+      const int end = start_[row + 2];
+      for (int t = std::max(start_[row - 1], s + 1); t < end; ++t) {
+        const Real ex = xs_[3 * t] - px, ey = xs_[3 * t + 1] - py, ez = xs_[3 * t + 2] - pz;
+        const Real reach = r + rs_[t];
+        if (ex * ex + ey * ey + ez * ez < reach * reach) {
+          const int i = sorted_[s], j = sorted_[t];
+          pairs.emplace_back(std::min(i, j), std::max(i, j));
         }
       }
     }
