@@ -19,7 +19,9 @@ std::string json_element(const std::string& path, std::size_t index) {
 
 std::string json_text(const Json& value) {
   constexpr std::size_t kMaxLength = 80;
-  std::string text = value.dump();
+  // Invalid UTF-8 (a key or text from a --set assignment or a damaged file) is shown as U+FFFD
+  // instead of throwing from inside an error message.
+  std::string text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
   if (text.size() > kMaxLength) text = text.substr(0, kMaxLength - 3) + "...";
   return text;
 }

@@ -194,17 +194,24 @@ MeshFile read_mesh(const std::string& path, const std::string& field) {
   }
 
   const MeshTopology topo = mesh_topology(out.mesh);
+  // The messages name an example edge, which exists only when the test fails (the edge is
+  // {-1, -1} otherwise): they are built only then.
   const auto at = [&](int v) { return "(" + to_text(out.mesh.vertices[v].transpose()) + ")"; };
-  require(topo.non_manifold_edges == 0, field, value,
-          "a manifold mesh: each edge shared by at most two triangles (" +
-              std::to_string(topo.non_manifold_edges) + " edges are shared by more, e.g. " +
-              at(topo.first_non_manifold_edge[0]) + "-" + at(topo.first_non_manifold_edge[1]) +
-              ")");
-  require(topo.misoriented_edges == 0, field, value,
-          "a consistently oriented mesh: neighbouring triangles run through their shared edge "
-          "in opposite directions (" +
-              std::to_string(topo.misoriented_edges) + " edges do not, e.g. " +
-              at(topo.first_misoriented_edge[0]) + "-" + at(topo.first_misoriented_edge[1]) + ")");
+  if (topo.non_manifold_edges != 0) {
+    throw InputError(field, value,
+                     "a manifold mesh: each edge shared by at most two triangles (" +
+                         std::to_string(topo.non_manifold_edges) +
+                         " edges are shared by more, e.g. " + at(topo.first_non_manifold_edge[0]) +
+                         "-" + at(topo.first_non_manifold_edge[1]) + ")");
+  }
+  if (topo.misoriented_edges != 0) {
+    throw InputError(
+        field, value,
+        "a consistently oriented mesh: neighbouring triangles run through their shared edge "
+        "in opposite directions (" +
+            std::to_string(topo.misoriented_edges) + " edges do not, e.g. " +
+            at(topo.first_misoriented_edge[0]) + "-" + at(topo.first_misoriented_edge[1]) + ")");
+  }
   return out;
 }
 

@@ -89,6 +89,11 @@ void apply_override(Json& scene, const std::string& assignment) {
   }
   const std::string path = assignment.substr(0, equals);
   const std::string text = assignment.substr(equals + 1);
+  try {
+    (void)Json(path).dump();
+  } catch (const Json::exception&) {
+    throw InputError(set_name(assignment) + ": the path is not valid UTF-8 text");
+  }
   Json value;
   // A path and a value of at most half the nesting each keep the edited scene within it.
   if (!parse_json_if_json(text, set_name(assignment), &value, kMaxJsonDepth / 2)) {

@@ -36,13 +36,16 @@ struct Pristine {
 };
 
 std::string scratch_dir() {
-  static const std::string dir = [] {
+  // Never destroyed: the atexit handler that removes the folder runs after the destructors of
+  // statics constructed after its registration, this one among them (a use after free that
+  // AddressSanitizer reported at the fuzzer's exit).
+  static const std::string& dir = *new std::string([] {
     const std::string base = std::filesystem::exists("/dev/shm") ? "/dev/shm" : "/tmp";
     std::string pattern = base + "/jelly-fuzz-XXXXXX";
     if (mkdtemp(pattern.data()) == nullptr) std::abort();
     std::atexit([] { std::filesystem::remove_all(scratch_dir()); });
     return pattern;
-  }();
+  }());
   return dir;
 }
 

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/scene.hpp>
 
 namespace jelly {
@@ -102,6 +103,17 @@ TEST(JsonParse, NumbersBeyondADoubleAreInputErrors) {
 TEST(JsonParse, SetValuesThatAreNotUtf8AreRefused) {
   EXPECT_EQ(error_of(kMinimal, {"description=\xff\xfe"}),
             "--set 'description=\xff\xfe': the value is not valid UTF-8 text");
+  // A path with such bytes became an object key, and the unknown-key message dumped it: an
+  // uncaught JSON exception (jelly_set_fuzzer under make test-sanitize).
+  EXPECT_EQ(error_of(kMinimal, {"cube.\xff\xff.origin=[1,2,3]"}),
+            "--set 'cube.\xff\xff.origin=[1,2,3]': the path is not valid UTF-8 text");
+}
+
+// Messages show JSON that is not valid UTF-8 (from a damaged file) with U+FFFD, not an exception.
+TEST(JsonParse, MessagesShowInvalidUtf8AsReplacementCharacters) {
+  Json object = Json::object();
+  object["\xff"] = 1;
+  EXPECT_EQ(json_text(object), "{\"\xEF\xBF\xBD\":1}");
 }
 
 // The message of loading the scene file at `path`, or "" when it loads.
