@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <optional>
 
 #include <jelly/core/detail/anchor_jacobian.hpp>
@@ -184,22 +183,13 @@ StepResult ImplicitEuler::do_step(const Dynamics& dynamics, State& s, Real h) {
   return impl_->step(dynamics, s, h);
 }
 
-namespace {
-// A tolerance as people write it (1e-12, not 9.9999999999999998e-13).
-std::string short_number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-}  // namespace
-
 std::vector<ToleranceMiss> ImplicitEuler::tolerance_misses() const {
   const ImplicitEulerOptions& o = impl_->options_;
   if (o.newton_iterations <= 1) return {};
   return {
       {"implicit_euler: Newton did not converge within integrator.options.newton_iterations = " +
            std::to_string(o.newton_iterations) +
-           " (newton_tolerance = " + short_number(o.newton_tolerance) + ")",
+           " (newton_tolerance = " + tolerance_text(o.newton_tolerance) + ")",
        impl_->newton_not_converged_}};
 }
 

@@ -1,10 +1,17 @@
 #include <jelly/solvers/integrators/integrator.hpp>
 
 #include <cmath>
+#include <cstdio>
 
 #include <jelly/core/errors.hpp>
 
 namespace jelly {
+
+std::string tolerance_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
 
 StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
   require(std::isfinite(h) && h > 0, "dt", h, "a finite time step > 0");

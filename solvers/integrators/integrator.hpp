@@ -21,6 +21,8 @@ struct ToleranceMiss {
   std::string what;  // "implicit_euler: Newton did not converge (newton_iterations = 5, ...)"
   long steps = 0;    // steps that missed it
 };
+// A tolerance as people write it, for ToleranceMiss::what (1e-12, not 9.9999999999999998e-13).
+std::string tolerance_text(double value);
 
 // A recoverable numerical failure is a returned status, not an exception.
 struct StepResult {

@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 
 #include <Eigen/Eigenvalues>
 
@@ -67,19 +66,10 @@ int ProjectiveDynamics::contacts_resolved() const {
   return contact_active_ ? contact_->count() : 0;
 }
 
-namespace {
-// A tolerance as people write it (1e-12, not 9.9999999999999998e-13).
-std::string short_number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-}  // namespace
-
 std::vector<ToleranceMiss> ProjectiveDynamics::tolerance_misses() const {
   if (options_.tolerance == 0) return {};
   return {{"projective_dynamics: the residual stayed above integrator.options.tolerance = " +
-               short_number(options_.tolerance) +
+               tolerance_text(options_.tolerance) +
                " after iterations = " + std::to_string(options_.iterations),
            not_converged_}};
 }

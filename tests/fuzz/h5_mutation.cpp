@@ -25,6 +25,15 @@ const char* const kScenes[kPristineCount] = {
     R"({"cube": {"n": 2, "edge_length": 1, "origin": [-0.5, 0.02, -0.5]},
         "terrains": [{"kind": "plane"}],
         "integrator": {"name": "implicit_euler", "dt": 0.01}, "duration": 0.2,
+        "output_interval": 0.02})",
+    // Two cubes, the upper one landing on the lower within 0.1 s: the checkpoint holds
+    // implicit_euler's contact pairs between bodies.
+    R"({"bodies": [{"kind": "cube", "name": "low", "n": 2, "edge_length": 0.5,
+                    "origin": [-0.25, 0.01, -0.25]},
+                   {"kind": "cube", "name": "high", "n": 2, "edge_length": 0.5,
+                    "origin": [-0.25, 1.03, -0.25]}],
+        "terrains": [{"kind": "plane"}],
+        "integrator": {"name": "implicit_euler", "dt": 0.01}, "duration": 0.2,
         "output_interval": 0.02})"};
 
 struct Pristine {

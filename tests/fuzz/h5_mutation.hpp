@@ -13,8 +13,9 @@
 namespace jelly::fuzz {
 
 // The pristine recordings: 0 = rk4 with seed contact on the slope, 1 = implicit_euler with
-// coulomb contact inside its solve (a checkpoint with integrator state).
-constexpr int kPristineCount = 2;
+// coulomb contact inside its solve (a checkpoint with integrator state), 2 = implicit_euler with
+// two cubes in contact (its state holds contact pairs between bodies).
+constexpr int kPristineCount = 3;
 const Scene& pristine_scene(int which);
 // Makes the pristine recordings (simulations of 0.2 s, seconds under the sanitizers on a loaded
 // machine). The HDF5 targets call it from LLVMFuzzerInitialize, so that the time is not charged

@@ -334,7 +334,9 @@ TEST(Xdmf, EachBodyAndItsSurfaceAreBlocks) {
         const double s = body.surface.vertex(vf, static_cast<int>(i)).norm();
         EXPECT_NEAR(speed[i], s, 1e-6 * (1 + s)) << body.name << " frame " << f << " vertex " << i;
       }
-      if (f == frames - 1) EXPECT_GT(*std::max_element(speed.begin(), speed.end()), 0.5);
+      if (f == frames - 1) {
+        EXPECT_GT(*std::max_element(speed.begin(), speed.end()), 0.5);
+      }
     }
   }
   H5Fclose(file);

@@ -203,13 +203,10 @@ TEST(Arkode, EveryLinearSolverAgreesWithSchur) {
 // nothing restarts ARKODE (before, every interval restarted it: the pinned particle had moved
 // within the Newton tolerance and the Simulator put it back).
 TEST(Arkode, DirkHonoursPinsInsideItsNewtonSolves) {
-  const Real m = 1, ks = 100, kd = 2, l0 = 1, stretch = 0.1;
-  Model model;
-  model.mass = VecX::Constant(2, m);
-  model.rest_position = VecX::Zero(6);
-  model.rest_position[3] = l0;
-  model.springs.add(0, 1, l0, {ks, kd}, SpringType::kStructural);
-  model.gravity.setZero();
+  TwoParticleSpring sys;
+  sys.kd = 2;
+  const Real m = sys.m, ks = sys.ks, kd = sys.kd, l0 = sys.l0, stretch = sys.stretch;
+  Model model = sys.model();
   model.pins.add_fixed(0, Vec3::Zero());
   State s = rest_state(model);
   s.x[3] = l0 + stretch;
