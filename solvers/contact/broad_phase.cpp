@@ -16,6 +16,17 @@ int hash_cell(int cx, int cy, int cz, unsigned mask) {
   return static_cast<int>(h & mask);
 }
 
+// The cell of a coordinate (in cells), clamped to +-2^30 so that a huge, infinite or NaN
+// coordinate (a diverging run, a damaged checkpoint) has a cell too: converting those to int was
+// undefined (found by jelly_checkpoint_fuzzer). Far particles share the clamped cells, and the
+// distance test keeps them apart.
+int cell_index(Real coordinate) {
+  constexpr Real kLimit = Real(1 << 30);
+  const Real c = std::floor(coordinate);
+  if (!(c > -kLimit)) return -(1 << 30);
+  return c < kLimit ? static_cast<int>(c) : (1 << 30);
+}
+
 }  // namespace
 
 void BroadPhase::find_pairs(const VecX& x, const VecX& radius, std::vector<Pair>& pairs) {
@@ -49,7 +60,7 @@ void BroadPhase::find_pairs(const VecX& x, const VecX& radius, std::vector<Pair>
   cell_.resize(n);
   for (int i = 0; i < n; ++i) {
     std::array<int, 3>& c = cell_[i];
-    for (int a = 0; a < 3; ++a) c[a] = static_cast<int>(std::floor(x[3 * i + a] * inverse));
+    for (int a = 0; a < 3; ++a) c[a] = cell_index(x[3 * i + a] * inverse);
     bucket_[i] = hash_cell(c[0], c[1], c[2], mask);
     ++start_[bucket_[i] + 1];
   }

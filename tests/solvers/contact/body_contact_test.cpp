@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <jelly/core/errors.hpp>
@@ -36,6 +37,20 @@ Pairs brute_force(const VecX& x, const VecX& r) {
 
 // Random clouds of different densities, sizes and radii (negative coordinates, coincident
 // points, a lone large particle): the same pairs as a brute-force search, each once.
+// Huge, infinite and NaN coordinates (a diverging run, a damaged checkpoint) get a cell too:
+// converting them to an int cell index was undefined behaviour (jelly_checkpoint_fuzzer). Only
+// the two particles within reach pair up.
+TEST(BroadPhase, HugeAndNonFiniteCoordinatesPairWithNothing) {
+  const Real inf = std::numeric_limits<Real>::infinity();
+  VecX x(3 * 6);
+  x << 0, 0, 0, 0.5, 0, 0, 1e300, 0, 0, -1e300, 1e300, 0, inf, 0, -inf, std::nan(""), 0, 0;
+  const VecX radius = VecX::Constant(6, 0.3);
+  BroadPhase broad;
+  Pairs pairs;
+  broad.find_pairs(x, radius, pairs);
+  EXPECT_EQ(pairs, Pairs({{0, 1}}));
+}
+
 TEST(BroadPhase, FindsExactlyThePairsOfABruteForceSearch) {
   std::mt19937 rng(42);
   BroadPhase broad;
