@@ -41,13 +41,15 @@ void BroadPhase::find_pairs(const VecX& x, const VecX& radius, std::vector<Pair>
   // most 8 cells per particle: neighbouring cells along x are neighbours in memory. Else a hash.
   Eigen::Array3d lo = Eigen::Array3d::Constant(std::numeric_limits<Real>::infinity());
   Eigen::Array3d hi = -lo;
+  bool finite = true;  // a NaN coordinate would not widen the box: the hash's clamped cells
   for (int i = 0; i < n; ++i) {
     const Eigen::Array3d p(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+    finite = finite && p.allFinite();
     lo = lo.min(p);
     hi = hi.max(p);
   }
   const Eigen::Array3d span = ((hi - lo) * inverse).floor() + 3;
-  if (span.allFinite() && span.prod() <= 8.0 * n + 64) {
+  if (finite && span.allFinite() && span.prod() <= 8.0 * n + 64) {
     find_pairs_dense(x, radius, lo, inverse, span.cast<int>(), pairs);
     return;
   }

@@ -49,6 +49,12 @@ TEST(BroadPhase, HugeAndNonFiniteCoordinatesPairWithNothing) {
   Pairs pairs;
   broad.find_pairs(x, radius, pairs);
   EXPECT_EQ(pairs, Pairs({{0, 1}}));
+  // A NaN among finite coordinates did not widen the bounding box of the dense grid, and its
+  // cell index was undefined (jelly_checkpoint_fuzzer, after the fix above).
+  VecX y(3 * 3);
+  y << 0, 0, 0, 0.5, 0, 0, std::nan(""), 0, 0;
+  broad.find_pairs(y, VecX::Constant(3, 0.3), pairs);
+  EXPECT_EQ(pairs, Pairs({{0, 1}}));
 }
 
 TEST(BroadPhase, FindsExactlyThePairsOfABruteForceSearch) {
