@@ -167,8 +167,7 @@ Table convergence_orders(const Table& accuracy, const Table& reference) {
     const Real error = accuracy.number(r, "error");
     const std::string& status = accuracy.text(r, "status");
     const bool completed = status == "completed" || status == "completed_with_warnings";
-    if (completed && std::isfinite(error) && error > floor &&
-        error > 0) {
+    if (completed && std::isfinite(error) && error > floor && error > 0) {
       list.emplace_back(accuracy.number(r, "dt"), error);
     }
   }

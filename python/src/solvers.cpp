@@ -240,7 +240,8 @@ void bind_solvers(py::module_& m) {
       .def_property_readonly(
           "status", [](const RunReport& r) { return std::string(run_status_name(r.status)); },
           "\"completed\", \"completed_with_warnings\", \"diverged\" or \"solver_failed\".")
-      .def_property_readonly("ok", &RunReport::ok, "True when completed (with or without warnings).")
+      .def_property_readonly("ok", &RunReport::ok,
+                             "True when completed (with or without warnings).")
       .def_readonly("t", &RunReport::t, "Simulated time reached (s).")
       .def_readonly("steps", &RunReport::steps, "Steps taken in this run.")
       .def_readonly("reason", &RunReport::reason,

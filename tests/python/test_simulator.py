@@ -1,6 +1,7 @@
 """Simulation from Python: equal to `jelly run` bit for bit, NumPy views of the C++ state,
 callbacks at every frame, reports (also of diverged runs), the GIL released while stepping."""
 
+import re
 import threading
 import weakref
 
@@ -255,3 +256,34 @@ def test_anchor_springs_pull_particles(scenes):
     assert sim.anchors == []
     with pytest.raises(jelly.InputError):
         sim.set_anchors([jelly.AnchorSpring(10**6, target, 1.0)])
+
+
+def test_missed_tolerance_is_completed_with_warnings_as_in_jelly_run(scenes, run_cli):
+    # The small slope with coulomb contact at 1/60 s and Newton cut to 5 iterations (the CLI test
+    # SilentNumericalFailure.NewtonStoppedAboveItsToleranceIsAWarningCountedInTheSummary): the
+    # module reports the same status and the same count of missed steps as the jelly program.
+    sets = ["cube.n=3", "integrator.name=implicit_euler", "integrator.dt=0.0166667",
+            "duration=3", "integrator.options.newton_iterations=5",
+            "terrains[0].contact.model=coulomb"]
+    args = [a for s in sets for a in ("--set", s)]
+    done = run_cli("run", scenes / "seed_slope.json", *args)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("jelly run: completed_with_warnings at t = ")
+    missed = int(re.search(r"newton_not_converged = (\d+)", done.stdout).group(1))
+    assert missed > 0
+
+    scene = jelly.load_scene(scenes / "seed_slope.json", sets)
+    report = jelly.Simulator(scene).run_until(scene.duration)
+    assert report.status == "completed_with_warnings" and report.ok
+    assert report.statistics["newton_not_converged"] == missed
+    assert f"on {missed} of 180 steps" in report.reason
+
+
+def test_arkode_linear_solver_is_one_of_its_table():
+    options = jelly.IntegratorOptions()
+    assert options.arkode.linear_solver == "auto"
+    for name in ["auto", "cg", "jacobi", "gmres", "schur", "klu"]:
+        options.arkode.linear_solver = name
+        assert options.arkode.linear_solver == name
+    with pytest.raises(ValueError, match="linear_solver"):
+        options.arkode.linear_solver = "lu"
