@@ -2,8 +2,10 @@
 // integrator on the seed slope (contact included).
 #include <benchmark/benchmark.h>
 
+#include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/jelly.hpp>
+#include <jelly/solvers/linear/cg_solver.hpp>
 
 namespace {
 
@@ -45,6 +47,80 @@ void BM_ComputeForcesBanded(benchmark::State& bench) {
       static_cast<double>(model.springs.size()), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_ComputeForcesBanded)->Arg(10)->Arg(20)->Unit(benchmark::kMicrosecond);
+
+// One product y = A p with implicit_euler's matrix-free backward-Euler matrix (the inner loop of
+// its CG: core/detail/band_system.hpp) of the n^3 seed cube, slightly deformed, at dt = 1/60 s;
+// second argument the threads.
+void BM_MatrixFreeProduct(benchmark::State& bench) {
+  CubeSpec spec;
+  spec.n = static_cast<int>(bench.range(0));
+  const int threads = static_cast<int>(bench.range(1));
+  const Model model = build_cube(spec);
+  const SpringBands bands(model);
+  if (!bands.dense()) bench.SkipWithError("the cube's springs do not fill their bands");
+  State s = rest_state(model);
+  for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
+  BandSystem system(bands, model.num_particles());
+  const Real h = 1.0 / 60;
+  VecX kw(model.num_dofs());
+  system.assemble(model, s.x, s.v, DefinitenessFix::kClampCompressed, h, h * h, s.v, kw, threads);
+  VecX p(model.num_dofs()), y(model.num_dofs());
+  for (int i = 0; i < p.size(); ++i) p[i] = std::cos(0.11 * i);
+  for (auto _ : bench) {
+    system.multiply(p, y, threads);
+    benchmark::DoNotOptimize(y.data());
+  }
+  bench.counters["springs"] = model.springs.size();
+  bench.counters["s_per_spring"] = benchmark::Counter(
+      static_cast<double>(model.springs.size()),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_MatrixFreeProduct)
+    ->Args({20, 1})
+    ->Args({40, 1})
+    ->Args({40, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// 20 iterations of implicit_euler's matrix-free block-Jacobi CG (solvers/linear/cg_solver.hpp)
+// on the system of BM_MatrixFreeProduct: the product plus CG's vector operations, ordered sums
+// and preconditioner; second argument the threads.
+void BM_MatrixFreeCgIterations(benchmark::State& bench) {
+  CubeSpec spec;
+  spec.n = static_cast<int>(bench.range(0));
+  const int threads = static_cast<int>(bench.range(1));
+  const Model model = build_cube(spec);
+  const SpringBands bands(model);
+  if (!bands.dense()) bench.SkipWithError("the cube's springs do not fill their bands");
+  State s = rest_state(model);
+  for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
+  BandSystem system(bands, model.num_particles());
+  const Real h = 1.0 / 60;
+  VecX kw(model.num_dofs());
+  system.assemble(model, s.x, s.v, DefinitenessFix::kClampCompressed, h, h * h, s.v, kw, threads);
+  MatrixFreeCg cg;
+  cg.set_diagonal_blocks(
+      model.num_particles(), [&](int i, Real d[9]) { system.diagonal_block(i, d); }, threads);
+  VecX b(model.num_dofs()), x(model.num_dofs());
+  for (int i = 0; i < b.size(); ++i) b[i] = std::cos(0.11 * i);
+  const MatrixFreeCg::Product apply = [&](const VecX& in, VecX& out) {
+    system.multiply(in, out, threads);
+  };
+  constexpr int kIterations = 20;
+  for (auto _ : bench) {
+    x.setZero();
+    const LinearResult r = cg.solve(apply, b, x, 1e-300, kIterations, threads);
+    benchmark::DoNotOptimize(x.data());
+    if (r.iterations != kIterations) bench.SkipWithError("CG stopped early");
+  }
+  bench.counters["s_per_cg_iteration"] = benchmark::Counter(
+      kIterations, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_MatrixFreeCgIterations)
+    ->Args({40, 1})
+    ->Args({40, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // One step (integrator + contact) of the seed scene: cube n = 10 on the 20-degree slope,
 // after 0.5 s of settling so that contacts are active.
