@@ -13,9 +13,6 @@ namespace {
 
 // Springs per thread below which another thread costs more than it saves (as the force loop).
 constexpr long kMinSlotsPerThread = 8192;
-// Slots per chunk of a product: the chunk's terms (3 x 8 bytes per slot) stay in the L1 cache
-// between their computation and their accumulation.
-constexpr int kProductChunk = 512;
 
 struct Ends {
   const Real *xa, *ya, *za, *xb, *yb, *zb;
@@ -284,32 +281,20 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
       const SpringBands::Band& band = bands[k];
       const SpringBands::Band::Reach r = band.reach(p0, p1);
       if (r.lo >= r.hi) continue;
+      const int a = band.first + r.lo, b = a + band.offset;
+      const Ends ep{sp + a, sp + n + a, sp + 2 * n + a, sp + b, sp + n + b, sp + 2 * n + b};
       const Slots& s = slots_[k];
-      // The slots whose first end (a = first + slot) or second end (b = a + offset) is ours.
-      const int first_lo = r.a0 - band.first, first_hi = r.a1 - band.first;
-      const int second_lo = r.b0 - band.first - band.offset;
-      const int second_hi = r.b1 - band.first - band.offset;
-      // Chunks of kProductChunk slots, aligned on the band's slot 0 (not on this thread's
-      // range): each particle gets its two terms of the band in the same order for any thread
-      // count, and a chunk's terms are added while they are still in the L1 cache.
-      for (int c0 = r.lo / kProductChunk * kProductChunk; c0 < r.hi; c0 += kProductChunk) {
-        const int lo = std::max(c0, r.lo), hi = std::min(c0 + kProductChunk, r.hi);
-        const int a = band.first + lo, b = a + band.offset;
-        const Ends ep{sp + a, sp + n + a, sp + 2 * n + a, sp + b, sp + n + b, sp + 2 * n + b};
-        band_products(hi - lo, ep, s.c1.data() + lo, s.c2.data() + lo, s.ux.data() + lo,
-                      s.uy.data() + lo, s.uz.data() + lo, tx, ty, tz);
-        const int f0 = std::max(lo, first_lo), f1 = std::min(hi, first_hi);
-        if (f0 < f1) {
-          const int q = f0 - lo, at = band.first + f0;
-          band_kernels::add(f1 - f0, tx + q, ty + q, tz + q, acc + at, acc + n + at,
-                            acc + 2 * n + at);
-        }
-        const int s0 = std::max(lo, second_lo), s1 = std::min(hi, second_hi);
-        if (s0 < s1) {
-          const int q = s0 - lo, at = band.first + band.offset + s0;
-          band_kernels::subtract(s1 - s0, tx + q, ty + q, tz + q, acc + at, acc + n + at,
-                                 acc + 2 * n + at);
-        }
+      band_products(r.hi - r.lo, ep, s.c1.data() + r.lo, s.c2.data() + r.lo, s.ux.data() + r.lo,
+                    s.uy.data() + r.lo, s.uz.data() + r.lo, tx, ty, tz);
+      if (r.a0 < r.a1) {
+        const int q = r.a0 - a;
+        band_kernels::add(r.a1 - r.a0, tx + q, ty + q, tz + q, acc + r.a0, acc + n + r.a0,
+                          acc + 2 * n + r.a0);
+      }
+      if (r.b0 < r.b1) {
+        const int q = r.b0 - b;
+        band_kernels::subtract(r.b1 - r.b0, tx + q, ty + q, tz + q, acc + r.b0, acc + n + r.b0,
+                               acc + 2 * n + r.b0);
       }
     }
     for (int i = p0; i < p1; ++i) {
