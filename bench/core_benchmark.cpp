@@ -48,32 +48,50 @@ void BM_ComputeForcesBanded(benchmark::State& bench) {
 }
 BENCHMARK(BM_ComputeForcesBanded)->Arg(10)->Arg(20)->Unit(benchmark::kMicrosecond);
 
-// One product y = A p with implicit_euler's matrix-free backward-Euler matrix (the inner loop of
-// its CG: core/detail/band_system.hpp) of the n^3 seed cube, slightly deformed, at dt = 1/60 s;
-// second argument the threads.
+// implicit_euler's matrix-free backward-Euler matrix (core/detail/band_system.hpp) of the n^3
+// seed cube, slightly deformed, at dt = 1/60 s, assembled on `threads` threads.
+struct DeformedCubeSystem {
+  Model model;
+  SpringBands bands;
+  BandSystem system;
+
+  DeformedCubeSystem(int n, int threads)
+      : model(build_cube([n] {
+          CubeSpec spec;
+          spec.n = n;
+          return spec;
+        }())),
+        bands(model),
+        system(bands, model.num_particles()) {
+    State s = rest_state(model);
+    for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
+    const Real h = 1.0 / 60;
+    VecX kw(model.num_dofs());
+    system.assemble(model, s.x, s.v, DefinitenessFix::kClampCompressed, h, h * h, s.v, kw, threads);
+  }
+  // A smooth vector of the system's size.
+  VecX vector() const {
+    VecX p(model.num_dofs());
+    for (int i = 0; i < p.size(); ++i) p[i] = std::cos(0.11 * i);
+    return p;
+  }
+};
+
+// One product y = A p (the inner loop of implicit_euler's CG); arguments n and the threads.
 void BM_MatrixFreeProduct(benchmark::State& bench) {
-  CubeSpec spec;
-  spec.n = static_cast<int>(bench.range(0));
   const int threads = static_cast<int>(bench.range(1));
-  const Model model = build_cube(spec);
-  const SpringBands bands(model);
-  if (!bands.dense()) bench.SkipWithError("the cube's springs do not fill their bands");
-  State s = rest_state(model);
-  for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
-  BandSystem system(bands, model.num_particles());
-  const Real h = 1.0 / 60;
-  VecX kw(model.num_dofs());
-  system.assemble(model, s.x, s.v, DefinitenessFix::kClampCompressed, h, h * h, s.v, kw, threads);
-  VecX p(model.num_dofs()), y(model.num_dofs());
-  for (int i = 0; i < p.size(); ++i) p[i] = std::cos(0.11 * i);
+  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
+  if (!cube.bands.dense()) bench.SkipWithError("the cube's springs do not fill their bands");
+  const VecX p = cube.vector();
+  VecX y(p.size());
   for (auto _ : bench) {
-    system.multiply(p, y, threads);
+    cube.system.multiply(p, y, threads);
     benchmark::DoNotOptimize(y.data());
   }
-  bench.counters["springs"] = model.springs.size();
+  const double springs = static_cast<double>(cube.model.springs.size());
+  bench.counters["springs"] = springs;
   bench.counters["s_per_spring"] = benchmark::Counter(
-      static_cast<double>(model.springs.size()),
-      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+      springs, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_MatrixFreeProduct)
     ->Args({20, 1})
@@ -83,28 +101,20 @@ BENCHMARK(BM_MatrixFreeProduct)
     ->UseRealTime();
 
 // 20 iterations of implicit_euler's matrix-free block-Jacobi CG (solvers/linear/cg_solver.hpp)
-// on the system of BM_MatrixFreeProduct: the product plus CG's vector operations, ordered sums
-// and preconditioner; second argument the threads.
+// on the same system: the product plus CG's vector operations, ordered sums and preconditioner;
+// arguments n and the threads.
 void BM_MatrixFreeCgIterations(benchmark::State& bench) {
-  CubeSpec spec;
-  spec.n = static_cast<int>(bench.range(0));
   const int threads = static_cast<int>(bench.range(1));
-  const Model model = build_cube(spec);
-  const SpringBands bands(model);
-  if (!bands.dense()) bench.SkipWithError("the cube's springs do not fill their bands");
-  State s = rest_state(model);
-  for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
-  BandSystem system(bands, model.num_particles());
-  const Real h = 1.0 / 60;
-  VecX kw(model.num_dofs());
-  system.assemble(model, s.x, s.v, DefinitenessFix::kClampCompressed, h, h * h, s.v, kw, threads);
+  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
+  if (!cube.bands.dense()) bench.SkipWithError("the cube's springs do not fill their bands");
   MatrixFreeCg cg;
   cg.set_diagonal_blocks(
-      model.num_particles(), [&](int i, Real d[9]) { system.diagonal_block(i, d); }, threads);
-  VecX b(model.num_dofs()), x(model.num_dofs());
-  for (int i = 0; i < b.size(); ++i) b[i] = std::cos(0.11 * i);
+      cube.model.num_particles(), [&](int i, Real d[9]) { cube.system.diagonal_block(i, d); },
+      threads);
+  const VecX b = cube.vector();
+  VecX x(b.size());
   const MatrixFreeCg::Product apply = [&](const VecX& in, VecX& out) {
-    system.multiply(in, out, threads);
+    cube.system.multiply(in, out, threads);
   };
   constexpr int kIterations = 20;
   for (auto _ : bench) {
