@@ -80,6 +80,12 @@ struct DeformedCubeSystem {
   DeformedCubeSystem(const DeformedCubeSystem&) = delete;
   DeformedCubeSystem& operator=(const DeformedCubeSystem&) = delete;
 
+  // False (and the benchmark skipped, saying why) when the system could not be built.
+  bool usable(benchmark::State& bench) const {
+    if (error != nullptr) bench.SkipWithError(error);
+    return error == nullptr;
+  }
+
   // A smooth vector of the system's size.
   VecX vector() const {
     VecX p(model.num_dofs());
@@ -92,10 +98,7 @@ struct DeformedCubeSystem {
 void BM_MatrixFreeProduct(benchmark::State& bench) {
   const int threads = static_cast<int>(bench.range(1));
   const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
-  if (cube.error != nullptr) {
-    bench.SkipWithError(cube.error);
-    return;
-  }
+  if (!cube.usable(bench)) return;
   const VecX p = cube.vector();
   VecX y(p.size());
   for (auto _ : bench) {
@@ -121,10 +124,7 @@ BENCHMARK(BM_MatrixFreeProduct)
 void BM_MatrixFreeCgIterations(benchmark::State& bench) {
   const int threads = static_cast<int>(bench.range(1));
   const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
-  if (cube.error != nullptr) {
-    bench.SkipWithError(cube.error);
-    return;
-  }
+  if (!cube.usable(bench)) return;
   MatrixFreeCg cg;
   const LinearResult blocks = cg.set_diagonal_blocks(
       cube.model.num_particles(), [&](int i, Real d[9]) { cube.system.diagonal_block(i, d); },
