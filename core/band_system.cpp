@@ -13,6 +13,8 @@ namespace {
 
 // Springs per thread below which another thread costs more than it saves (as the force loop).
 constexpr long kMinSlotsPerThread = 8192;
+// Per-thread buffers of a pass over a band's slots: c1, c2, e1, ux, uy, uz, tx, ty, tz.
+constexpr size_t kBuffers = 9;
 
 struct Ends {
   const Real *xa, *ya, *za, *xb, *yb, *zb;
@@ -25,8 +27,8 @@ struct Ends {
 JELLY_VECTOR_CLONES
 int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
                 const Real* __restrict rest, const Real* __restrict ks, const Real* __restrict kd,
-                Real* __restrict c1, Real* __restrict c2, Real* __restrict ux, Real* __restrict uy,
-                Real* __restrict uz, Real* __restrict tx, Real* __restrict ty,
+                Real* __restrict c1, Real* __restrict c2, Real* __restrict e1, Real* __restrict ux,
+                Real* __restrict uy, Real* __restrict uz, Real* __restrict tx, Real* __restrict ty,
                 Real* __restrict tz) {
   const Real* __restrict xa = x.xa;
   const Real* __restrict ya = x.ya;
@@ -67,6 +69,7 @@ int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
     const Real along = ks[j] - s;
     c1[j] = alpha * kd[j] + beta * along;
     c2[j] = beta * s;
+    e1[j] = c1[j] * inv * inv;  // 0 for an empty slot (0 * 1e300 * 1e300 = 0)
     ux[j] = u0;
     uy[j] = u1;
     uz[j] = u2;
@@ -80,23 +83,31 @@ int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
   return collapsed;
 }
 
-// Per slot t = B (p_a - p_b) = c1 (u . d) u + c2 d.
+// Per slot t = B (p_a - p_b) = c1 (u . d) u + c2 d = e1 (e . d) e + c2 d, with e = x_a - x_b
+// (u = e / |e|) recomputed from the positions and e1 = c1 / |e|^2: 16 bytes per slot to read
+// instead of 40 (at n = 40 they then fit in a 32 MB L3 cache; docs/benchmarks.md).
 JELLY_VECTOR_CLONES
-void band_products(int n, Ends p, const Real* __restrict c1, const Real* __restrict c2,
-                   const Real* __restrict ux, const Real* __restrict uy, const Real* __restrict uz,
+void band_products(int n, Ends x, Ends p, const Real* __restrict e1, const Real* __restrict c2,
                    Real* __restrict tx, Real* __restrict ty, Real* __restrict tz) {
-  const Real* __restrict xa = p.xa;
-  const Real* __restrict ya = p.ya;
-  const Real* __restrict za = p.za;
-  const Real* __restrict xb = p.xb;
-  const Real* __restrict yb = p.yb;
-  const Real* __restrict zb = p.zb;
+  const Real* __restrict xa = x.xa;
+  const Real* __restrict ya = x.ya;
+  const Real* __restrict za = x.za;
+  const Real* __restrict xb = x.xb;
+  const Real* __restrict yb = x.yb;
+  const Real* __restrict zb = x.zb;
+  const Real* __restrict pxa = p.xa;
+  const Real* __restrict pya = p.ya;
+  const Real* __restrict pza = p.za;
+  const Real* __restrict pxb = p.xb;
+  const Real* __restrict pyb = p.yb;
+  const Real* __restrict pzb = p.zb;
   for (int j = 0; j < n; ++j) {
-    const Real d0 = xa[j] - xb[j], d1 = ya[j] - yb[j], d2 = za[j] - zb[j];
-    const Real ud = c1[j] * (ux[j] * d0 + uy[j] * d1 + uz[j] * d2);
-    tx[j] = ud * ux[j] + c2[j] * d0;
-    ty[j] = ud * uy[j] + c2[j] * d1;
-    tz[j] = ud * uz[j] + c2[j] * d2;
+    const Real u0 = xa[j] - xb[j], u1 = ya[j] - yb[j], u2 = za[j] - zb[j];
+    const Real d0 = pxa[j] - pxb[j], d1 = pya[j] - pyb[j], d2 = pza[j] - pzb[j];
+    const Real ud = e1[j] * (u0 * d0 + u1 * d1 + u2 * d2);
+    tx[j] = ud * u0 + c2[j] * d0;
+    ty[j] = ud * u1 + c2[j] * d1;
+    tz[j] = ud * u2 + c2[j] * d2;
   }
 }
 
@@ -142,24 +153,22 @@ BandSystem::BandSystem(const SpringBands& bands, int num_particles)
   for (const SpringBands::Band& band : bands.bands()) {
     Slots s;
     const size_t n = band.spring.size();
-    s.c1.assign(n, 0.0);
+    s.e1.assign(n, 0.0);
     s.c2.assign(n, 0.0);
-    s.ux.assign(n, 0.0);
-    s.uy.assign(n, 0.0);
-    s.uz.assign(n, 0.0);
     slots_.push_back(std::move(s));
   }
   for (const auto& band : bands.bands()) slots_total_ += band.slots();
   stride_ = static_cast<size_t>(num_particles) + static_cast<size_t>(bands.max_offset());
   mass_.assign(num_particles, 0.0);
   diagonal_.assign(6 * static_cast<size_t>(num_particles), 0.0);
-  scratch_.assign(12 * static_cast<size_t>(num_particles), 0.0);
+  positions_.assign(3 * static_cast<size_t>(num_particles), 0.0);
+  scratch_.assign(9 * static_cast<size_t>(num_particles), 0.0);
 }
 
 int BandSystem::team(int threads) const {
   const int team = parallel::team_size(threads, slots_total_, kMinSlotsPerThread);
-  if (band_.size() < static_cast<size_t>(team) * 8 * stride_) {
-    band_.assign(static_cast<size_t>(team) * 8 * stride_, 0.0);
+  if (band_.size() < static_cast<size_t>(team) * kBuffers * stride_) {
+    band_.assign(static_cast<size_t>(team) * kBuffers * stride_, 0.0);
   }
   return team;
 }
@@ -174,8 +183,8 @@ bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, Defi
   const int fix_code = fix == DefinitenessFix::kClampCompressed ? 1
                        : fix == DefinitenessFix::kProjectPsd    ? 2
                                                                 : 0;
-  Real* sx = scratch_.data();
-  Real* sv = sx + 3 * static_cast<size_t>(n);
+  Real* sx = positions_.data();
+  Real* sv = scratch_.data();
   Real* sw = sv + 3 * static_cast<size_t>(n);
   Real* acc = sw + 3 * static_cast<size_t>(n);
   Real* diag = diagonal_.data();
@@ -195,10 +204,11 @@ bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, Defi
       mass_[i] = m[i];
     }
 #pragma omp barrier
-    Real* buffer = band_.data() + static_cast<size_t>(part) * 8 * stride;
+    Real* buffer = band_.data() + static_cast<size_t>(part) * kBuffers * stride;
     Real* c1 = buffer;
     Real* c2 = c1 + stride;
-    Real* ux = c2 + stride;
+    Real* e1 = c2 + stride;
+    Real* ux = e1 + stride;
     Real* uy = ux + stride;
     Real* uz = uy + stride;
     Real* tx = uz + stride;
@@ -213,18 +223,15 @@ bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, Defi
       const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
       const Ends ev{sv + a, sv + n + a, sv + 2 * n + a, sv + b, sv + n + b, sv + 2 * n + b};
       const Ends ew{sw + a, sw + n + a, sw + 2 * n + a, sw + b, sw + n + b, sw + 2 * n + b};
-      collapsed +=
-          band_blocks(r.hi - r.lo, fix_code, alpha, beta, ex, ev, ew, band.rest.data() + r.lo,
-                      band.ks.data() + r.lo, band.kd.data() + r.lo, c1, c2, ux, uy, uz, tx, ty, tz);
+      collapsed += band_blocks(r.hi - r.lo, fix_code, alpha, beta, ex, ev, ew,
+                               band.rest.data() + r.lo, band.ks.data() + r.lo,
+                               band.kd.data() + r.lo, c1, c2, e1, ux, uy, uz, tx, ty, tz);
       // This thread stores the slots whose first particle is its own.
       Slots& out = slots_[k];
       if (r.a0 < r.a1) {
         const int q = r.a0 - a, slot = r.a0 - band.first, len = r.a1 - r.a0;
-        std::copy(c1 + q, c1 + q + len, out.c1.data() + slot);
+        std::copy(e1 + q, e1 + q + len, out.e1.data() + slot);
         std::copy(c2 + q, c2 + q + len, out.c2.data() + slot);
-        std::copy(ux + q, ux + q + len, out.ux.data() + slot);
-        std::copy(uy + q, uy + q + len, out.uy.data() + slot);
-        std::copy(uz + q, uz + q + len, out.uz.data() + slot);
         add_slot_terms(n, r.a0, len, q, true, c1, c2, ux, uy, uz, tx, ty, tz, acc, diag);
       }
       if (r.b0 < r.b1) {
@@ -262,8 +269,9 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
   const std::vector<SpringBands::Band>& bands = bands_->bands();
   const int team = this->team(threads);
   const size_t stride = stride_;
+  const Real* sx = positions_.data();
   Real* sp = scratch_.data();
-  Real* acc = sp + 9 * static_cast<size_t>(n);
+  Real* acc = sp + 3 * static_cast<size_t>(n);
   parallel::run(team, [&](int part, int parts) {
     const parallel::Range range = parallel::split(n, part, parts);
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
@@ -274,7 +282,7 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
       }
     }
 #pragma omp barrier
-    Real* tx = band_.data() + static_cast<size_t>(part) * 8 * stride;
+    Real* tx = band_.data() + static_cast<size_t>(part) * kBuffers * stride;
     Real* ty = tx + stride;
     Real* tz = ty + stride;
     for (size_t k = 0; k < bands.size(); ++k) {
@@ -282,20 +290,11 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
       const SpringBands::Band::Reach r = band.reach(p0, p1);
       if (r.lo >= r.hi) continue;
       const int a = band.first + r.lo, b = a + band.offset;
+      const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
       const Ends ep{sp + a, sp + n + a, sp + 2 * n + a, sp + b, sp + n + b, sp + 2 * n + b};
       const Slots& s = slots_[k];
-      band_products(r.hi - r.lo, ep, s.c1.data() + r.lo, s.c2.data() + r.lo, s.ux.data() + r.lo,
-                    s.uy.data() + r.lo, s.uz.data() + r.lo, tx, ty, tz);
-      if (r.a0 < r.a1) {
-        const int q = r.a0 - a;
-        band_kernels::add(r.a1 - r.a0, tx + q, ty + q, tz + q, acc + r.a0, acc + n + r.a0,
-                          acc + 2 * n + r.a0);
-      }
-      if (r.b0 < r.b1) {
-        const int q = r.b0 - b;
-        band_kernels::subtract(r.b1 - r.b0, tx + q, ty + q, tz + q, acc + r.b0, acc + n + r.b0,
-                               acc + 2 * n + r.b0);
-      }
+      band_products(r.hi - r.lo, ex, ep, s.e1.data() + r.lo, s.c2.data() + r.lo, tx, ty, tz);
+      band_kernels::add_ends(a, b, r.a0, r.a1, r.b0, r.b1, tx, ty, tz, acc, acc + n, acc + 2 * n);
     }
     for (int i = p0; i < p1; ++i) {
       for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c * n + i];

@@ -86,6 +86,44 @@ void subtract(int n, const Real* __restrict tx, const Real* __restrict ty,
   }
 }
 
+JELLY_VECTOR_CLONES
+void add_difference(int n, const Real* __restrict ux, const Real* __restrict uy,
+                    const Real* __restrict uz, const Real* __restrict wx, const Real* __restrict wy,
+                    const Real* __restrict wz, Real* __restrict ax, Real* __restrict ay,
+                    Real* __restrict az) {
+  for (int j = 0; j < n; ++j) {
+    ax[j] += ux[j] - wx[j];
+    ay[j] += uy[j] - wy[j];
+    az[j] += uz[j] - wz[j];
+  }
+}
+
+void add_ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx, const Real* ty,
+              const Real* tz, Real* ax, Real* ay, Real* az) {
+  // Particles in both ranges: one pass, t_first - t_second. Elsewhere +t or -t alone, which
+  // are the same bits as the difference with a zero term (x - 0 = x, acc + -x = acc - x).
+  const int o0 = std::max(a0, b0), o1 = std::min(a1, b1);
+  const auto first_ends = [&](int i0, int i1) {
+    if (i0 < i1)
+      add(i1 - i0, tx + (i0 - a), ty + (i0 - a), tz + (i0 - a), ax + i0, ay + i0, az + i0);
+  };
+  const auto second_ends = [&](int i0, int i1) {
+    if (i0 < i1)
+      subtract(i1 - i0, tx + (i0 - b), ty + (i0 - b), tz + (i0 - b), ax + i0, ay + i0, az + i0);
+  };
+  if (o0 >= o1) {
+    first_ends(a0, a1);
+    second_ends(b0, b1);
+    return;
+  }
+  add_difference(o1 - o0, tx + (o0 - a), ty + (o0 - a), tz + (o0 - a), tx + (o0 - b), ty + (o0 - b),
+                 tz + (o0 - b), ax + o0, ay + o0, az + o0);
+  first_ends(a0, o0);
+  first_ends(o1, a1);
+  second_ends(b0, o0);
+  second_ends(o1, b1);
+}
+
 }  // namespace band_kernels
 
 SpringBands::Band::Reach SpringBands::Band::reach(int p0, int p1) const {

@@ -19,5 +19,11 @@ namespace jelly::band_kernels {
 void add(int n, const Real* tx, const Real* ty, const Real* tz, Real* ax, Real* ay, Real* az);
 // a[j] -= t[j] for j in [0, n), for the three coordinates.
 void subtract(int n, const Real* tx, const Real* ty, const Real* tz, Real* ax, Real* ay, Real* az);
+// A band's per-slot terms t (t[0] the term of the slot whose first end is particle a and
+// second end particle b) added to particles: a[i] += t(slot with first end i) for i in
+// [a0, a1) and a[i] -= t(slot with second end i) for i in [b0, b1), as a[i] += t_first - t_second
+// where a particle is both (one pass; the same bits for any split of the particles).
+void add_ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx, const Real* ty,
+              const Real* tz, Real* ax, Real* ay, Real* az);
 
 }  // namespace jelly::band_kernels

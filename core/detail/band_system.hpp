@@ -1,11 +1,12 @@
 #pragma once
 // The backward-Euler matrix A = M - alpha D - beta K of a lattice without an assembled sparse
 // matrix: per spring slot of the force loop's bands (core/detail/spring_bands.hpp) its 3x3 block
-// B = -alpha D_k - beta K_k = c1 u u^T + c2 I (u the spring's unit direction) as five numbers,
-// and products A p = M p + sum over springs of +-B (p_a - p_b) computed band by band like the
+// B = -alpha D_k - beta K_k = c1 u u^T + c2 I (u the spring's unit direction) as two numbers,
+// c1 / |e|^2 and c2 with e = x_a - x_b recomputed from the positions kept at assembly, and
+// products A p = M p + sum over springs of +-B (p_a - p_b) computed band by band like the
 // force loop (vectorised, threaded by particle ranges: the same bits for any thread count).
-// 40 bytes per spring instead of about 220 for the full compressed-column matrix, and each
-// product reads a fifth of the memory (docs/implicit.md, "Matrix-free CG").
+// 16 bytes per spring instead of about 220 for the full compressed-column matrix (docs/implicit.md,
+// "Matrix-free CG"; docs/benchmarks.md has the products' times).
 #include <vector>
 
 #include <jelly/core/definiteness.hpp>
@@ -40,18 +41,19 @@ class BandSystem {
 
  private:
   struct Slots {
-    std::vector<Real> c1, c2, ux, uy, uz;  // [slots]
+    std::vector<Real> e1, c2;  // [slots]: c1 / |x_a - x_b|^2 and c2
   };
   // The threads of a pass over the slots, with band_ sized for them.
   int team(int threads) const;
 
   const SpringBands* bands_ = nullptr;
   int num_particles_ = 0;
-  long slots_total_ = 0;        // slots of all bands
-  size_t stride_ = 0;           // per-thread buffer length: N + the largest offset
-  std::vector<Slots> slots_;    // per band
-  std::vector<Real> mass_;      // [N] m + the diagonal additions
-  std::vector<Real> diagonal_;  // [6N] xx, yy, zz, xy, xz, yz of the spring part of A_ii
+  long slots_total_ = 0;         // slots of all bands
+  size_t stride_ = 0;            // per-thread buffer length: N + the largest offset
+  std::vector<Slots> slots_;     // per band
+  std::vector<Real> mass_;       // [N] m + the diagonal additions
+  std::vector<Real> diagonal_;   // [6N] xx, yy, zz, xy, xz, yz of the spring part of A_ii
+  std::vector<Real> positions_;  // [3N] x, y, z of the particles at the last assembly
   // Scratch: SoA copies of the inputs, accumulators, and per thread its slots' terms.
   mutable std::vector<Real> scratch_;
   mutable std::vector<Real> band_;
