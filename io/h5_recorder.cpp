@@ -105,6 +105,22 @@ struct Batch {
 // the largest divisor of it whose chunk fits in HDF5's 1 MiB chunk cache. A chunk then never
 // spans two flushes, so a flush writes whole new chunks and never rewrites (and moves) a
 // compressed chunk that the file on disk already points to: a killed run leaves intact chunks.
+// The frames of a block held in memory (each block waits in one of up to four batches: being
+// filled, two queued, one being written) are limited to this many bytes of particle data: a large
+// body is flushed in blocks of fewer frames than flush_every_frames (n = 40: 2 frames of 3 MB).
+constexpr size_t kMaxBlockBytes = size_t{8} << 20;
+
+// Frames per block: flush_every_frames, or when frames of `frame_bytes` bytes would exceed
+// kMaxBlockBytes, the largest power of two that fits (a power of two divides into chunks of any
+// smaller power of two; chunk_frames), at least 1.
+int block_frames(int flush_every, size_t frame_bytes) {
+  const size_t fit = kMaxBlockBytes / std::max<size_t>(frame_bytes, 1);
+  if (static_cast<size_t>(flush_every) <= fit) return flush_every;
+  size_t block = 1;
+  while (2 * block <= fit) block *= 2;
+  return static_cast<int>(block);
+}
+
 hsize_t chunk_frames(size_t values, int flush_every) {
   const size_t bytes = 8 * std::max<size_t>(values, 1);
   for (int d = flush_every; d > 1; --d) {
@@ -186,6 +202,7 @@ struct H5Recorder::Impl {
   std::vector<h5::Series> observables, terrains, terrain_rotations;
   std::unique_ptr<h5::CheckpointWriter> checkpoint;
   long frames_received = 0;
+  int block = 1;  // frames per flush block (block_frames)
 
   // Writer-thread side: the HDF5 work and the observables happen there, under the library mutex.
   VecX x_work, v_work;
@@ -276,7 +293,13 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
   h5::write_attribute(par, "run_status", std::string("running"));
 
   const int level = options.compression_level;
-  const int every = options.flush_every_frames;
+  // Per frame: positions and velocities of every particle, and the surfaces' vertices.
+  size_t frame_bytes = 48 * static_cast<size_t>(n);
+  for (const Body& b : model.bodies) {
+    if (!b.surface.empty()) frame_bytes += 24 * static_cast<size_t>(b.surface.num_vertices());
+  }
+  block = block_frames(options.flush_every_frames, frame_bytes);
+  const int every = block;
   h5::create_group(f, "particles");
   if (model.bodies.empty()) {
     bodies.push_back({"jelly", 0, n, nullptr, {}, {}, {}, {}, {}, {}});
@@ -611,7 +634,7 @@ void H5Recorder::on_frame(const Simulator& sim) {
   }
   ++b.frames;
   ++m.frames_received;
-  if (static_cast<int>(b.frames) >= m.options.flush_every_frames) {
+  if (static_cast<int>(b.frames) >= m.block) {
     b.checkpoint = sim.snapshot();
     b.has_checkpoint = true;
     m.submit();

@@ -32,7 +32,16 @@ using h5::check;
 using h5::Handle;
 
 constexpr long kLayoutVersion = 2;    // of /xdmf; a group of another version is rebuilt
-constexpr hsize_t kBlockFrames = 32;  // frames read and derived at a time
+constexpr hsize_t kBlockFrames = 32;  // frames read and derived at a time, at most
+// ... and at most this many bytes of them (n = 40: 7 MB a frame, 2 frames at a time; before, 32
+// frames took 230 MB and were most of a recorded run's peak memory).
+constexpr hsize_t kBlockBytes = hsize_t{16} << 20;
+
+// Frames per pass for frames of `frame_bytes` bytes: kBlockFrames, fewer for large frames, >= 1.
+hsize_t frames_per_pass(hsize_t frame_bytes) {
+  return std::max<hsize_t>(1,
+                           std::min(kBlockFrames, kBlockBytes / std::max<hsize_t>(frame_bytes, 1)));
+}
 // Strain is stored to 5 decimals (HDF5 scale-offset, lossy: |error| < 1e-5, invisible in a
 // colour map), which halves its size; speed is stored as computed (float32).
 constexpr int kStrainDigits = 5;
@@ -547,8 +556,10 @@ void update_body(hid_t file, const Recording& r, const RecordedBody& body, hsize
   // Positions are read for the bounding box of every new frame (terrain meshes are sized by it).
   const hsize_t from = std::min({speed_done, strain_done, first_new_view});
   std::vector<float> speed_rows, strain_rows;
-  for (hsize_t f0 = from; f0 < r.frames; f0 += kBlockFrames) {
-    const hsize_t count = std::min(kBlockFrames, r.frames - f0);
+  // Per frame: positions and velocities read (doubles), speeds and strains derived (floats).
+  const hsize_t pass = frames_per_pass(48 * n + 4 * n + (options.strain ? 4 * m : 0));
+  for (hsize_t f0 = from; f0 < r.frames; f0 += pass) {
+    const hsize_t count = std::min(pass, r.frames - f0);
     const std::vector<double> x = read_rows<double>(position.get(), f0, count, H5T_NATIVE_DOUBLE);
     for (hsize_t k = 0; k < count * n; ++k) bounds.add(Vec3(x[3 * k], x[3 * k + 1], x[3 * k + 2]));
     if (f0 + count > speed_done) {
@@ -611,8 +622,9 @@ void update_surface(hid_t file, const Recording& r, const RecordedBody& body,
       series(group.get(), "speed", H5T_IEEE_F32LE, {vertices}, options.compression_level);
   const hsize_t done = std::min(r.frames, h5::dataset_dims(speed.get())[0]);
   std::vector<float> rows;
-  for (hsize_t f0 = done; f0 < r.frames; f0 += kBlockFrames) {
-    const hsize_t count = std::min(kBlockFrames, r.frames - f0);
+  const hsize_t pass = frames_per_pass(24 * n + 4 * vertices);
+  for (hsize_t f0 = done; f0 < r.frames; f0 += pass) {
+    const hsize_t count = std::min(pass, r.frames - f0);
     const std::vector<double> v = read_rows<double>(velocity.get(), f0, count, H5T_NATIVE_DOUBLE);
     rows.assign(count * vertices, 0.0f);
     for (hsize_t f = 0; f < count; ++f) {

@@ -169,6 +169,35 @@ TEST(Layout, NamesAndShapes) {
   H5Fclose(file);
 }
 
+// A block of frames held in memory is at most 8 MiB of particle data: with flush_every_frames =
+// 1000, a cube of 11^3 = 1331 particles (63,888 bytes a frame: 131 fit) is flushed in blocks of
+// 128 frames (the largest power of two that fits), so its position chunks hold 32 frames (the
+// largest divisor of 128 whose chunk fits in 1 MiB; blocks of 1000 would give 25).
+TEST(Layout, LargeFramesAreFlushedInSmallerBlocks) {
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  Simulator sim = testing::slope_sim(ContactModel::kCoulomb, 11);
+  ASSERT_EQ(sim.model().num_particles(), 1331);
+  RecorderOptions options;
+  options.flush_every_frames = 1000;
+  {
+    H5Recorder recorder(path, sim, options);
+    sim.add_observer(recorder);
+    ASSERT_TRUE(sim.run_until(0.05).ok());
+  }
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const hid_t d = H5Dopen2(file, "/particles/jelly/position/value", H5P_DEFAULT);
+  const hid_t plist = H5Dget_create_plist(d);
+  hsize_t chunk[3] = {0, 0, 0};
+  EXPECT_EQ(H5Pget_chunk(plist, 3, chunk), 3);
+  EXPECT_EQ(chunk[0], 32u);
+  EXPECT_EQ(chunk[1], 1331u);
+  H5Pclose(plist);
+  H5Dclose(d);
+  H5Fclose(file);
+}
+
 TEST(Describe, SummarisesTheRun) {
   TempDir dir;
   const std::string path = dir.file("info.h5");
