@@ -264,7 +264,7 @@ void BandSystem::diagonal_block(int i, Real out[9]) const {
   out[5] = out[7] = d[5 * n];
 }
 
-void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
+void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) const {
   const int n = num_particles_;
   const std::vector<SpringBands::Band>& bands = bands_->bands();
   const int team = this->team(threads);
@@ -276,9 +276,15 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads) const {
     const parallel::Range range = parallel::split(n, part, parts);
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
     for (int i = p0; i < p1; ++i) {
+      Real q[3] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
+      if (input.slot != nullptr && input.slot[i] >= 0) {
+        const Real* f = input.map + 9 * static_cast<size_t>(input.slot[i]);
+        const Real q0 = q[0], q1 = q[1], q2 = q[2];
+        for (int c = 0; c < 3; ++c) q[c] = f[c] * q0 + f[3 + c] * q1 + f[6 + c] * q2;
+      }
       for (int c = 0; c < 3; ++c) {
-        sp[c * n + i] = p[3 * i + c];
-        acc[c * n + i] = mass_[i] * p[3 * i + c];
+        sp[c * n + i] = q[c];
+        acc[c * n + i] = mass_[i] * q[c];
       }
     }
 #pragma omp barrier

@@ -15,6 +15,14 @@
 
 namespace jelly {
 
+// A linear map of the product's input at some particles (implicit_euler's contact filter):
+// p_i -> map[slot[i]] p_i where slot[i] >= 0 (slot: one entry per particle; map: 3x3,
+// column-major). Applied while the input is copied, so the filtered input costs no extra pass.
+struct InputMap {
+  const int* slot = nullptr;
+  const Real* map = nullptr;  // 9 numbers per slot
+};
+
 class BandSystem {
  public:
   BandSystem() = default;
@@ -34,8 +42,9 @@ class BandSystem {
                 Real beta, const VecX& w, VecX& kw, int threads);
   // A_pp += value I (anchors, wind drag). Call after assemble.
   void add_diagonal(int particle, Real value);
-  // y = A p. No allocation after the first call with this thread count.
-  void multiply(const VecX& p, VecX& y, int threads) const;
+  // y = A p, or y = A (F p) with F the map `input` (when its slot is not null). No allocation
+  // after the first call with this thread count.
+  void multiply(const VecX& p, VecX& y, int threads, InputMap input = {}) const;
   // The diagonal 3x3 block of particle i, row-major.
   void diagonal_block(int i, Real out[9]) const;
 

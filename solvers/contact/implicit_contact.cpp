@@ -311,10 +311,13 @@ bool ImplicitContact::constrain_rhs(const VecX& b, bool prescribe, const VecX* a
   return true;
 }
 
-void ImplicitContact::filter_input(const VecX& p, VecX& q) const {
-  q = p;
-  for (const Contact& c : contacts_)
-    particle(q, c.particle) = free_projector(c) * particle(p, c.particle);
+InputMap ImplicitContact::input_map() {
+  projectors_.resize(9 * contacts_.size());
+  for (size_t k = 0; k < contacts_.size(); ++k) {
+    const Mat3 s = free_projector(contacts_[k]);
+    std::copy(s.data(), s.data() + 9, projectors_.data() + 9 * k);
+  }
+  return InputMap{slot_.data(), projectors_.data()};
 }
 
 void ImplicitContact::filter_output(const VecX& p, VecX& y) const {

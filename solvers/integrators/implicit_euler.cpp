@@ -120,7 +120,7 @@ struct ImplicitEuler::Impl {
   bool matrix_free_failed_ = false;  // a collapsed spring: the assembled path from then on
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
-  VecX az_, filtered_;
+  VecX az_;
   int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
@@ -298,7 +298,6 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       a_ = SparseMatrix();
       band_.emplace(*bands, model.num_particles());
       az_.setZero(n);
-      filtered_.setZero(n);
       size_vectors();
       matrix_free_ = true;
       factorization_seconds_ += seconds_since(start);
@@ -400,14 +399,10 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
   factorization_seconds_ += seconds_since(start);
   if (r.ok()) {
     start = Clock::now();
+    const InputMap input = constrained ? contact_.input_map() : InputMap{};
     const auto apply = [&](const VecX& in, VecX& out) {
-      if (!constrained) {
-        band_->multiply(in, out, threads_);
-        return;
-      }
-      contact_.filter_input(in, filtered_);
-      band_->multiply(filtered_, out, threads_);
-      contact_.filter_output(in, out);
+      band_->multiply(in, out, threads_, input);
+      if (constrained) contact_.filter_output(in, out);
     };
     r = band_cg_.solve(apply, b, y, options_.cg_tolerance, options_.cg_max_iterations, threads_);
     solve_seconds_ += seconds_since(start);

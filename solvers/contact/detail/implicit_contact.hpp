@@ -35,6 +35,7 @@
 
 #include <Eigen/SparseCore>
 
+#include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
@@ -97,9 +98,10 @@ class ImplicitContact {
   //     whether z is non-zero), then with A z (forms rhs and projects guess).
   bool constrain_rhs(const VecX& b, bool prescribe, const VecX* a_z, VecX& rhs, VecX& z,
                      VecX& guess);
-  //   filter_input: q = p with q_c = S_c p_c at the contacts (q = p elsewhere);
+  //   input_map: q = p with q_c = S_c p_c at the contacts (q = p elsewhere), as a map for
+  //     BandSystem::multiply (valid until the contacts change);
   //   filter_output: y_c = S_c y_c + C_c p_c + (I - S_c) p_c at the contacts, for y = A q.
-  void filter_input(const VecX& p, VecX& q) const;
+  InputMap input_map();
   void filter_output(const VecX& p, VecX& y) const;
   //   the filtered diagonal block S D S + C + I - S of a contact particle (D row-major, in
   //     place), for block Jacobi; returns false for a particle without contact.
@@ -158,6 +160,7 @@ class ImplicitContact {
   VecX x0_, v0_;
   std::vector<Contact> contacts_, next_;
   std::vector<int> slot_;          // [N]: index into contacts_ or -1
+  std::vector<Real> projectors_;   // [9 * contacts]: S_c column-major (input_map)
   std::vector<char> pinned_mask_;  // [N]: pinned this step
   std::vector<Real> saved_;        // original values of the constrained columns
   std::vector<int> saved_at_;      // [contacts]: offset into saved_
