@@ -85,7 +85,7 @@ int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
 
 // Per slot t = B (p_a - p_b) = c1 (u . d) u + c2 d = e1 (e . d) e + c2 d, with e = x_a - x_b
 // (u = e / |e|) recomputed from the positions and e1 = c1 / |e|^2: 16 bytes per slot to read
-// instead of 40 (at n = 40 they then fit in a 32 MB L3 cache; docs/benchmarks.md).
+// instead of 40 (the product is bound by memory traffic at n = 40; docs/benchmarks.md).
 JELLY_VECTOR_CLONES
 void band_products(int n, Ends x, Ends p, const Real* __restrict e1, const Real* __restrict c2,
                    Real* __restrict tx, Real* __restrict ty, Real* __restrict tz) {

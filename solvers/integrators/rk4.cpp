@@ -32,22 +32,19 @@ StepResult RungeKutta4::do_step(const Dynamics& dynamics, State& s, Real h) {
     xs[i] = x[i] + half * v[i];
     vs[i] = v[i] + half * a[i];
   });
+  // After stage 2 (3): its slope into the sum, and stage 3 (4) at y + c k2 (k3), c = h/2 (h).
+  const auto next_stage = [&](Real c) {
+    pass([&](long i) {
+      dx[i] += 2 * vs[i];
+      dv[i] += 2 * a[i];
+      xs[i] = x[i] + c * vs[i];
+      vs[i] = v[i] + c * a[i];
+    });
+  };
   dynamics.stage_acceleration(s.t + half, x_stage_, v_stage_, a_);
-  // Stage 3, at y + h/2 k2.
-  pass([&](long i) {
-    dx[i] += 2 * vs[i];
-    dv[i] += 2 * a[i];
-    xs[i] = x[i] + half * vs[i];
-    vs[i] = v[i] + half * a[i];
-  });
+  next_stage(half);
   dynamics.stage_acceleration(s.t + half, x_stage_, v_stage_, a_);
-  // Stage 4, at y + h k3.
-  pass([&](long i) {
-    dx[i] += 2 * vs[i];
-    dv[i] += 2 * a[i];
-    xs[i] = x[i] + h * vs[i];
-    vs[i] = v[i] + h * a[i];
-  });
+  next_stage(h);
   dynamics.stage_acceleration(s.t + h, x_stage_, v_stage_, a_);
   pass([&](long i) {
     dx[i] += vs[i];
