@@ -280,7 +280,8 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) c
       if (input.slot != nullptr && input.slot[i] >= 0) {
         const Real* f = input.map + 9 * static_cast<size_t>(input.slot[i]);
         const Real q0 = q[0], q1 = q[1], q2 = q[2];
-        for (int c = 0; c < 3; ++c) q[c] = f[c] * q0 + f[3 + c] * q1 + f[6 + c] * q2;
+        // Summed as Eigen's 3x3 product does (a0 + (a1 + a2)): the same bits as S_c p_c.
+        for (int c = 0; c < 3; ++c) q[c] = f[c] * q0 + (f[3 + c] * q1 + f[6 + c] * q2);
       }
       for (int c = 0; c < 3; ++c) {
         sp[c * n + i] = q[c];

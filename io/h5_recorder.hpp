@@ -13,8 +13,9 @@ namespace jelly {
 struct RecorderOptions {
   std::string scene_json;  // the whole scene as JSON text (stored as an attribute), may be empty
   std::string integrator_name;  // attribute; defaults to sim.integrator().name()
-  // Frames are written in blocks of this many and the file is flushed after each block (with a
-  // fresh /checkpoint): a run killed by SIGKILL leaves a file readable up to the last flush.
+  // Frames are written in blocks of at most this many (fewer when they would exceed 8 MiB of
+  // particle data: docs/output.md) and the file is flushed after each block (with a fresh
+  // /checkpoint): a run killed by SIGKILL leaves a file readable up to the last flush.
   int flush_every_frames = 10;
   int compression_level = 4;  // deflate (with byte shuffle) of the time series, 0 = off
   bool write_xdmf = true;     // <path without .h5>.xdmf beside the file, written at on_finish

@@ -111,8 +111,10 @@ void bind_io(py::module_& m) {
       .def_readwrite("scene_json", &RecorderOptions::scene_json, "The scene stored in the file.")
       .def_readwrite("integrator_name", &RecorderOptions::integrator_name,
                      "Attribute; default: the simulator's.")
-      .def_readwrite("flush_every_frames", &RecorderOptions::flush_every_frames,
-                     "Frames per block; the file is flushed after each block.")
+      .def_readwrite(
+          "flush_every_frames", &RecorderOptions::flush_every_frames,
+          "Frames per block at most (fewer when a block would exceed 8 MiB of particle data); the "
+          "file is flushed after each block.")
       .def_readwrite("compression_level", &RecorderOptions::compression_level,
                      "Deflate 0..9, 0 = off.")
       .def_readwrite("write_xdmf", &RecorderOptions::write_xdmf,

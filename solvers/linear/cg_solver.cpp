@@ -247,6 +247,13 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
         r_norm = std::sqrt(sums.first);
         ++k;
         if (r_norm <= target || !std::isfinite(r_norm)) break;
+        if (!(sums.second > 0)) {  // r^T P r: the rounded preconditioner is not positive definite
+          result = LinearResult::failure(LinearStatus::kNotPositiveDefinite,
+                                         "CG: r^T P r = " + std::to_string(sums.second) +
+                                             " at iteration " + std::to_string(k) +
+                                             ": block-Jacobi preconditioner not positive definite");
+          break;
+        }
         const Real beta = sums.second / rz;
         rz = sums.second;
         for_entries([&](long begin, long end) {
@@ -390,7 +397,7 @@ LinearResult CgSolver::Impl::factorize(const SparseMatrix& a, LinearSolverCounte
         const int base = diagonal_block_[i];
         const int s = outer[3 * i + 1] - outer[3 * i];
         for (int c = 0; c < 3; ++c)
-          for (int r = 0; r < 3; ++r) block(r, c) = values[base + c * s + r];
+          for (int row = 0; row < 3; ++row) block(row, c) = values[base + c * s + row];
       });
       if (!r.ok()) {
         a_ = nullptr;
