@@ -272,6 +272,7 @@ class ImplicitEulerOptions:
     linear_solver: str
     cg_preconditioner: str
     cg_tolerance: float
+    contact_screening_tolerance: float
     cg_max_iterations: int
     refactor_iterations: int
     ordering: str

@@ -121,6 +121,7 @@ struct ImplicitEuler::Impl {
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
   VecX az_;
+  Real screen_tolerance_ = 0;  // > 0: the running solve is a screening solve to this tolerance
   int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
@@ -404,7 +405,9 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
       band_->multiply(in, out, threads_, input);
       if (constrained) contact_.filter_output(in, out);
     };
-    r = band_cg_.solve(apply, b, y, options_.cg_tolerance, options_.cg_max_iterations, threads_);
+    r = band_cg_.solve(apply, b, y,
+                       screen_tolerance_ > 0 ? screen_tolerance_ : options_.cg_tolerance,
+                       options_.cg_max_iterations, threads_);
     solve_seconds_ += seconds_since(start);
   }
   return finish_solve(model, r, b, y, constrained, t);
@@ -506,6 +509,12 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   for (int round = 1;; ++round) {
     const bool constrained = contact_active_ && contact_.has_constraints();
     if (constrained) constrain(b_, true, dv_);
+    // Screening (options_.contact_screening_tolerance): a loose solve first, finished below
+    // only if it keeps the contacts' set.
+    const Real screen = options_.contact_screening_tolerance;
+    const bool screening = matrix_free_ && contact_active_ && !bodies_active_ &&
+                           screen > options_.cg_tolerance && round < options_.contact_iterations;
+    screen_tolerance_ = screening ? screen : 0;
     if (StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t);
         !r.ok) {
       have_dv_ = false;
@@ -515,7 +524,19 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     ++newton_iterations_;
     if (!contact_active_ && !bodies_active_) break;
     const bool last = round >= options_.contact_iterations;
-    const bool terrain_changed = contact_active_ && update_contacts(*terrains, b_, !last);
+    bool terrain_changed = contact_active_ && update_contacts(*terrains, b_, !last);
+    if (screening && !terrain_changed) {
+      // The set held on the loose solve: finish the solve at the full tolerance and check again.
+      screen_tolerance_ = 0;
+      const bool still = contact_active_ && contact_.has_constraints();
+      if (still) constrain(b_, true, dv_);
+      if (StepResult r = factorize_and_solve(model, still ? rhs_ : b_, dv_, still, s.t); !r.ok) {
+        have_dv_ = false;
+        return r;
+      }
+      if (still) dv_ += z_;
+      terrain_changed = update_contacts(*terrains, b_, !last);
+    }
     const bool pairs_changed = bodies_active_ && bodies_.update(dv_, !last);
     if (last || (!terrain_changed && !pairs_changed)) break;
     if (pairs_changed) {
@@ -525,6 +546,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
       refresh_pair_terms();
     }
   }
+  screen_tolerance_ = 0;
   have_dv_ = true;
   return StepResult::success();
 }

@@ -47,6 +47,11 @@ void ImplicitEulerOptions::validate(const std::string& prefix) const {
           "an integer >= 1");
   require(contact_iterations >= 1 && contact_iterations <= 100, prefix + "contact_iterations",
           contact_iterations, "an integer in [1, 100]");
+  require(std::isfinite(contact_screening_tolerance) &&
+              (contact_screening_tolerance == 0 ||
+               (contact_screening_tolerance > 0 && contact_screening_tolerance < 1)),
+          prefix + "contact_screening_tolerance", contact_screening_tolerance,
+          "0 (off) or a relative residual in (0, 1)");
 }
 
 ImplicitEulerOptions ImplicitEulerOptions::read(JsonFields& f) {
@@ -66,6 +71,8 @@ ImplicitEulerOptions ImplicitEulerOptions::read(JsonFields& f) {
   o.ordering = choice(cholmod_orderings(), "ordering", o.ordering);
   o.contact = choice(implicit_contact_modes(), "contact", o.contact);
   o.contact_iterations = f.integer_or("contact_iterations", o.contact_iterations);
+  o.contact_screening_tolerance =
+      f.number_or("contact_screening_tolerance", o.contact_screening_tolerance);
   o.validate(f.prefix());
   return o;
 }
@@ -83,6 +90,7 @@ Json ImplicitEulerOptions::to_json() const {
   out["ordering"] = std::string(name_of(cholmod_orderings(), ordering));
   out["contact"] = std::string(name_of(implicit_contact_modes(), contact));
   out["contact_iterations"] = contact_iterations;
+  out["contact_screening_tolerance"] = contact_screening_tolerance;
   return out;
 }
 
