@@ -287,3 +287,42 @@ def test_arkode_linear_solver_is_one_of_its_table():
         assert options.arkode.linear_solver == name
     with pytest.raises(ValueError, match="linear_solver"):
         options.arkode.linear_solver = "lu"
+
+
+def test_contact_screening_equals_jelly_run_and_is_validated(scenes, run_cli, tmp_path):
+    # implicit_euler's opt-in contact_screening_tolerance on the matrix-free path (8^3 particles
+    # lowered onto the coulomb slope): the module's run is the jelly program's bit for bit, with
+    # the same statistics, and screening adds finishing solves to the unscreened run's.
+    sets = ["cube.n=8", "cube.origin=[-2.2222222,0.7,-2.2222222]",
+            "integrator.name=implicit_euler", "integrator.dt=0.0166666666666667", "duration=0.5",
+            "terrains[0].contact.model=coulomb"]
+    screened = sets + ["integrator.options.contact_screening_tolerance=0.01"]
+
+    def cli_solves(scene_sets, path):
+        args = [a for s in scene_sets for a in ("--set", s)]
+        done = run_cli("run", scenes / "seed_slope.json", *args, "-o", path, "--quiet")
+        assert done.returncode == 0, done.stderr
+        return int(re.search(r"linear_solves = (\d+)", done.stdout).group(1))
+
+    plain_solves = cli_solves(sets, tmp_path / "plain.h5")
+    cli_file, py_file = tmp_path / "cli.h5", tmp_path / "py.h5"
+    screened_solves = cli_solves(screened, cli_file)
+    assert screened_solves > plain_solves
+
+    scene = jelly.load_scene(scenes / "seed_slope.json", screened)
+    sim = jelly.Simulator(scene)
+    with jelly.H5Recorder(str(py_file), sim, scene) as recorder:
+        sim.add_observer(recorder)
+        report = sim.run_until(scene.duration)
+    assert report.status == "completed" and report.ok
+    assert report.statistics["linear_solves"] == screened_solves
+    assert_same_file(cli_file, py_file)
+
+    options = jelly.IntegratorOptions()
+    assert options.implicit.contact_screening_tolerance == 0
+    options.implicit.contact_screening_tolerance = 0.01
+    assert options.implicit.contact_screening_tolerance == 0.01
+    options.implicit.contact_screening_tolerance = 1.5
+    model = jelly.build_cube(jelly.CubeSpec())
+    with pytest.raises(jelly.InputError, match="contact_screening_tolerance = 1.5 is invalid"):
+        jelly.Simulator(model, integrator="implicit_euler", integrator_options=options)
