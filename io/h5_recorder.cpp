@@ -299,7 +299,6 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
     if (!b.surface.empty()) frame_bytes += 24 * static_cast<size_t>(b.surface.num_vertices());
   }
   block = block_frames(options.flush_every_frames, frame_bytes);
-  const int every = block;
   h5::create_group(f, "particles");
   if (model.bodies.empty()) {
     bodies.push_back({"jelly", 0, n, nullptr, {}, {}, {}, {}, {}, {}});
@@ -340,7 +339,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
     h5::write_dataset(g.get(), "mass", {N}, model.mass.data() + body.first);
     h5::write_dataset(g.get(), "rest_position", {N, 3},
                       model.rest_position.data() + 3 * body.first);
-    const hsize_t frame_chunk = chunk_frames(3 * N, every);
+    const hsize_t frame_chunk = chunk_frames(3 * N, block);
     {
       h5::Handle p = h5::create_group(g.get(), "position");
       if (bi == 0) {
@@ -379,7 +378,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       h5::Handle p = h5::create_group(sg.get(), "position");
       link_clock(p.get());
       body.surface_position = h5::Series(p.get(), "value", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                                         {V, 3}, chunk_frames(3 * V, every), level);
+                                         {V, 3}, chunk_frames(3 * V, block), level);
     }
   }
 

@@ -4,6 +4,8 @@
 // chunks whose partial sums are added in chunk order). Results of every loop built on these
 // are the same bit for bit for any thread count.
 #include <algorithm>
+#include <array>
+#include <cstddef>
 #include <vector>
 
 #ifdef _OPENMP
@@ -69,20 +71,35 @@ void for_ranges(int threads, long n, Body&& body, long min_items = kMinItemsPerT
 constexpr long kSumChunk = 8192;
 inline long sum_chunks(long n) { return std::max<long>(1, (n + kSumChunk - 1) / kSumChunk); }
 
-// The sum over chunks of chunk_sum(begin, end), with `partials` as workspace (resized to the
-// number of chunks; no allocation once it has that size).
-template <class ChunkSum>
-Real ordered_sum(int threads, long n, std::vector<Real>& partials, ChunkSum&& chunk_sum) {
-  const long chunks = sum_chunks(n);
-  if (static_cast<long>(partials.size()) != chunks) partials.assign(chunks, 0.0);
+// The K sums of chunk_sums(begin, end) -> std::array<Real, K> over a fixed partition of [0, n)
+// into chunks of `chunk` items (one chunk when n is smaller), each added in chunk order: the
+// same values for any number of threads. `partials` is workspace (K per chunk; no allocation
+// once it has that size).
+template <std::size_t K, class ChunkSums>
+std::array<Real, K> ordered_sums(int threads, long n, long chunk, std::vector<Real>& partials,
+                                 ChunkSums&& chunk_sums) {
+  const long chunks = std::max<long>(1, (n + chunk - 1) / chunk);
+  if (static_cast<long>(partials.size()) != static_cast<long>(K) * chunks)
+    partials.assign(K * chunks, 0.0);
   run(team_size(threads, chunks, 1), [&](int part, int parts) {
     const Range r = split(chunks, part, parts);
-    for (long c = r.begin; c < r.end; ++c)
-      partials[c] = chunk_sum(c * kSumChunk, std::min(n, (c + 1) * kSumChunk));
+    for (long c = r.begin; c < r.end; ++c) {
+      const std::array<Real, K> s = chunk_sums(c * chunk, std::min(n, (c + 1) * chunk));
+      std::copy(s.begin(), s.end(), partials.begin() + K * c);
+    }
   });
-  Real total = 0;
-  for (long c = 0; c < chunks; ++c) total += partials[c];
+  std::array<Real, K> total{};
+  for (long c = 0; c < chunks; ++c)
+    for (std::size_t k = 0; k < K; ++k) total[k] += partials[K * c + k];
   return total;
+}
+
+// The sum over chunks of kSumChunk items of chunk_sum(begin, end) (ordered_sums with one sum).
+template <class ChunkSum>
+Real ordered_sum(int threads, long n, std::vector<Real>& partials, ChunkSum&& chunk_sum) {
+  return ordered_sums<1>(threads, n, kSumChunk, partials, [&](long begin, long end) {
+    return std::array<Real, 1>{chunk_sum(begin, end)};
+  })[0];
 }
 
 // Keeps libraries that start their own threads (OpenMP regions inside CHOLMOD, which asks for

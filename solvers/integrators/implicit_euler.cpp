@@ -505,22 +505,29 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   contact_terrains_ = terrains;
   contact_active_ = (resolves_contact() || !model.pins.empty()) &&
                     contact_.begin_step(model, *terrains, s, f_, h);
+  // One solve of the current set (constrained by the contacts it holds) into dv_.
+  const auto solve = [&]() -> StepResult {
+    const bool constrained = contact_active_ && contact_.has_constraints();
+    if (constrained) constrain(b_, true, dv_);
+    StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t);
+    if (!r.ok) {
+      have_dv_ = false;
+      screen_tolerance_ = 0;
+      return r;
+    }
+    if (constrained) dv_ += z_;
+    return r;
+  };
   // Solve; with contacts, again while their active set changes.
   for (int round = 1;; ++round) {
     const bool constrained = contact_active_ && contact_.has_constraints();
-    if (constrained) constrain(b_, true, dv_);
     // Screening (options_.contact_screening_tolerance): a loose solve first, finished below
     // only if it keeps the contacts' set.
     const Real screen = options_.contact_screening_tolerance;
     const bool screening = matrix_free_ && contact_active_ && !bodies_active_ &&
                            screen > options_.cg_tolerance && round < options_.contact_iterations;
     screen_tolerance_ = screening ? screen : 0;
-    if (StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t);
-        !r.ok) {
-      have_dv_ = false;
-      return r;
-    }
-    if (constrained) dv_ += z_;
+    if (StepResult r = solve(); !r.ok) return r;
     ++newton_iterations_;
     if (!contact_active_ && !bodies_active_) break;
     const bool last = round >= options_.contact_iterations;
@@ -528,13 +535,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     if (screening && !terrain_changed) {
       // The set held on the loose solve: finish the solve at the full tolerance and check again.
       screen_tolerance_ = 0;
-      const bool still = contact_active_ && contact_.has_constraints();
-      if (still) constrain(b_, true, dv_);
-      if (StepResult r = factorize_and_solve(model, still ? rhs_ : b_, dv_, still, s.t); !r.ok) {
-        have_dv_ = false;
-        return r;
-      }
-      if (still) dv_ += z_;
+      if (StepResult r = solve(); !r.ok) return r;
       terrain_changed = update_contacts(*terrains, b_, !last);
     }
     const bool pairs_changed = bodies_active_ && bodies_.update(dv_, !last);

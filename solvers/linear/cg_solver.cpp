@@ -3,8 +3,8 @@
 #include <time.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <utility>
 #include <vector>
 
 #include <Eigen/LU>
@@ -59,30 +59,13 @@ struct CgWork {
   Real sum(ChunkSum&& f) {
     return parallel::ordered_sum(threads, r.size(), partials, f);
   }
-  // The two sums of f(begin, end) -> (a, b) over fixed chunks of whole particles (kPairChunk
+  // The two sums of f(begin, end) -> {a, b} over fixed chunks of whole particles (kPairChunk
   // entries), in chunk order.
   static constexpr long kPairChunk = 3 * 2731;
   std::vector<Real> pair_partials;
   template <class ChunkSums>
-  std::pair<Real, Real> sum2(ChunkSums&& f) {
-    const long n = r.size();
-    const long chunks = std::max<long>(1, (n + kPairChunk - 1) / kPairChunk);
-    if (static_cast<long>(pair_partials.size()) != 2 * chunks)
-      pair_partials.assign(2 * chunks, 0.0);
-    parallel::run(parallel::team_size(threads, chunks, 1), [&](int part, int parts) {
-      const parallel::Range range = parallel::split(chunks, part, parts);
-      for (long c = range.begin; c < range.end; ++c) {
-        const std::pair<Real, Real> s = f(c * kPairChunk, std::min(n, (c + 1) * kPairChunk));
-        pair_partials[2 * c] = s.first;
-        pair_partials[2 * c + 1] = s.second;
-      }
-    });
-    Real a = 0, b = 0;
-    for (long c = 0; c < chunks; ++c) {
-      a += pair_partials[2 * c];
-      b += pair_partials[2 * c + 1];
-    }
-    return {a, b};
+  std::array<Real, 2> sum2(ChunkSums&& f) {
+    return parallel::ordered_sums<2>(threads, r.size(), kPairChunk, pair_partials, f);
   }
   // body(begin, end) over a static split of [0, n) (boundaries multiples of 3).
   template <class Body>
@@ -161,8 +144,8 @@ struct BlockInverses {
 
   // One pass for CG's update: x += alpha p, r -= alpha q, z = P r; returns r.r and r.z, summed
   // in fixed chunks of whole particles in chunk order (the same bits for any thread count).
-  std::pair<Real, Real> update(CgWork& work, Real alpha, const Real* p, const Real* q, Real* x,
-                               Real* r, Real* z) const {
+  std::array<Real, 2> update(CgWork& work, Real alpha, const Real* p, const Real* q, Real* x,
+                             Real* r, Real* z) const {
     return work.sum2([&](long begin, long end) {
       Real rr = 0, rz = 0;
       for (long i = begin; i < end; ++i) {
@@ -174,7 +157,7 @@ struct BlockInverses {
         rr += r[i] * r[i];
         rz += r[i] * z[i];
       }
-      return std::pair<Real, Real>(rr, rz);
+      return std::array<Real, 2>{rr, rz};
     });
   }
 };
@@ -243,19 +226,20 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
       }
       const Real alpha = rz / curvature;
       if (blocks != nullptr) {  // block Jacobi: the update, z and both sums in one pass
-        const std::pair<Real, Real> sums = blocks->update(work, alpha, pp, pq, px, pr, pz);
-        r_norm = std::sqrt(sums.first);
+        const std::array<Real, 2> sums = blocks->update(work, alpha, pp, pq, px, pr, pz);
+        const Real rz_next = sums[1];
+        r_norm = std::sqrt(sums[0]);
         ++k;
         if (r_norm <= target || !std::isfinite(r_norm)) break;
-        if (!(sums.second > 0)) {  // r^T P r: the rounded preconditioner is not positive definite
+        if (!(rz_next > 0)) {  // r^T P r: the rounded preconditioner is not positive definite
           result = LinearResult::failure(LinearStatus::kNotPositiveDefinite,
-                                         "CG: r^T P r = " + std::to_string(sums.second) +
+                                         "CG: r^T P r = " + std::to_string(rz_next) +
                                              " at iteration " + std::to_string(k) +
                                              ": block-Jacobi preconditioner not positive definite");
           break;
         }
-        const Real beta = sums.second / rz;
-        rz = sums.second;
+        const Real beta = rz_next / rz;
+        rz = rz_next;
         for_entries([&](long begin, long end) {
           for (long i = begin; i < end; ++i) pp[i] = pz[i] + beta * pp[i];
         });
