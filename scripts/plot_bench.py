@@ -5,8 +5,9 @@
 
 Writes bench_stability.png (largest stable dt against ks, measured and predicted, log-log),
 bench_work_precision.png (error against wall time and against force evaluations) and
-bench_speed.png (cost per step against the number of springs), for whichever of the tables
-stability.csv, accuracy.csv and speed.csv exist.
+bench_speed.png (cost per step against the number of springs) and bench_budget.png (the cost
+of a 1/60 s frame against its error, and the stiffest stable ks, per setup and size), for
+whichever of the tables stability.csv, accuracy.csv, speed.csv and budget.csv exist.
 """
 import argparse
 import csv
@@ -152,6 +153,60 @@ def plot_speed(rows, meta, out):
     plt.close(fig)
 
 
+def plot_budget(rows, meta, out):
+    """Cost of a 1/60 s frame against the error to the RK4 reference, and the stiffest stable ks."""
+    sizes = sorted({int(r["n"]) for r in rows})
+    setups = []
+    for r in rows:  # in the table's order
+        if r["setup"] not in setups:
+            setups.append(r["setup"])
+    markers = "os^Dv<>p"
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    labelled = set()
+    for i, setup in enumerate(setups):
+        for j, n in enumerate(sizes):
+            sel = [r for r in rows if r["setup"] == setup and int(r["n"]) == n
+                   and r["status"] in COMPLETED and finite(r["frame_seconds_mean"])
+                   and finite(r["error_max"])]
+            for r in sel:
+                axes[0].loglog(r["frame_seconds_mean"] * 1e3, max(r["error_max"], 1e-9),
+                               markers[j % len(markers)], color="C%d" % (i % 10),
+                               label=None if setup in labelled else setup)
+                labelled.add(setup)
+    budget_ms = 1e3 / 60
+    axes[0].axvline(budget_ms, color="0.3", linestyle="--", linewidth=1)
+    axes[0].text(budget_ms * 1.05, axes[0].get_ylim()[0] * 1.5, "1/60 s", fontsize=7, color="0.3")
+    axes[0].set_xlabel("wall time of a 1/60 s frame (ms, mean over the run; indicative: shared CPU)")
+    axes[0].set_ylabel("largest RMS particle distance to RK4 (m)")
+    axes[0].set_title("cost and error; markers: " + ", ".join(
+        "%s n = %d" % (markers[j % len(markers)], n) for j, n in enumerate(sizes)), fontsize=8)
+    # The stiffest ks of the ladder each setup keeps stable at its steps per frame.
+    width = 0.8 / max(len(sizes), 1)
+    for j, n in enumerate(sizes):
+        ks = []
+        for setup in setups:
+            sel = [r for r in rows if r["setup"] == setup and int(r["n"]) == n]
+            value = sel[0]["stiffest_ks"] if sel else float("nan")
+            ks.append(value if finite(value) and value > 0 else float("nan"))
+        axes[1].bar([k + (j - (len(sizes) - 1) / 2) * width for k in range(len(setups))], ks,
+                    width=width, label="n = %d" % n)
+    axes[1].set_yscale("log")
+    axes[1].set_xticks(range(len(setups)))
+    axes[1].set_xticklabels(setups, rotation=45, ha="right", fontsize=7)
+    axes[1].set_ylabel("stiffest stable ks of the ladder (N/m)")
+    axes[1].set_title("stiffness kept stable at the setup's steps per frame (missing: not searched)",
+                      fontsize=8)
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=6)
+    fig.suptitle("which integrator for a 1/60 s frame: the seed cube falling onto the seed slope "
+                 "(coulomb contact)", fontsize=9)
+    footer(fig, meta)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--in", dest="input", default="out/bench", help="directory of the CSVs")
@@ -160,7 +215,8 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     jobs = [("stability.csv", plot_stability, "bench_stability.png"),
             ("accuracy.csv", plot_work_precision, "bench_work_precision.png"),
-            ("speed.csv", plot_speed, "bench_speed.png")]
+            ("speed.csv", plot_speed, "bench_speed.png"),
+            ("budget.csv", plot_budget, "bench_budget.png")]
     written = 0
     for table, plot, png in jobs:
         path = os.path.join(args.input, table)
