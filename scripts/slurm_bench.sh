@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# A jelly-bench sweep as a Slurm job array: one shard per array task, then the merge
+# (docs/benchmarks.md, "Sweeps on a Slurm cluster").
+#
+#   scripts/slurm_bench.sh submit N OUT COMMAND [ARGS...]
+#       submits an array of N tasks (task i runs `jelly-bench COMMAND ARGS --shard i/N
+#       --out OUT/shards`) and a merge job that starts when all of them succeeded
+#       (`jelly-bench merge OUT/shards --out OUT`); prints both job ids.
+#   sbatch --array=0-(N-1) scripts/slurm_bench.sh shard N OUT COMMAND [ARGS...]
+#       a task of the array (what `submit` submits): shard $SLURM_ARRAY_TASK_ID of N. Also
+#       for rerunning failed tasks alone, e.g. `--array=3,5`.
+#   scripts/slurm_bench.sh merge OUT
+#       the merge alone (also after a partial rerun of failed tasks).
+#
+# Environment: JELLY_BENCH, the jelly-bench program (default: build/bench/jelly-bench of this
+# checkout, else jelly-bench on PATH); SBATCH_FLAGS, extra sbatch flags for both jobs (e.g.
+# "--partition=short --time=02:00:00"). Each task uses the cores Slurm gives it (jelly's
+# default `threads` is the process's CPU affinity); set them with `--cpus-per-task` in
+# SBATCH_FLAGS. Exit codes: those of jelly-bench; 2 for a wrong use of this script.
+#SBATCH --job-name=jelly-bench
+#SBATCH --output=jelly-bench-%A_%a.out
+set -euo pipefail
+
+usage() {
+  echo "error: $1" >&2
+  echo "usage: $0 submit N OUT COMMAND [ARGS...] | shard N OUT COMMAND [ARGS...] | merge OUT" >&2
+  exit 2
+}
+
+# This file's checkout: Slurm runs a copy of the batch script from its spool directory, so the
+# submitting side passes its own location in JELLY_SOURCE.
+source_dir=${JELLY_SOURCE:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)}
+if [[ -z ${JELLY_BENCH:-} ]]; then
+  if [[ -x $source_dir/build/bench/jelly-bench ]]; then
+    JELLY_BENCH=$source_dir/build/bench/jelly-bench
+  else
+    JELLY_BENCH=$(command -v jelly-bench || true)
+  fi
+fi
+[[ -n ${JELLY_BENCH:-} && -x $JELLY_BENCH ]] ||
+  usage "no jelly-bench program: build it (make build) or set JELLY_BENCH"
+# Absolute, so that the jobs find it from their own working directory.
+JELLY_BENCH=$(cd "$(dirname "$JELLY_BENCH")" && pwd)/$(basename "$JELLY_BENCH")
+
+mode=${1:-}
+[[ $# -ge 1 ]] && shift
+case $mode in
+  submit)
+    [[ $# -ge 3 ]] || usage "submit needs N, OUT and a jelly-bench command"
+    n=$1 out=$2
+    shift 2
+    [[ $n =~ ^[1-9][0-9]*$ ]] || usage "N = '$n' is invalid: a whole number of tasks, at least 1"
+    [[ $1 != merge ]] || usage "COMMAND = merge is invalid: the merge job is submitted for you"
+    command -v sbatch >/dev/null || usage "sbatch not found: submit on a Slurm login node"
+    mkdir -p "$out/shards"
+    out=$(cd "$out" && pwd)
+    read -r -a flags <<<"${SBATCH_FLAGS:-}"
+    export JELLY_BENCH JELLY_SOURCE=$source_dir
+    array=$(sbatch --parsable --export=ALL --array="0-$((n - 1))" "${flags[@]}" \
+      --output="$out/shards/%x-%A_%a.out" "$source_dir/scripts/slurm_bench.sh" shard "$n" "$out" "$@")
+    array=${array%%;*}  # --parsable prints "jobid[;cluster]"
+    merge=$(sbatch --parsable --export=ALL --dependency="afterok:$array" "${flags[@]}" \
+      --output="$out/%x-merge-%j.out" "$source_dir/scripts/slurm_bench.sh" merge "$out")
+    merge=${merge%%;*}
+    echo "submitted: shards job $array (array 0-$((n - 1))), merge job $merge; results in $out"
+    ;;
+  shard)
+    [[ $# -ge 3 ]] || usage "shard needs N, OUT and a jelly-bench command"
+    n=$1 out=$2
+    shift 2
+    [[ $n =~ ^[1-9][0-9]*$ ]] || usage "N = '$n' is invalid: a whole number of tasks, at least 1"
+    [[ -n ${SLURM_ARRAY_TASK_ID:-} ]] ||
+      usage "shard runs as a task of a Slurm job array (SLURM_ARRAY_TASK_ID is unset)"
+    [[ $SLURM_ARRAY_TASK_ID =~ ^[0-9]+$ && $SLURM_ARRAY_TASK_ID -lt $n ]] ||
+      usage "SLURM_ARRAY_TASK_ID = '$SLURM_ARRAY_TASK_ID' is invalid: an array index in [0, $n)"
+    exec "$JELLY_BENCH" "$@" --shard "$SLURM_ARRAY_TASK_ID/$n" --out "$out/shards"
+    ;;
+  merge)
+    [[ $# -eq 1 ]] || usage "merge needs OUT only"
+    exec "$JELLY_BENCH" merge "$1/shards" --out "$1"
+    ;;
+  *)
+    usage "mode = '$mode' is invalid: submit, shard or merge"
+    ;;
+esac
