@@ -8,7 +8,9 @@
 #       (`jelly-bench merge OUT/shards --out OUT`); prints both job ids.
 #   sbatch --array=0-(N-1) scripts/slurm_bench.sh shard N OUT COMMAND [ARGS...]
 #       a task of the array (what `submit` submits): shard $SLURM_ARRAY_TASK_ID of N. Also
-#       for rerunning failed tasks alone, e.g. `--array=3,5`.
+#       for rerunning failed tasks alone, e.g. `--array=3,5`, from the checkout's directory
+#       (or with JELLY_BENCH exported); add `--output=OUT/shards/%x-%A_%a.out` to keep their
+#       logs with the others'.
 #   scripts/slurm_bench.sh merge OUT
 #       the merge alone (also after a partial rerun of failed tasks).
 #
@@ -27,9 +29,16 @@ usage() {
   exit 2
 }
 
-# This file's checkout: Slurm runs a copy of the batch script from its spool directory, so the
-# submitting side passes its own location in JELLY_SOURCE.
-source_dir=${JELLY_SOURCE:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)}
+# This file's checkout. Slurm runs a copy of the batch script from its spool directory, so
+# `submit` passes its own location in JELLY_SOURCE; a task submitted by hand (a rerun) falls
+# back to the directory sbatch was run from, the checkout in the examples.
+if [[ -n ${JELLY_SOURCE:-} ]]; then
+  source_dir=$JELLY_SOURCE
+elif [[ -n ${SLURM_JOB_ID:-} && -n ${SLURM_SUBMIT_DIR:-} ]]; then
+  source_dir=$SLURM_SUBMIT_DIR
+else
+  source_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+fi
 if [[ -z ${JELLY_BENCH:-} ]]; then
   if [[ -x $source_dir/build/bench/jelly-bench ]]; then
     JELLY_BENCH=$source_dir/build/bench/jelly-bench
@@ -54,12 +63,14 @@ case $mode in
     command -v sbatch >/dev/null || usage "sbatch not found: submit on a Slurm login node"
     mkdir -p "$out/shards"
     out=$(cd "$out" && pwd)
-    read -r -a flags <<<"${SBATCH_FLAGS:-}"
+    read -r -a flags <<<"${SBATCH_FLAGS:-}"  # split on blanks: no flag value with a space
     export JELLY_BENCH JELLY_SOURCE=$source_dir
-    array=$(sbatch --parsable --export=ALL --array="0-$((n - 1))" "${flags[@]}" \
+    array=$(sbatch --parsable --export=ALL --array="0-$((n - 1))" ${flags[@]+"${flags[@]}"} \
       --output="$out/shards/%x-%A_%a.out" "$source_dir/scripts/slurm_bench.sh" shard "$n" "$out" "$@")
     array=${array%%;*}  # --parsable prints "jobid[;cluster]"
-    merge=$(sbatch --parsable --export=ALL --dependency="afterok:$array" "${flags[@]}" \
+    # A failed task cancels the merge (Slurm would otherwise keep it pending for ever).
+    merge=$(sbatch --parsable --export=ALL --dependency="afterok:$array" --kill-on-invalid-dep=yes \
+      ${flags[@]+"${flags[@]}"} \
       --output="$out/%x-merge-%j.out" "$source_dir/scripts/slurm_bench.sh" merge "$out")
     merge=${merge%%;*}
     echo "submitted: shards job $array (array 0-$((n - 1))), merge job $merge; results in $out"
