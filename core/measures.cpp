@@ -1,5 +1,9 @@
 #include <jelly/core/measures.hpp>
 
+#include <vector>
+
+#include <jelly/core/detail/parallel.hpp>
+
 namespace jelly {
 
 Real kinetic_energy(const Model& model, const VecX& v) {
@@ -16,6 +20,28 @@ Real elastic_energy(const Model& model, const VecX& x) {
     const Real stretch = (particle(x, s.a[k]) - particle(x, s.b[k])).norm() - s.rest_length[k];
     e += 0.5 * s.ks[k] * stretch * stretch;
   }
+  return e;
+}
+
+Real elastic_energy(const Model& model, const VecX& x, int threads) {
+  const Springs& s = model.springs;
+  thread_local std::vector<Real> partials;  // no allocation once sized
+  return parallel::ordered_sum(threads, s.size(), partials, [&](long begin, long end) {
+    Real e = 0;
+    for (long k = begin; k < end; ++k) {
+      const Real stretch = (particle(x, s.a[k]) - particle(x, s.b[k])).norm() - s.rest_length[k];
+      e += 0.5 * s.ks[k] * stretch * stretch;
+    }
+    return e;
+  });
+}
+
+Real energy_in_frame(const Model& model, const VecX& x, const VecX& v, const Vec3& u, Real t,
+                     int threads) {
+  Real e = elastic_energy(model, x, threads) + gravitational_energy(model, x) +
+           t * model.mass.sum() * model.gravity.dot(u);
+  for (int i = 0; i < model.num_particles(); ++i)
+    e += 0.5 * model.mass[i] * (particle(v, i) - u).squaredNorm();
   return e;
 }
 

@@ -27,4 +27,13 @@ inline Real total_energy(const Model& m, const State& s) {
   return kinetic_energy(m, s.v) + elastic_energy(m, s.x) + gravitational_energy(m, s.x);
 }
 
+// elastic_energy on up to `threads` threads, its terms summed in fixed chunks: the same value
+// for any thread count (rounded unlike the one-loop sum above).
+Real elastic_energy(const Model& model, const VecX& x, int threads);
+// The total energy in the frame moving with velocity u at time t (elastic and gravitational at
+// x - u t, kinetic of v - u), on up to `threads` threads: the same value for any thread count.
+// Contact's restitution budgets compare it before and after a step.
+Real energy_in_frame(const Model& model, const VecX& x, const VecX& v, const Vec3& u, Real t,
+                     int threads);
+
 }  // namespace jelly

@@ -50,13 +50,6 @@ void add_block(SparseMatrix& a, int r, int c, const Mat3& block) {
     for (int k = 0; k < 3; ++k) values[q * stride + k] += block(k, q);
 }
 
-Real total_energy(const Model& model, const VecX& x, const VecX& v) {
-  Real e = elastic_energy(model, x) + gravitational_energy(model, x);
-  for (int i = 0; i < model.num_particles(); ++i)
-    e += 0.5 * model.mass[i] * particle(v, i).squaredNorm();
-  return e;
-}
-
 }  // namespace
 
 bool ImplicitBodyContact::begin_step(const Model& model, BodyContact& contact, const State& s0,
@@ -231,7 +224,7 @@ bool ImplicitBodyContact::update(const VecX& dv, bool commit) {
   return changed;
 }
 
-void ImplicitBodyContact::finish(const Model& model, State& s1, BodyContact& contact) {
+void ImplicitBodyContact::finish(const Model& model, State& s1, BodyContact& contact, int threads) {
   const auto start = Clock::now();
   resolved_.clear();
   carried_.clear();
@@ -298,7 +291,8 @@ void ImplicitBodyContact::finish(const Model& model, State& s1, BodyContact& con
       linear += model.mass[k] * particle(s1.v, k).dot(dv);
       quadratic += 0.5 * model.mass[k] * dv.squaredNorm();
     }
-    const Real budget = total_energy(model, x0_, v0_) - total_energy(model, s1.x, s1.v);
+    const Real budget = energy_in_frame(model, x0_, v0_, Vec3::Zero(), 0, threads) -
+                        energy_in_frame(model, s1.x, s1.v, Vec3::Zero(), 0, threads);
     Real s = 1;
     if (linear + quadratic > budget) {
       const Real disc = linear * linear + 4 * quadratic * budget;

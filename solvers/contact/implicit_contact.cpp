@@ -64,16 +64,6 @@ bool uses_coulomb(const Terrain& terrain) {
   return terrain.contact().model == ContactModel::kCoulomb;
 }
 
-// Energy in the frame moving with velocity u: elastic + gravitational at x - u t + kinetic of
-// v - u.
-Real energy_in_frame(const Model& model, const VecX& x, const VecX& v, const Vec3& u, Real t) {
-  Real e = elastic_energy(model, x) + gravitational_energy(model, x) +
-           t * model.mass.sum() * model.gravity.dot(u);
-  for (int i = 0; i < model.num_particles(); ++i)
-    e += 0.5 * model.mass[i] * (particle(v, i) - u).squaredNorm();
-  return e;
-}
-
 }  // namespace
 
 Mat3 ImplicitContact::free_projector(const Contact& c) {
@@ -502,7 +492,7 @@ bool ImplicitContact::update_impl(const Terrains& terrains, const VecX& dv, bool
   return changed;
 }
 
-void ImplicitContact::finish(const Model& model, const Terrains& terrains, State& s1) {
+void ImplicitContact::finish(const Model& model, const Terrains& terrains, State& s1, int threads) {
   // Particles left below a surface (the active set was still changing when the solves ran out):
   // onto the surface, without inward velocity.
   projected_ = 0;
@@ -527,36 +517,13 @@ void ImplicitContact::finish(const Model& model, const Terrains& terrains, State
     v -= (v - c.surface_velocity).dot(c.normal) * c.normal;
   }
   // Restitution for the particles that hit their surface, within the energy the step lost.
-  Real quadratic = 0;
-  bool any_impact = false, one_frame = true;
-  Vec3 frame = Vec3::Zero();
+  bounces_.clear();
   for (const Contact& c : contacts_) {
     const Real bounce = bounce_speed(c, terrains);  // 0 for pins
-    if (bounce <= 0) continue;
-    quadratic += 0.5 * model.mass[c.particle] * bounce * bounce;
-    if (!any_impact) frame = c.surface_velocity;
-    one_frame = one_frame && (c.surface_velocity - frame).norm() <= 1e-12 * (1 + frame.norm());
-    any_impact = true;
+    if (bounce > 0) bounces_.push_back({c.particle, c.normal, c.surface_velocity, bounce});
   }
-  if (!any_impact) return;
-  if (!one_frame) frame.setZero();
-  Real linear = 0;
-  for (const Contact& c : contacts_) {
-    linear += model.mass[c.particle] * bounce_speed(c, terrains) *
-              (particle(s1.v, c.particle) - frame).dot(c.normal);
-  }
-  const Real budget = energy_in_frame(model, x0_, v0_, frame, t1_ - h_) -
-                      energy_in_frame(model, s1.x, s1.v, frame, t1_);
-  // Largest s in [0, 1] with kinetic energy gain s linear + s^2 quadratic <= budget.
-  Real s = 1;
-  if (linear + quadratic > budget) {
-    const Real disc = linear * linear + 4 * quadratic * budget;
-    s = disc > 0 ? std::clamp((-linear + std::sqrt(disc)) / (2 * quadratic), 0.0, 1.0) : 0.0;
+  if (add_bounded_bounces(model, x0_, v0_, t1_ - h_, s1, bounces_, threads) < 1)
     ++counters_.restitution_limited;
-  }
-  if (s <= 0) return;
-  for (const Contact& c : contacts_)
-    particle(s1.v, c.particle) += (s * bounce_speed(c, terrains)) * c.normal;
 }
 
 }  // namespace jelly

@@ -14,20 +14,10 @@ constexpr Real kTinySlip = 1e-12;
 
 Vec3 tangential(const Vec3& w, const Vec3& n) { return w - w.dot(n) * n; }
 
-// Energy in the frame moving with velocity u: elastic + gravitational at x - u t + kinetic of
-// v - u.
-Real energy_in_frame(const Model& model, const VecX& x, const VecX& v, const Vec3& u, Real t) {
-  Real e = elastic_energy(model, x) + gravitational_energy(model, x) +
-           t * model.mass.sum() * model.gravity.dot(u);
-  for (int i = 0; i < model.num_particles(); ++i)
-    e += 0.5 * model.mass[i] * (particle(v, i) - u).squaredNorm();
-  return e;
-}
-
 }  // namespace
 
 Real add_bounded_bounces(const Model& model, const VecX& x0, const VecX& v0, Real t0, State& s1,
-                         const std::vector<Bounce>& bounces) {
+                         const std::vector<Bounce>& bounces, int threads) {
   if (bounces.empty()) return 1;
   Real quadratic = 0;
   bool one_frame = true;
@@ -40,8 +30,8 @@ Real add_bounded_bounces(const Model& model, const VecX& x0, const VecX& v0, Rea
   Real linear = 0;
   for (const Bounce& b : bounces)
     linear += model.mass[b.particle] * b.speed * (particle(s1.v, b.particle) - frame).dot(b.normal);
-  const Real budget =
-      energy_in_frame(model, x0, v0, frame, t0) - energy_in_frame(model, s1.x, s1.v, frame, s1.t);
+  const Real budget = energy_in_frame(model, x0, v0, frame, t0, threads) -
+                      energy_in_frame(model, s1.x, s1.v, frame, s1.t, threads);
   // Largest s in [0, 1] with kinetic energy gain s linear + s^2 quadratic <= budget.
   Real s = 1;
   if (linear + quadratic > budget) {
@@ -223,7 +213,7 @@ void PositionContact::project_with_friction(VecX& x) {
   }
 }
 
-void PositionContact::finish(const Model& model, State& s1) {
+void PositionContact::finish(const Model& model, State& s1, int threads) {
   bounces_.clear();
   for (int i : active_) {
     const Slot& s = slot_[i];
@@ -237,7 +227,7 @@ void PositionContact::finish(const Model& model, State& s1) {
       bounces_.push_back({i, s.normal, s.surface_velocity, c.restitution * approach});
   }
   if (bounces_.empty()) return;
-  if (add_bounded_bounces(model, x0_, v0_, t1_ - h_, s1, bounces_) < 1)
+  if (add_bounded_bounces(model, x0_, v0_, t1_ - h_, s1, bounces_, threads) < 1)
     ++counters_.restitution_limited;
 }
 

@@ -616,9 +616,9 @@ StepResult ImplicitEuler::Impl::step(const Dynamics& dynamics, State& s, Real h)
   s.v = v1_;
   s.x += h * s.v;
   s.t += h;
-  if (contact_active_) contact_.finish(dynamics.model(), *contact_terrains_, s);
+  if (contact_active_) contact_.finish(dynamics.model(), *contact_terrains_, s, threads_);
   if (bodies_active_) {
-    bodies_.finish(dynamics.model(), s, *body_contact_);
+    bodies_.finish(dynamics.model(), s, *body_contact_, threads_);
   } else if (body_contact_ != nullptr) {
     body_contact_->record_step({}, 0.0);
   }

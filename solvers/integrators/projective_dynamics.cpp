@@ -367,7 +367,7 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
   s.v = (x_ - s.x) / h;
   s.x = x_;
   s.t += h;
-  if (contact_active_) contact_->finish(model, s);
+  if (contact_active_) contact_->finish(model, s, dynamics.threads());
   return StepResult::success();
 }
 

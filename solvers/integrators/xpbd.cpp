@@ -163,7 +163,7 @@ StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
     place_pins(model.pins, t1, s.x);
     s.v = (s.x - x_start_) / hs;
     s.t = t1;
-    if (contact_active_) contact_->finish(model, s);
+    if (contact_active_) contact_->finish(model, s, dynamics.threads());
     ++substeps_;
   }
   if (!s.x.allFinite() || !s.v.allFinite())

@@ -89,8 +89,8 @@ class ImplicitBodyContact {
   // the set changes; the new set replaces the old only with `commit`.
   bool update(const VecX& dv, bool commit);
   // Ends the step s1 (x1 = x0 + h v1): restitution within the energy the step lost (from the
-  // step's start), statistics into `contact`.
-  void finish(const Model& model, State& s1, BodyContact& contact);
+  // step's start; the energies on up to `threads` threads), statistics into `contact`.
+  void finish(const Model& model, State& s1, BodyContact& contact, int threads);
 
   // The active pairs' (i, j, mode, viscosity, kappa), appended to `out`, and back (restore
   // throws InputError for values no save could have written).

@@ -40,6 +40,7 @@
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/position_contact.hpp>
 
 namespace jelly {
 
@@ -115,8 +116,8 @@ class ImplicitContact {
   void subtract_friction(const VecX& v1, VecX& w) const;
   // Ends the step (s1 = x0 + h v1, v1; time t1): zeroes the contacts' normal velocity relative to
   // the surface, projects onto the surface any particle left below it, and applies restitution
-  // within the energy budget.
-  void finish(const Model& model, const Terrains& terrains, State& s1);
+  // within the energy budget (add_bounded_bounces; its energies on up to `threads` threads).
+  void finish(const Model& model, const Terrains& terrains, State& s1, int threads);
 
   // The contact set as numbers (what begin_step() carries over: particle, terrain, mode,
   // viscosity, release per contact), appended to `out`; and back (InputError when malformed).
@@ -159,6 +160,7 @@ class ImplicitContact {
   const Model* model_ = nullptr;  // of the current step
   VecX x0_, v0_;
   std::vector<Contact> contacts_, next_;
+  std::vector<Bounce> bounces_;    // finish(): the contacts that bounce
   std::vector<int> slot_;          // [N]: index into contacts_ or -1
   std::vector<Real> projectors_;   // [9 * contacts]: S_c column-major (input_map)
   std::vector<char> pinned_mask_;  // [N]: pinned this step

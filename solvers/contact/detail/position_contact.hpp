@@ -64,8 +64,9 @@ class PositionContact {
   // Ends the (sub)step at s1 (t1, v1 = (x1 - x0) / h): contacts stop moving into their surface,
   // and those that approached it faster than its resting_speed at the start bounce with its
   // restitution, scaled down so that the energy (kinetic + elastic + gravitational, in the
-  // surface's frame) does not exceed the energy at the start.
-  void finish(const Model& model, State& s1);
+  // surface's frame) does not exceed the energy at the start (computed on up to `threads`
+  // threads).
+  void finish(const Model& model, State& s1, int threads);
 
   // Particles in contact (after project / finish), and which.
   int count() const { return static_cast<int>(active_.size()); }
@@ -106,8 +107,9 @@ class PositionContact {
 
 // Adds speed * normal to the velocity of each bounce, all scaled by the largest s in [0, 1] that
 // keeps the total energy of s1 (in the frame of the surfaces when they move alike, else the
-// fixed frame) at most that of the start (x0, v0 at time t0). Returns s.
+// fixed frame) at most that of the start (x0, v0 at time t0); the energies on up to `threads`
+// threads. Returns s.
 Real add_bounded_bounces(const Model& model, const VecX& x0, const VecX& v0, Real t0, State& s1,
-                         const std::vector<Bounce>& bounces);
+                         const std::vector<Bounce>& bounces, int threads);
 
 }  // namespace jelly

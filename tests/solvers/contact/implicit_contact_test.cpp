@@ -114,7 +114,7 @@ TEST(ImplicitContact, RestitutionIsBoundedByTheEnergyTheStepLost) {
     s1.x[0] = 0;
     s1.x[3] = 1 + std::sqrt(2 * stored / pair.ks);
     s1.v[0] = -0.1;
-    contact.finish(m, wall, s1);
+    contact.finish(m, wall, s1, 1);
     const Real bounce = s1.v[0];
     const Real expected = std::sqrt(2 * std::min(0.5 - stored, 0.5));  // e V = 1 if affordable
     EXPECT_NEAR(bounce, expected, 1e-12) << stored;
