@@ -18,7 +18,8 @@
 # checkout, else jelly-bench on PATH); SBATCH_FLAGS, extra sbatch flags for both jobs (e.g.
 # "--partition=short --time=02:00:00"). Each task uses the cores Slurm gives it (jelly's
 # default `threads` is the process's CPU affinity); set them with `--cpus-per-task` in
-# SBATCH_FLAGS. Exit codes: those of jelly-bench; 2 for a wrong use of this script.
+# SBATCH_FLAGS; for timed commands (speed, budget) add --exclusive, or tasks sharing a node
+# time each other. Exit codes: those of jelly-bench; 2 for a wrong use of this script.
 #SBATCH --job-name=jelly-bench
 #SBATCH --output=jelly-bench-%A_%a.out
 set -euo pipefail
@@ -61,6 +62,10 @@ case $mode in
     [[ $n =~ ^[1-9][0-9]*$ ]] || usage "N = '$n' is invalid: a whole number of tasks, at least 1"
     [[ $1 != merge ]] || usage "COMMAND = merge is invalid: the merge job is submitted for you"
     command -v sbatch >/dev/null || usage "sbatch not found: submit on a Slurm login node"
+    # Shards of an earlier sweep would be merged with (or overwritten by) this one's.
+    if compgen -G "$out/shards/*.shard-*-of-*.csv" >/dev/null; then
+      usage "OUT = '$out' already holds shards of a sweep ($out/shards): choose a new OUT or remove them"
+    fi
     mkdir -p "$out/shards"
     out=$(cd "$out" && pwd)
     read -r -a flags <<<"${SBATCH_FLAGS:-}"  # split on blanks: no flag value with a space
@@ -68,12 +73,13 @@ case $mode in
     array=$(sbatch --parsable --export=ALL --array="0-$((n - 1))" ${flags[@]+"${flags[@]}"} \
       --output="$out/shards/%x-%A_%a.out" "$source_dir/scripts/slurm_bench.sh" shard "$n" "$out" "$@")
     array=${array%%;*}  # --parsable prints "jobid[;cluster]"
+    echo "submitted: shards job $array (array 0-$((n - 1)))"
     # A failed task cancels the merge (Slurm would otherwise keep it pending for ever).
     merge=$(sbatch --parsable --export=ALL --dependency="afterok:$array" --kill-on-invalid-dep=yes \
       ${flags[@]+"${flags[@]}"} \
       --output="$out/%x-merge-%j.out" "$source_dir/scripts/slurm_bench.sh" merge "$out")
     merge=${merge%%;*}
-    echo "submitted: shards job $array (array 0-$((n - 1))), merge job $merge; results in $out"
+    echo "submitted: merge job $merge, after job $array; results in $out"
     ;;
   shard)
     [[ $# -ge 3 ]] || usage "shard needs N, OUT and a jelly-bench command"

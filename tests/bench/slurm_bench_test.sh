@@ -42,11 +42,15 @@ export SBATCH_LOG=$work/sbatch.log SBATCH_IDS=$work/ids SBATCH_DIR=$work
 export JELLY_BENCH=$bench
 
 # A sweep of 3 shards, submitted from another directory, and the merge after them.
-(cd "$work" && PATH=$work/bin:$PATH bash "$script" submit 3 sweep budget --quick >submit.out) ||
-  fail "submit: $(cat "$work/submit.out")"
-grep -q "shards job 101 (array 0-2), merge job 102" "$work/submit.out" ||
-  fail "submit printed: $(cat "$work/submit.out")"
+(cd "$work" && PATH=$work/bin:$PATH SBATCH_FLAGS="--time=00:10:00 --exclusive" \
+  bash "$script" submit 3 sweep budget --quick >submit.out) || fail "submit: $(cat "$work/submit.out")"
+grep -q "shards job 101 (array 0-2)" "$work/submit.out" && grep -q "merge job 102, after job 101" \
+  "$work/submit.out" || fail "submit printed: $(cat "$work/submit.out")"
 grep -qx -- "--dependency=afterok:101" "$work/sbatch.log" || fail "the merge does not wait for the array"
+grep -qx -- "--kill-on-invalid-dep=yes" "$work/sbatch.log" || fail "a failed task would leave the merge pending"
+[[ $(grep -cx -- "--exclusive" "$work/sbatch.log") -eq 2 ]] || fail "SBATCH_FLAGS not given to both jobs"
+[[ $(grep -cx -- "--output=$work/sweep/shards/%x-%A_%a.out" "$work/sbatch.log") -eq 1 ]] ||
+  fail "the tasks' logs are not kept with their shards"
 for i in 0 1 2; do
   [[ -s $work/sweep/shards/budget.shard-$i-of-3.csv ]] || fail "no shard $i: $(cat "$work/task-$i.out")"
 done
@@ -69,6 +73,8 @@ expect_refusal() {
   [[ $code -eq 2 ]] || fail "$what: exit code $code, expected 2: $(cat "$work/refusal.out")"
   grep -q -- "$pattern" "$work/refusal.out" || fail "$what: $(cat "$work/refusal.out")"
 }
+expect_refusal "a second sweep into the same OUT" "already holds shards" \
+  env PATH="$work/bin:$PATH" bash "$script" submit 3 "$work/sweep" budget --quick
 expect_refusal "N = 0" "N = '0' is invalid" env PATH="$work/bin:$PATH" bash "$script" submit 0 "$work/x" budget
 if ! PATH=/usr/bin:/bin command -v sbatch >/dev/null; then
   expect_refusal "no sbatch" "sbatch not found" env PATH=/usr/bin:/bin bash "$script" submit 2 "$work/x" budget
