@@ -170,7 +170,6 @@ int BandSystem::team(int threads) const {
   if (band_.size() < static_cast<size_t>(team) * kBuffers * stride_) {
     band_.assign(static_cast<size_t>(team) * kBuffers * stride_, 0.0);
   }
-  bands_->balance(team);
   return team;
 }
 
@@ -192,7 +191,7 @@ bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, Defi
   const Real* m = model.mass.data();
   bool any_collapsed = false;
   parallel::run(team, [&](int part, int parts) {
-    const parallel::Range range = bands_->thread_range(part, parts);
+    const parallel::Range range = parallel::split(n, part, parts);
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
     for (int i = p0; i < p1; ++i) {
       for (int c = 0; c < 3; ++c) {
@@ -274,7 +273,7 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) c
   Real* sp = scratch_.data();
   Real* acc = sp + 3 * static_cast<size_t>(n);
   parallel::run(team, [&](int part, int parts) {
-    const parallel::Range range = bands_->thread_range(part, parts);
+    const parallel::Range range = parallel::split(n, part, parts);
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
     for (int i = p0; i < p1; ++i) {
       Real q[3] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};

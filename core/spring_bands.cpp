@@ -137,59 +137,6 @@ SpringBands::Band::Reach SpringBands::Band::reach(int p0, int p1) const {
   return r;
 }
 
-long SpringBands::slots_touching(int p0, int p1) const {
-  if (p0 >= p1) return 0;
-  long slots = 0;
-  for (const Band& band : bands_) {
-    const Band::Reach r = band.reach(p0, p1);
-    slots += std::max(0, r.hi - r.lo);
-  }
-  return slots;
-}
-
-void SpringBands::balance(int parts) const {
-  if (parts == cut_parts_) return;
-  const int n = particles_;
-  cuts_.assign(static_cast<size_t>(parts) + 1, n);
-  cuts_[0] = 0;
-  // The longest range from `begin` whose thread computes at most `most` slots.
-  const auto reach_end = [&](int begin, long most) {
-    int lo = begin, hi = n;  // the last end within `most` (the slots grow with the end)
-    while (lo < hi) {
-      const int mid = hi - (hi - lo) / 2;
-      if (slots_touching(begin, mid) <= most) {
-        lo = mid;
-      } else {
-        hi = mid - 1;
-      }
-    }
-    return lo;
-  };
-  // Whether `parts` ranges of at most `most` slots each cover the particles (greedily).
-  const auto fits = [&](long most) {
-    int begin = 0;
-    for (int part = 0; part < parts && begin < n; ++part) begin = reach_end(begin, most);
-    return begin >= n;
-  };
-  // The least such bound (bisection), then its ranges.
-  long lo = slots_touching(0, n) / parts, hi = slots_touching(0, n);
-  while (lo < hi) {
-    const long mid = lo + (hi - lo) / 2;
-    if (fits(mid)) {
-      hi = mid;
-    } else {
-      lo = mid + 1;
-    }
-  }
-  for (int part = 0; part + 1 < parts; ++part) cuts_[part + 1] = reach_end(cuts_[part], lo);
-  cut_parts_ = parts;
-}
-
-parallel::Range SpringBands::thread_range(int part, int parts) const {
-  if (parts != cut_parts_) return parallel::split(particles_, part, parts);
-  return {cuts_[part], cuts_[part + 1]};
-}
-
 SpringBands::SpringBands(const Model& model)
     : particles_(model.num_particles()), springs_(model.springs.size()) {
   const Springs& s = model.springs;
@@ -273,9 +220,8 @@ void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& 
   const Real* m = model.mass.data();
   const Vec3 g = model.gravity;
   bool any_collapsed = false;
-  balance(team);
   parallel::run(team, [&](int part, int parts) {
-    const parallel::Range range = thread_range(part, parts);
+    const parallel::Range range = parallel::split(n, part, parts);
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
     for (int i = p0; i < p1; ++i) {
       px[i] = x[3 * i];

@@ -52,8 +52,7 @@ class BandSystem {
   struct Slots {
     std::vector<Real> e1, c2;  // [slots]: c1 / |x_a - x_b|^2 and c2
   };
-  // The threads of a pass over the slots, with band_ sized and the bands' ranges balanced for
-  // them.
+  // The threads of a pass over the slots, with band_ sized for them.
   int team(int threads) const;
 
   const SpringBands* bands_ = nullptr;

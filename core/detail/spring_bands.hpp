@@ -11,12 +11,9 @@
 // do not fill their bands densely, or a state with a degenerate (collapsed) spring, is evaluated
 // by compute_forces instead. With threads, each thread owns a range of particles; it computes
 // the forces of the slots that touch its particles (the slots at the boundary of two ranges are
-// computed by both) and adds them in the serial loop's order (docs/threads.md). The ranges are
-// balanced by slots, not particles: a range above the first also computes the slots that cross
-// into it from below (up to the band's offset per band).
+// computed by both) and adds them in the serial loop's order (docs/threads.md).
 #include <vector>
 
-#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/model.hpp>
 
 namespace jelly {
@@ -59,19 +56,9 @@ class SpringBands {
   void compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f,
                       int threads = 1) const;
 
-  // The particles [begin, end) of thread `part` of `parts` in a band loop: ranges with about
-  // equal numbers of slots to compute once balance(parts) was called (else equal numbers of
-  // particles). Any split gives the same bits; this one gives the threads equal work.
-  parallel::Range thread_range(int part, int parts) const;
-  // Computes the balanced ranges of `parts` threads (allocates when `parts` changes). Call
-  // before the parallel region.
-  void balance(int parts) const;
-
  private:
   // Copies rest lengths, ks and kd from the model into the bands.
   void copy_coefficients(const Model& model);
-  // The slots a thread owning the particles [p0, p1) computes, over all bands.
-  long slots_touching(int p0, int p1) const;
 
   std::vector<Band> bands_;
   int particles_ = 0;
@@ -83,9 +70,6 @@ class SpringBands {
   mutable std::vector<Real> scratch_;
   mutable std::vector<Real> band_force_;
   mutable std::vector<int> collapsed_;
-  // balance(): the first particle of each of cut_parts_ ranges, and the end.
-  mutable std::vector<int> cuts_;
-  mutable int cut_parts_ = 0;
 };
 
 }  // namespace jelly
