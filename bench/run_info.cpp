@@ -4,6 +4,7 @@
 #include <fstream>
 #include <thread>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/version.hpp>
 
 #ifndef JELLY_BENCH_BUILD_TYPE
@@ -27,7 +28,10 @@ std::string cpu_model() {
 Metadata run_metadata(const std::vector<std::string>& arguments) {
   Metadata m;
   m["cpu"] = cpu_model();
-  m["cores"] = std::to_string(std::thread::hardware_concurrency());
+  // The cores this process may run on (its CPU affinity: a Slurm task's allocation, taskset),
+  // which the default thread count uses; and the machine's.
+  m["cores"] = std::to_string(parallel::available_cores());
+  m["hardware_cores"] = std::to_string(std::thread::hardware_concurrency());
   m["build_type"] = JELLY_BENCH_BUILD_TYPE;
   m["jelly_version"] = JELLY_VERSION_STRING;
 #if defined(__clang__)

@@ -8,7 +8,8 @@
 
 namespace jelly::bench {
 
-// Keys: cpu, cores, build_type, jelly_version, compiler, command_line, date_utc.
+// Keys: cpu, cores (those the process may run on), hardware_cores, build_type, jelly_version,
+// compiler, command_line, date_utc.
 Metadata run_metadata(const std::vector<std::string>& arguments);
 
 // The CPU model from /proc/cpuinfo ("unknown" when it cannot be read).

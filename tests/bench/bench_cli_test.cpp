@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -91,6 +92,22 @@ TEST_F(BenchCli, QuickKeepsOptionsGivenExplicitly) {
   // The row of the one configuration: item 0, rk4, n = 3, 1 thread, ..., steps = 7 (not
   // --quick's 20).
   EXPECT_THAT(csv, HasSubstr("\n0,rk4,3,1,27,185,0.001,7,completed,"));
+}
+
+// The `cores` of a table's metadata are the ones the run could use (its CPU affinity: taskset,
+// a Slurm task's allocation), which its default thread count follows; `hardware_cores` the
+// machine's.
+TEST_F(BenchCli, CoresAreTheProcessAffinity) {
+  if (std::system("command -v taskset >/dev/null 2>&1") != 0) GTEST_SKIP() << "no taskset";
+  const fs::path out = dir_ / "out";
+  const std::string command = std::string("taskset -c 0 '") + JELLY_BENCH +
+                              "' budget --quick --setups 'xpbd s1' --out '" + out.string() +
+                              "' >/dev/null 2>&1 </dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  const std::string csv = read_file(out / "budget.csv");
+  EXPECT_THAT(csv, HasSubstr("\n# cores: 1\n"));
+  EXPECT_THAT(csv, HasSubstr("\n# hardware_cores: " +
+                             std::to_string(std::thread::hardware_concurrency()) + "\n"));
 }
 
 }  // namespace
