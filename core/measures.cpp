@@ -13,26 +13,26 @@ Real kinetic_energy(const Model& model, const VecX& v) {
   return e;
 }
 
-Real elastic_energy(const Model& model, const VecX& x) {
-  const Springs& s = model.springs;
+namespace {
+// The energy ks (|xa - xb| - l0)^2 / 2 of springs [begin, end), summed in order.
+Real springs_energy(const Springs& s, const VecX& x, long begin, long end) {
   Real e = 0;
-  for (int k = 0; k < s.size(); ++k) {
+  for (long k = begin; k < end; ++k) {
     const Real stretch = (particle(x, s.a[k]) - particle(x, s.b[k])).norm() - s.rest_length[k];
     e += 0.5 * s.ks[k] * stretch * stretch;
   }
   return e;
 }
+}  // namespace
+
+Real elastic_energy(const Model& model, const VecX& x) {
+  return springs_energy(model.springs, x, 0, model.springs.size());
+}
 
 Real elastic_energy(const Model& model, const VecX& x, int threads) {
-  const Springs& s = model.springs;
   thread_local std::vector<Real> partials;  // no allocation once sized
-  return parallel::ordered_sum(threads, s.size(), partials, [&](long begin, long end) {
-    Real e = 0;
-    for (long k = begin; k < end; ++k) {
-      const Real stretch = (particle(x, s.a[k]) - particle(x, s.b[k])).norm() - s.rest_length[k];
-      e += 0.5 * s.ks[k] * stretch * stretch;
-    }
-    return e;
+  return parallel::ordered_sum(threads, model.springs.size(), partials, [&](long begin, long end) {
+    return springs_energy(model.springs, x, begin, end);
   });
 }
 

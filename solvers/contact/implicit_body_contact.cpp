@@ -8,6 +8,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/solvers/contact/detail/restitution.hpp>
 
 namespace jelly {
 
@@ -293,14 +294,8 @@ void ImplicitBodyContact::finish(const Model& model, State& s1, BodyContact& con
     }
     const Real budget = energy_in_frame(model, x0_, v0_, Vec3::Zero(), 0, threads) -
                         energy_in_frame(model, s1.x, s1.v, Vec3::Zero(), 0, threads);
-    Real s = 1;
-    if (linear + quadratic > budget) {
-      const Real disc = linear * linear + 4 * quadratic * budget;
-      s = disc > 0 && quadratic > 0
-              ? std::clamp((-linear + std::sqrt(disc)) / (2 * quadratic), 0.0, 1.0)
-              : 0.0;
-      ++counters_.restitution_limited;
-    }
+    const Real s = affordable_scale(linear, quadratic, budget);
+    if (linear + quadratic > budget) ++counters_.restitution_limited;
     if (s > 0) s1.v += s * bounce_;
   }
   seconds_ += std::chrono::duration<double>(Clock::now() - start).count();

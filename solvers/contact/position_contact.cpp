@@ -16,33 +16,6 @@ Vec3 tangential(const Vec3& w, const Vec3& n) { return w - w.dot(n) * n; }
 
 }  // namespace
 
-Real add_bounded_bounces(const Model& model, const VecX& x0, const VecX& v0, Real t0, State& s1,
-                         const std::vector<Bounce>& bounces, int threads) {
-  if (bounces.empty()) return 1;
-  Real quadratic = 0;
-  bool one_frame = true;
-  const Vec3 first = bounces.front().surface_velocity;
-  for (const Bounce& b : bounces) {
-    quadratic += 0.5 * model.mass[b.particle] * b.speed * b.speed;
-    one_frame = one_frame && (b.surface_velocity - first).norm() <= 1e-12 * (1 + first.norm());
-  }
-  const Vec3 frame = one_frame ? first : Vec3::Zero();
-  Real linear = 0;
-  for (const Bounce& b : bounces)
-    linear += model.mass[b.particle] * b.speed * (particle(s1.v, b.particle) - frame).dot(b.normal);
-  const Real budget = energy_in_frame(model, x0, v0, frame, t0, threads) -
-                      energy_in_frame(model, s1.x, s1.v, frame, s1.t, threads);
-  // Largest s in [0, 1] with kinetic energy gain s linear + s^2 quadratic <= budget.
-  Real s = 1;
-  if (linear + quadratic > budget) {
-    const Real disc = linear * linear + 4 * quadratic * budget;
-    s = disc > 0 ? std::clamp((-linear + std::sqrt(disc)) / (2 * quadratic), 0.0, 1.0) : 0.0;
-  }
-  if (s <= 0) return 0;
-  for (const Bounce& b : bounces) particle(s1.v, b.particle) += (s * b.speed) * b.normal;
-  return s;
-}
-
 bool PositionContact::begin(const Model& model, const Terrains& terrains, const State& s0, Real h,
                             bool keep_contacts) {
   const bool same_scene = model_ == &model && terrains_ == &terrains &&

@@ -78,9 +78,10 @@ struct ImplicitEuler::Impl {
   void constrain(const VecX& b, bool prescribe, VecX& guess);
   // The contacts' next active set after a solve (ImplicitContact::update).
   bool update_contacts(const Terrains& terrains, const VecX& b, bool commit);
-  // Matrix-free block-Jacobi CG on band_ (filtered by the contacts when constrained).
-  StepResult solve_matrix_free(const Model& model, const VecX& b, VecX& y, bool constrained,
-                               Real t);
+  // Matrix-free block-Jacobi CG on band_ (filtered by the contacts when constrained), to the
+  // relative residual `tolerance`.
+  StepResult solve_matrix_free(const Model& model, const VecX& b, VecX& y, bool constrained, Real t,
+                               Real tolerance);
   // The solve's status as a step result (naming t), a check for non-finite values, and the
   // momentum correction of an unconstrained CG solve.
   StepResult finish_solve(const Model& model, const LinearResult& r, const VecX& b, VecX& y,
@@ -88,9 +89,10 @@ struct ImplicitEuler::Impl {
   // Factorizes A (filtered by the contact constraints, if any) and solves for dv_: the
   // linearized step, repeated while the contacts' active set changes.
   StepResult linearized_solve(const Dynamics& dynamics, const State& s, Real h);
-  // Factorizes a_ and solves a_ y = b (constrained: a_ is filtered by contacts).
+  // Factorizes a_ and solves a_ y = b (constrained: a_ is filtered by contacts); a matrix-free
+  // solve to `cg_tolerance` when given (a screening solve), else to options_.cg_tolerance.
   StepResult factorize_and_solve(const Model& model, const VecX& b, VecX& y, bool constrained,
-                                 Real t);
+                                 Real t, Real cg_tolerance = 0);
   // Newton corrections on the nonlinear backward-Euler equations from v1_.
   StepResult newton(const Dynamics& dynamics, const State& s, Real h);
   // Wind drag at time t: d(f)/d(v) = -drag on its particles, so A gains h drag on the diagonal.
@@ -121,7 +123,6 @@ struct ImplicitEuler::Impl {
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
   VecX az_;
-  Real screen_tolerance_ = 0;  // > 0: the running solve is a screening solve to this tolerance
   int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
@@ -387,7 +388,7 @@ bool ImplicitEuler::Impl::update_contacts(const Terrains& terrains, const VecX& 
 }
 
 StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX& b, VecX& y,
-                                                  bool constrained, Real t) {
+                                                  bool constrained, Real t, Real tolerance) {
   auto start = Clock::now();
   // Block Jacobi: the inverses of the (filtered) diagonal blocks.
   LinearResult r = band_cg_.set_diagonal_blocks(
@@ -405,9 +406,7 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
       band_->multiply(in, out, threads_, input);
       if (constrained) contact_.filter_output(in, out);
     };
-    r = band_cg_.solve(apply, b, y,
-                       screen_tolerance_ > 0 ? screen_tolerance_ : options_.cg_tolerance,
-                       options_.cg_max_iterations, threads_);
+    r = band_cg_.solve(apply, b, y, tolerance, options_.cg_max_iterations, threads_);
     solve_seconds_ += seconds_since(start);
   }
   return finish_solve(model, r, b, y, constrained, t);
@@ -447,8 +446,11 @@ void ImplicitEuler::Impl::refresh_pair_terms() {
 }
 
 StepResult ImplicitEuler::Impl::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
-                                                    bool constrained, Real t) {
-  if (matrix_free_) return solve_matrix_free(model, b, y, constrained, t);
+                                                    bool constrained, Real t, Real cg_tolerance) {
+  if (matrix_free_) {
+    return solve_matrix_free(model, b, y, constrained, t,
+                             cg_tolerance > 0 ? cg_tolerance : options_.cg_tolerance);
+  }
   auto start = Clock::now();
   LinearResult r = solver_->factorize(a_);
   factorization_seconds_ += seconds_since(start);
@@ -505,14 +507,15 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   contact_terrains_ = terrains;
   contact_active_ = (resolves_contact() || !model.pins.empty()) &&
                     contact_.begin_step(model, *terrains, s, f_, h);
-  // One solve of the current set (constrained by the contacts it holds) into dv_.
-  const auto solve = [&]() -> StepResult {
+  // One solve of the current set (constrained by the contacts it holds) into dv_, to CG's
+  // `tolerance` (0: cg_tolerance).
+  const auto solve = [&](Real tolerance) -> StepResult {
     const bool constrained = contact_active_ && contact_.has_constraints();
     if (constrained) constrain(b_, true, dv_);
-    StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t);
+    StepResult r =
+        factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t, tolerance);
     if (!r.ok) {
       have_dv_ = false;
-      screen_tolerance_ = 0;
       return r;
     }
     if (constrained) dv_ += z_;
@@ -526,16 +529,14 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     const Real screen = options_.contact_screening_tolerance;
     const bool screening = matrix_free_ && contact_active_ && !bodies_active_ &&
                            screen > options_.cg_tolerance && round < options_.contact_iterations;
-    screen_tolerance_ = screening ? screen : 0;
-    if (StepResult r = solve(); !r.ok) return r;
+    if (StepResult r = solve(screening ? screen : 0); !r.ok) return r;
     ++newton_iterations_;
     if (!contact_active_ && !bodies_active_) break;
     const bool last = round >= options_.contact_iterations;
     bool terrain_changed = contact_active_ && update_contacts(*terrains, b_, !last);
     if (screening && !terrain_changed) {
       // The set held on the loose solve: finish the solve at the full tolerance and check again.
-      screen_tolerance_ = 0;
-      if (StepResult r = solve(); !r.ok) return r;
+      if (StepResult r = solve(0); !r.ok) return r;
       terrain_changed = update_contacts(*terrains, b_, !last);
     }
     const bool pairs_changed = bodies_active_ && bodies_.update(dv_, !last);
@@ -547,7 +548,6 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
       refresh_pair_terms();
     }
   }
-  screen_tolerance_ = 0;
   have_dv_ = true;
   return StepResult::success();
 }

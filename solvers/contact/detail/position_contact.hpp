@@ -18,16 +18,9 @@
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/restitution.hpp>
 
 namespace jelly {
-
-// A restitution impulse after a (sub)step.
-struct Bounce {
-  int particle;
-  Vec3 normal;
-  Vec3 surface_velocity;
-  Real speed;  // e times the approach speed
-};
 
 class PositionContact {
  public:
@@ -104,12 +97,5 @@ class PositionContact {
   std::vector<Bounce> bounces_;
   Counters counters_;
 };
-
-// Adds speed * normal to the velocity of each bounce, all scaled by the largest s in [0, 1] that
-// keeps the total energy of s1 (in the frame of the surfaces when they move alike, else the
-// fixed frame) at most that of the start (x0, v0 at time t0); the energies on up to `threads`
-// threads. Returns s.
-Real add_bounded_bounces(const Model& model, const VecX& x0, const VecX& v0, Real t0, State& s1,
-                         const std::vector<Bounce>& bounces, int threads);
 
 }  // namespace jelly
