@@ -117,6 +117,32 @@ BENCHMARK(BM_MatrixFreeProduct)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// One assembly of the matrix-free system (implicit_euler's per-step A = M - h D - h^2 K and
+// K v, core/detail/band_system.hpp) on the deformed cube; arguments n and the threads.
+void BM_MatrixFreeAssembly(benchmark::State& bench) {
+  const int threads = static_cast<int>(bench.range(1));
+  DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
+  if (!cube.usable(bench)) return;
+  State s = rest_state(cube.model);
+  for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
+  const VecX v = 0.1 * cube.vector();
+  VecX kw(cube.model.num_dofs());
+  const Real h = 1.0 / 60;
+  for (auto _ : bench) {
+    cube.system.assemble(cube.model, s.x, v, DefinitenessFix::kClampCompressed, h, h * h, v, kw,
+                         threads);
+    benchmark::DoNotOptimize(kw.data());
+  }
+  const double springs = static_cast<double>(cube.model.springs.size());
+  bench.counters["s_per_spring"] = benchmark::Counter(
+      springs, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_MatrixFreeAssembly)
+    ->Args({40, 1})
+    ->Args({40, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 // A solve of 100 iterations of implicit_euler's matrix-free block-Jacobi CG
 // (solvers/linear/cg_solver.hpp) on the same system from x = 0: 101 products (the starting
 // residual's and one per iteration) plus CG's vector operations, ordered sums and

@@ -20,16 +20,17 @@ struct Ends {
   const Real *xa, *ya, *za, *xb, *yb, *zb;
 };
 
-// Per slot: B = c1 u u^T + c2 I and t = K_k (w_a - w_b), with (the spring_blocks of
-// core/jacobian.cpp) s the geometric stiffness after the definiteness fix,
-// K_k = -(ks - s) u u^T - s I, D_k = -kd u u^T, B = -alpha D_k - beta K_k. Returns the number of
-// collapsed springs.
-JELLY_VECTOR_CLONES
-int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
-                const Real* __restrict rest, const Real* __restrict ks, const Real* __restrict kd,
-                Real* __restrict c1, Real* __restrict c2, Real* __restrict e1, Real* __restrict ux,
-                Real* __restrict uy, Real* __restrict uz, Real* __restrict tx, Real* __restrict ty,
-                Real* __restrict tz) {
+// max(x, 0) as std::max computes it (x itself unless x < 0; NaN stays NaN), by value.
+inline Real positive_part(Real x) { return x < 0 ? 0.0 : x; }
+
+// The loop of band_blocks for one definiteness fix (1 kClampCompressed, 2 kProjectPsd, else
+// none): a template, because a select on the fix in the loop kept it from being vectorised.
+template <int Fix>
+__attribute__((always_inline)) inline int band_blocks_loop(
+    int n, Real alpha, Real beta, Ends x, Ends v, Ends w, const Real* __restrict rest,
+    const Real* __restrict ks, const Real* __restrict kd, Real* __restrict c1, Real* __restrict c2,
+    Real* __restrict e1, Real* __restrict ux, Real* __restrict uy, Real* __restrict uz,
+    Real* __restrict tx, Real* __restrict ty, Real* __restrict tz) {
   const Real* __restrict xa = x.xa;
   const Real* __restrict ya = x.ya;
   const Real* __restrict za = x.za;
@@ -59,10 +60,10 @@ int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
     const Real spring_geometric = ks[j] * (1 - rest[j] * inv);
     const Real damper_geometric = kd[j] * c * inv;
     Real s;
-    if (fix == 1) {  // kClampCompressed
-      s = std::max<Real>(spring_geometric, 0) + std::max<Real>(damper_geometric, 0);
-    } else if (fix == 2) {  // kProjectPsd
-      s = std::max<Real>(spring_geometric + damper_geometric, 0);
+    if constexpr (Fix == 1) {
+      s = positive_part(spring_geometric) + positive_part(damper_geometric);
+    } else if constexpr (Fix == 2) {
+      s = positive_part(spring_geometric + damper_geometric);
     } else {
       s = spring_geometric + damper_geometric;
     }
@@ -81,6 +82,26 @@ int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
     collapsed += length < kDegenerateLength * rest[j];
   }
   return collapsed;
+}
+
+// Per slot: B = c1 u u^T + c2 I and t = K_k (w_a - w_b), with (the spring_blocks of
+// core/jacobian.cpp) s the geometric stiffness after the definiteness fix,
+// K_k = -(ks - s) u u^T - s I, D_k = -kd u u^T, B = -alpha D_k - beta K_k. Returns the number of
+// collapsed springs.
+JELLY_VECTOR_CLONES
+int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
+                const Real* __restrict rest, const Real* __restrict ks, const Real* __restrict kd,
+                Real* __restrict c1, Real* __restrict c2, Real* __restrict e1, Real* __restrict ux,
+                Real* __restrict uy, Real* __restrict uz, Real* __restrict tx, Real* __restrict ty,
+                Real* __restrict tz) {
+  if (fix == 1)
+    return band_blocks_loop<1>(n, alpha, beta, x, v, w, rest, ks, kd, c1, c2, e1, ux, uy, uz, tx,
+                               ty, tz);
+  if (fix == 2)
+    return band_blocks_loop<2>(n, alpha, beta, x, v, w, rest, ks, kd, c1, c2, e1, ux, uy, uz, tx,
+                               ty, tz);
+  return band_blocks_loop<0>(n, alpha, beta, x, v, w, rest, ks, kd, c1, c2, e1, ux, uy, uz, tx, ty,
+                             tz);
 }
 
 // Per slot t = B (p_a - p_b) = c1 (u . d) u + c2 d = e1 (e . d) e + c2 d, with e = x_a - x_b
@@ -262,6 +283,50 @@ void BandSystem::diagonal_block(int i, Real out[9]) const {
   out[1] = out[3] = d[3 * n];
   out[2] = out[6] = d[4 * n];
   out[5] = out[7] = d[5 * n];
+}
+
+void BandSystem::multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y) const {
+  const int n = num_particles_;
+  const Real* sx = positions_.data();
+  const std::vector<SpringBands::Band>& bands = bands_->bands();
+  // The term t of `slot` of band k, as band_products computes it.
+  const auto term = [&](size_t k, int slot, Real t[3]) {
+    const SpringBands::Band& band = bands[k];
+    const int a = band.first + slot, b = a + band.offset;
+    const Real u0 = sx[a] - sx[b], u1 = sx[n + a] - sx[n + b], u2 = sx[2 * n + a] - sx[2 * n + b];
+    const Real d0 = p[3 * a] - p[3 * b], d1 = p[3 * a + 1] - p[3 * b + 1],
+               d2 = p[3 * a + 2] - p[3 * b + 2];
+    const Real e1 = slots_[k].e1[slot], c2 = slots_[k].c2[slot];
+    const Real ud = e1 * (u0 * d0 + u1 * d1 + u2 * d2);
+    t[0] = ud * u0 + c2 * d0;
+    t[1] = ud * u1 + c2 * d1;
+    t[2] = ud * u2 + c2 * d2;
+  };
+  for (const int i : particles) {
+    Real acc[3];
+    for (int c = 0; c < 3; ++c) acc[c] = mass_[i] * p[3 * i + c];
+    // Band by band as multiply adds them (band_kernels::add_ends): t_first - t_second where the
+    // particle is both ends' of a slot, else +t_first or -t_second.
+    for (size_t k = 0; k < bands.size(); ++k) {
+      const SpringBands::Band& band = bands[k];
+      const int first = i - band.first, second = first - band.offset;
+      const bool is_first = first >= 0 && first < band.slots();
+      const bool is_second = second >= 0 && second < band.slots();
+      Real tf[3] = {}, ts[3] = {};
+      if (is_first) term(k, first, tf);
+      if (is_second) term(k, second, ts);
+      for (int c = 0; c < 3; ++c) {
+        if (is_first && is_second) {
+          acc[c] += tf[c] - ts[c];
+        } else if (is_first) {
+          acc[c] += tf[c];
+        } else if (is_second) {
+          acc[c] -= ts[c];
+        }
+      }
+    }
+    for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c];
+  }
 }
 
 void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) const {

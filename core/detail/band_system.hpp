@@ -45,6 +45,10 @@ class BandSystem {
   // y = A p, or y = A (F p) with F the map `input` (when its slot is not null). No allocation
   // after the first call with this thread count.
   void multiply(const VecX& p, VecX& y, int threads, InputMap input = {}) const;
+  // The rows of y = A p at the given particles only (the other rows of y are left as they
+  // are): the same bits as multiply's. Serial; for a few particles (the contacts' impulses)
+  // instead of a whole product.
+  void multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y) const;
   // The diagonal 3x3 block of particle i, row-major.
   void diagonal_block(int i, Real out[9]) const;
 

@@ -150,8 +150,8 @@ void bind_solvers(py::module_& m) {
                      "Relative residual of CG.")
       .def_readwrite("contact_screening_tolerance",
                      &ImplicitEulerOptions::contact_screening_tolerance,
-                     "0 (off) or a looser CG residual at which each solve of a step with "
-                     "contacts first checks the contacts' set (docs/implicit.md).")
+                     "A looser CG residual at which each solve of a step with contacts first "
+                     "checks the contacts' set (default 1e-3; 0 = off; docs/implicit.md).")
       .def_readwrite("cg_max_iterations", &ImplicitEulerOptions::cg_max_iterations,
                      "CG iteration cap.")
       .def_readwrite("refactor_iterations", &ImplicitEulerOptions::refactor_iterations,

@@ -384,7 +384,7 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
                              SparseMatrix& a) {
   // p = (A dv - b)_c from the original column (A is symmetric).
   return update_impl(
-      terrains, dv, commit,
+      terrains, dv, commit, false,
       [&](int ci, const Contact& c) {
         const BlockColumn col = block_column(a, c.particle);
         const Real* orig = saved_.data() + saved_at_[ci];
@@ -400,9 +400,9 @@ bool ImplicitContact::update(const Terrains& terrains, const VecX& b, const VecX
 }
 
 bool ImplicitContact::update_from_product(const Terrains& terrains, const VecX& b, const VecX& dv,
-                                          bool commit, const VecX& a_dv) {
+                                          bool commit, const VecX& a_dv, bool screening) {
   return update_impl(
-      terrains, dv, commit,
+      terrains, dv, commit, screening,
       [&](int, const Contact& c) {
         return Vec3(particle(a_dv, c.particle) - particle(b, c.particle));
       },
@@ -411,7 +411,8 @@ bool ImplicitContact::update_from_product(const Terrains& terrains, const VecX& 
 
 template <class Impulse, class Unconstrain>
 bool ImplicitContact::update_impl(const Terrains& terrains, const VecX& dv, bool commit,
-                                  Impulse&& impulse, Unconstrain&& unconstrain_matrix) {
+                                  bool screening, Impulse&& impulse,
+                                  Unconstrain&& unconstrain_matrix) {
   bool changed = false;
   next_.clear();
   for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
@@ -476,7 +477,10 @@ bool ImplicitContact::update_impl(const Terrains& terrains, const VecX& dv, bool
     }
   }
   if (!changed) {  // same particles in the same order: keep the new impulses and friction
-    contacts_.swap(next_);
+    // (Screening: the finished solve decides them. Taking them from the loose solve as well
+    // would update the friction once more per step than without screening: the jelly then
+    // ended 3 mm from the unscreened run at n = 20 in 0.5 s, against 3e-5 m without.)
+    if (!screening) contacts_.swap(next_);
   } else if (commit) {
     unconstrain_matrix();
     contacts_.swap(next_);

@@ -77,11 +77,13 @@ struct ImplicitEuler::Impl {
   // or its matrix-free counterpart).
   void constrain(const VecX& b, bool prescribe, VecX& guess);
   // The contacts' next active set after a solve (ImplicitContact::update).
-  bool update_contacts(const Terrains& terrains, const VecX& b, bool commit);
+  bool update_contacts(const Terrains& terrains, const VecX& b, bool commit,
+                       bool screening = false);
   // Matrix-free block-Jacobi CG on band_ (filtered by the contacts when constrained), to the
-  // relative residual `tolerance`.
+  // relative residual `tolerance`; `resume`: the system is the last solve's (its block
+  // inverses are kept).
   StepResult solve_matrix_free(const Model& model, const VecX& b, VecX& y, bool constrained, Real t,
-                               Real tolerance);
+                               Real tolerance, bool resume);
   // The solve's status as a step result (naming t), a check for non-finite values, and the
   // momentum correction of an unconstrained CG solve.
   StepResult finish_solve(const Model& model, const LinearResult& r, const VecX& b, VecX& y,
@@ -90,9 +92,10 @@ struct ImplicitEuler::Impl {
   // linearized step, repeated while the contacts' active set changes.
   StepResult linearized_solve(const Dynamics& dynamics, const State& s, Real h);
   // Factorizes a_ and solves a_ y = b (constrained: a_ is filtered by contacts); a matrix-free
-  // solve to `cg_tolerance` when given (a screening solve), else to options_.cg_tolerance.
+  // solve to `cg_tolerance` when given (a screening solve), else to options_.cg_tolerance, and
+  // with `resume` (matrix-free only) from the last solve's system and preconditioner.
   StepResult factorize_and_solve(const Model& model, const VecX& b, VecX& y, bool constrained,
-                                 Real t, Real cg_tolerance = 0);
+                                 Real t, Real cg_tolerance = 0, bool resume = false);
   // Newton corrections on the nonlinear backward-Euler equations from v1_.
   StepResult newton(const Dynamics& dynamics, const State& s, Real h);
   // Wind drag at time t: d(f)/d(v) = -drag on its particles, so A gains h drag on the diagonal.
@@ -123,6 +126,7 @@ struct ImplicitEuler::Impl {
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
   VecX az_;
+  std::vector<int> contact_rows_;  // the contacts' particles, for their rows of A dv
   int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
   ImplicitContact contact_;
@@ -381,23 +385,31 @@ void ImplicitEuler::Impl::constrain(const VecX& b, bool prescribe, VecX& guess) 
   contact_.constrain_rhs(b, prescribe, &az_, rhs_, z_, guess);
 }
 
-bool ImplicitEuler::Impl::update_contacts(const Terrains& terrains, const VecX& b, bool commit) {
+bool ImplicitEuler::Impl::update_contacts(const Terrains& terrains, const VecX& b, bool commit,
+                                          bool screening) {
   if (!matrix_free_) return contact_.update(terrains, b, dv_, commit, a_);
-  band_->multiply(dv_, az_, threads_);
-  return contact_.update_from_product(terrains, b, dv_, commit, az_);
+  // The contacts' impulses need A dv at their particles only.
+  contact_rows_.clear();
+  for (const auto& c : contact_.contacts()) contact_rows_.push_back(c.particle);
+  band_->multiply_rows(dv_, contact_rows_, az_);
+  return contact_.update_from_product(terrains, b, dv_, commit, az_, screening);
 }
 
 StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX& b, VecX& y,
-                                                  bool constrained, Real t, Real tolerance) {
+                                                  bool constrained, Real t, Real tolerance,
+                                                  bool resume) {
   auto start = Clock::now();
   // Block Jacobi: the inverses of the (filtered) diagonal blocks.
-  LinearResult r = band_cg_.set_diagonal_blocks(
-      model.num_particles(),
-      [&](int i, Real d[9]) {
-        band_->diagonal_block(i, d);
-        if (constrained) contact_.filter_diagonal_block(i, d);
-      },
-      threads_);
+  LinearResult r;
+  if (!resume) {
+    r = band_cg_.set_diagonal_blocks(
+        model.num_particles(),
+        [&](int i, Real d[9]) {
+          band_->diagonal_block(i, d);
+          if (constrained) contact_.filter_diagonal_block(i, d);
+        },
+        threads_);
+  }
   factorization_seconds_ += seconds_since(start);
   if (r.ok()) {
     start = Clock::now();
@@ -446,10 +458,11 @@ void ImplicitEuler::Impl::refresh_pair_terms() {
 }
 
 StepResult ImplicitEuler::Impl::factorize_and_solve(const Model& model, const VecX& b, VecX& y,
-                                                    bool constrained, Real t, Real cg_tolerance) {
+                                                    bool constrained, Real t, Real cg_tolerance,
+                                                    bool resume) {
   if (matrix_free_) {
     return solve_matrix_free(model, b, y, constrained, t,
-                             cg_tolerance > 0 ? cg_tolerance : options_.cg_tolerance);
+                             cg_tolerance > 0 ? cg_tolerance : options_.cg_tolerance, resume);
   }
   auto start = Clock::now();
   LinearResult r = solver_->factorize(a_);
@@ -508,12 +521,17 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   contact_active_ = (resolves_contact() || !model.pins.empty()) &&
                     contact_.begin_step(model, *terrains, s, f_, h);
   // One solve of the current set (constrained by the contacts it holds) into dv_, to CG's
-  // `tolerance` (0: cg_tolerance).
-  const auto solve = [&](Real tolerance) -> StepResult {
+  // `tolerance` (0: cg_tolerance); `resume`: the set and the system are the last solve's, which
+  // this one continues (rhs_, z_ and the block inverses stay; dv_ back to the free directions).
+  const auto solve = [&](Real tolerance, bool resume) -> StepResult {
     const bool constrained = contact_active_ && contact_.has_constraints();
-    if (constrained) constrain(b_, true, dv_);
-    StepResult r =
-        factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t, tolerance);
+    if (constrained && resume) {
+      contact_.project(dv_);
+    } else if (constrained) {
+      constrain(b_, true, dv_);
+    }
+    StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t,
+                                       tolerance, resume);
     if (!r.ok) {
       have_dv_ = false;
       return r;
@@ -529,14 +547,14 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     const Real screen = options_.contact_screening_tolerance;
     const bool screening = matrix_free_ && contact_active_ && !bodies_active_ &&
                            screen > options_.cg_tolerance && round < options_.contact_iterations;
-    if (StepResult r = solve(screening ? screen : 0); !r.ok) return r;
+    if (StepResult r = solve(screening ? screen : 0, false); !r.ok) return r;
     ++newton_iterations_;
     if (!contact_active_ && !bodies_active_) break;
     const bool last = round >= options_.contact_iterations;
-    bool terrain_changed = contact_active_ && update_contacts(*terrains, b_, !last);
+    bool terrain_changed = contact_active_ && update_contacts(*terrains, b_, !last, screening);
     if (screening && !terrain_changed) {
       // The set held on the loose solve: finish the solve at the full tolerance and check again.
-      if (StepResult r = solve(0); !r.ok) return r;
+      if (StepResult r = solve(0, true); !r.ok) return r;
       terrain_changed = update_contacts(*terrains, b_, !last);
     }
     const bool pairs_changed = bodies_active_ && bodies_.update(dv_, !last);

@@ -290,13 +290,14 @@ def test_arkode_linear_solver_is_one_of_its_table():
 
 
 def test_contact_screening_equals_jelly_run_and_is_validated(scenes, run_cli, tmp_path):
-    # implicit_euler's opt-in contact_screening_tolerance on the matrix-free path (8^3 particles
+    # implicit_euler's contact_screening_tolerance on the matrix-free path (8^3 particles
     # lowered onto the coulomb slope): the module's run is the jelly program's bit for bit, with
     # the same statistics, and screening adds finishing solves to the unscreened run's.
     sets = ["cube.n=8", "cube.origin=[-2.2222222,0.7,-2.2222222]",
             "integrator.name=implicit_euler", "integrator.dt=0.0166666666666667", "duration=0.5",
             "terrains[0].contact.model=coulomb"]
     screened = sets + ["integrator.options.contact_screening_tolerance=0.01"]
+    sets = sets + ["integrator.options.contact_screening_tolerance=0"]
 
     def cli_solves(scene_sets, path):
         args = [a for s in scene_sets for a in ("--set", s)]
@@ -319,7 +320,7 @@ def test_contact_screening_equals_jelly_run_and_is_validated(scenes, run_cli, tm
     assert_same_file(cli_file, py_file)
 
     options = jelly.IntegratorOptions()
-    assert options.implicit.contact_screening_tolerance == 0
+    assert options.implicit.contact_screening_tolerance == 0.001
     options.implicit.contact_screening_tolerance = 0.01
     assert options.implicit.contact_screening_tolerance == 0.01
     options.implicit.contact_screening_tolerance = 1.5

@@ -107,9 +107,12 @@ class ImplicitContact {
   //   the filtered diagonal block S D S + C + I - S of a contact particle (D row-major, in
   //     place), for block Jacobi; returns false for a particle without contact.
   bool filter_diagonal_block(int particle, Real block[9]) const;
-  //   update from the product a_dv = A dv with the original A (no matrix to unconstrain).
+  //   update from the product a_dv = A dv with the original A (no matrix to unconstrain; only
+  //     its rows at the contacts' particles are read). With `screening` (dv from a loose solve
+  //     that is finished only if the set holds) a set that holds is left as it was: the
+  //     impulses and friction modes come from the finished solve, as without screening.
   bool update_from_product(const Terrains& terrains, const VecX& b, const VecX& dv, bool commit,
-                           const VecX& a_dv);
+                           const VecX& a_dv, bool screening = false);
   // S applied in place to a 3N vector (a Newton residual).
   void project(VecX& w) const;
   // w += c_i (v1 - u)_t: removes the sliding friction impulses at velocities v1 from w.
@@ -149,10 +152,10 @@ class ImplicitContact {
   Contact make_contact(const Terrains& terrains, int i, int k, const Vec3& v1, Real mass) const;
   void index_contacts();
   // update() with the constraint impulse of contact ci from impulse(ci, c) and the matrix put
-  // back by unconstrain_matrix() when the set changes.
+  // back by unconstrain_matrix() when the set changes (`screening`: see update_from_product).
   template <class Impulse, class Unconstrain>
-  bool update_impl(const Terrains& terrains, const VecX& dv, bool commit, Impulse&& impulse,
-                   Unconstrain&& unconstrain_matrix);
+  bool update_impl(const Terrains& terrains, const VecX& dv, bool commit, bool screening,
+                   Impulse&& impulse, Unconstrain&& unconstrain_matrix);
   // The coulomb terrain that position p (at time t1) penetrates deepest, or -1.
   int penetrated_terrain(const Terrains& terrains, const Vec3& p, Real tolerance) const;
 
