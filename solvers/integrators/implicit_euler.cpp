@@ -80,8 +80,8 @@ struct ImplicitEuler::Impl {
   bool update_contacts(const Terrains& terrains, const VecX& b, bool commit,
                        bool screening = false);
   // Matrix-free block-Jacobi CG on band_ (filtered by the contacts when constrained), to the
-  // relative residual `tolerance`; `resume`: the system is the last solve's (its block
-  // inverses are kept).
+  // relative residual `tolerance`; `resume`: continues the last solve's CG iteration (the same
+  // system and block inverses) to this tolerance.
   StepResult solve_matrix_free(const Model& model, const VecX& b, VecX& y, bool constrained, Real t,
                                Real tolerance, bool resume);
   // The solve's status as a step result (naming t), a check for non-finite values, and the
@@ -126,6 +126,7 @@ struct ImplicitEuler::Impl {
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
   VecX az_;
+  VecX cg_x_;                      // the last matrix-free CG iterate, for resuming it
   std::vector<int> contact_rows_;  // the contacts' particles, for their rows of A dv
   int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
@@ -399,7 +400,7 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
                                                   bool constrained, Real t, Real tolerance,
                                                   bool resume) {
   auto start = Clock::now();
-  // Block Jacobi: the inverses of the (filtered) diagonal blocks.
+  // Block Jacobi: the inverses of the (filtered) diagonal blocks (kept when resuming).
   LinearResult r;
   if (!resume) {
     r = band_cg_.set_diagonal_blocks(
@@ -418,7 +419,9 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
       band_->multiply(in, out, threads_, input);
       if (constrained) contact_.filter_output(in, out);
     };
-    r = band_cg_.solve(apply, b, y, tolerance, options_.cg_max_iterations, threads_);
+    if (resume) y = cg_x_;  // the iterate as CG left it (before finish_solve's correction)
+    r = band_cg_.solve(apply, b, y, tolerance, options_.cg_max_iterations, threads_, resume);
+    cg_x_ = y;
     solve_seconds_ += seconds_since(start);
   }
   return finish_solve(model, r, b, y, constrained, t);
@@ -521,15 +524,11 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   contact_active_ = (resolves_contact() || !model.pins.empty()) &&
                     contact_.begin_step(model, *terrains, s, f_, h);
   // One solve of the current set (constrained by the contacts it holds) into dv_, to CG's
-  // `tolerance` (0: cg_tolerance); `resume`: the set and the system are the last solve's, which
-  // this one continues (rhs_, z_ and the block inverses stay; dv_ back to the free directions).
+  // `tolerance` (0: cg_tolerance); `resume`: the set and the system are the last solve's, whose
+  // CG iteration this one continues (rhs_, z_ and the block inverses stay).
   const auto solve = [&](Real tolerance, bool resume) -> StepResult {
     const bool constrained = contact_active_ && contact_.has_constraints();
-    if (constrained && resume) {
-      contact_.project(dv_);
-    } else if (constrained) {
-      constrain(b_, true, dv_);
-    }
+    if (constrained && !resume) constrain(b_, true, dv_);
     StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t,
                                        tolerance, resume);
     if (!r.ok) {

@@ -46,6 +46,13 @@ struct CgWork {
   int threads = 1;
   std::vector<Real> partials;
   VecX r, z, p, q;
+  // Where the last solve stopped converged, for resuming it: |b|, |r|, and when it had started
+  // iterating (block Jacobi), r^T z of the last direction and of the new residual (the
+  // direction not yet updated with it).
+  struct Stop {
+    bool resumable = false, started = false;
+    Real b_norm = 0, r_norm = 0, rz = 0, rz_next = 0;
+  } stop;
 
   void resize(Eigen::Index n) {
     if (r.size() == n) return;
@@ -167,7 +174,7 @@ struct BlockInverses {
 template <class Apply, class Precondition>
 LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition&& precondition,
                     const VecX& b, VecX& x, int max_iterations, LinearSolverCounters& counters,
-                    const BlockInverses* blocks = nullptr) {
+                    const BlockInverses* blocks = nullptr, bool resume = false) {
   VecX& r_ = work.r;
   VecX& z_ = work.z;
   VecX& p_ = work.p;
@@ -182,25 +189,37 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
   Real* pz = z_.data();
   Real* pp = p_.data();
   Real* pq = q_.data();
-  const Real b_norm = std::sqrt(sum([&](long begin, long end) {
-    Real s = 0;
-    for (long i = begin; i < end; ++i) s += pb[i] * pb[i];
-    return s;
-  }));
+  CgWork::Stop& stop = work.stop;
   LinearResult result;
-  if (b_norm == 0) {
-    x.setZero();
-    return result;
-  }
-  multiply(x, q_);
-  Real r_norm = std::sqrt(sum([&](long begin, long end) {
-    Real s = 0;
-    for (long i = begin; i < end; ++i) {
-      pr[i] = pb[i] - pq[i];
-      s += pr[i] * pr[i];
+  if (resume && !stop.resumable)
+    return LinearResult::failure(LinearStatus::kInvalidInput,
+                                 "CG: resume without a solve that stopped converged");
+  stop.resumable = false;
+  Real b_norm, r_norm;
+  if (resume) {
+    b_norm = stop.b_norm;
+    r_norm = stop.r_norm;
+  } else {
+    b_norm = std::sqrt(sum([&](long begin, long end) {
+      Real s = 0;
+      for (long i = begin; i < end; ++i) s += pb[i] * pb[i];
+      return s;
+    }));
+    if (b_norm == 0) {
+      x.setZero();
+      stop = {true, false, 0, 0, 0, 0};
+      return result;
     }
-    return s;
-  }));
+    multiply(x, q_);
+    r_norm = std::sqrt(sum([&](long begin, long end) {
+      Real s = 0;
+      for (long i = begin; i < end; ++i) {
+        pr[i] = pb[i] - pq[i];
+        s += pr[i] * pr[i];
+      }
+      return s;
+    }));
+  }
   const Real target = tolerance * b_norm;
   const auto dot = [&](const Real* u, const Real* w) {
     return sum([&](long begin, long end) {
@@ -210,10 +229,29 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
     });
   };
   int k = 0;
+  // The next direction from the residual's r^T z (the end of an iteration).
+  const auto next_direction = [&](Real& rz, Real rz_next) {
+    const Real beta = rz_next / rz;
+    rz = rz_next;
+    for_entries([&](long begin, long end) {
+      for (long i = begin; i < end; ++i) pp[i] = pz[i] + beta * pp[i];
+    });
+  };
   if (r_norm > target) {
-    precondition(r_, z_);
-    for_entries([&](long begin, long end) { std::copy(pz + begin, pz + end, pp + begin); });
-    Real rz = dot(pr, pz);
+    Real rz;
+    if (resume && stop.started) {  // end the iteration the stop left, as one solve would
+      rz = stop.rz;
+      if (!(stop.rz_next > 0))
+        return LinearResult::failure(LinearStatus::kNotPositiveDefinite,
+                                     "CG: r^T P r = " + std::to_string(stop.rz_next) +
+                                         " on resuming: block-Jacobi preconditioner not positive "
+                                         "definite");
+      next_direction(rz, stop.rz_next);
+    } else {
+      precondition(r_, z_);
+      for_entries([&](long begin, long end) { std::copy(pz + begin, pz + end, pp + begin); });
+      rz = dot(pr, pz);
+    }
     while (k < max_iterations) {
       multiply(p_, q_);
       const Real curvature = dot(pp, pq);
@@ -230,7 +268,11 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
         const Real rz_next = sums[1];
         r_norm = std::sqrt(sums[0]);
         ++k;
-        if (r_norm <= target || !std::isfinite(r_norm)) break;
+        if (r_norm <= target) {
+          stop = {true, true, b_norm, r_norm, rz, rz_next};
+          break;
+        }
+        if (!std::isfinite(r_norm)) break;
         if (!(rz_next > 0)) {  // r^T P r: the rounded preconditioner is not positive definite
           result = LinearResult::failure(LinearStatus::kNotPositiveDefinite,
                                          "CG: r^T P r = " + std::to_string(rz_next) +
@@ -238,11 +280,7 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
                                              ": block-Jacobi preconditioner not positive definite");
           break;
         }
-        const Real beta = rz_next / rz;
-        rz = rz_next;
-        for_entries([&](long begin, long end) {
-          for (long i = begin; i < end; ++i) pp[i] = pz[i] + beta * pp[i];
-        });
+        next_direction(rz, rz_next);
         continue;
       }
       r_norm = std::sqrt(sum([&](long begin, long end) {
@@ -257,14 +295,11 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
       ++k;
       if (r_norm <= target || !std::isfinite(r_norm)) break;
       precondition(r_, z_);
-      const Real rz_next = dot(pr, pz);
-      const Real beta = rz_next / rz;
-      rz = rz_next;
-      for_entries([&](long begin, long end) {
-        for (long i = begin; i < end; ++i) pp[i] = pz[i] + beta * pp[i];
-      });
+      next_direction(rz, dot(pr, pz));
     }
   }
+  if (result.ok() && r_norm <= target && !stop.resumable)
+    stop = {true, false, b_norm, r_norm, 0, 0};
   counters.cg_iterations += k;
   result.iterations = k;
   result.residual = r_norm / b_norm;
@@ -531,7 +566,7 @@ LinearResult MatrixFreeCg::set_diagonal_blocks(int particles, const DiagonalBloc
 }
 
 LinearResult MatrixFreeCg::solve(const Product& apply, const VecX& b, VecX& x, Real tolerance,
-                                 int max_iterations, int threads) {
+                                 int max_iterations, int threads, bool resume) {
   CgWork& work = impl_->work;
   const BlockInverses& blocks = impl_->blocks;
   if (b.size() % 3 != 0 || x.size() != b.size() ||
@@ -542,7 +577,7 @@ LinearResult MatrixFreeCg::solve(const Product& apply, const VecX& b, VecX& x, R
   ++impl_->counters.solves;
   const auto precondition = [&](const VecX& r, VecX& z) { blocks.apply(work, r, z); };
   return cg_run(work, tolerance, apply, precondition, b, x, max_iterations, impl_->counters,
-                &blocks);
+                &blocks, resume);
 }
 
 }  // namespace jelly

@@ -66,9 +66,11 @@ class MatrixFreeCg {
   // naming the first such block. No allocation once called with this size and thread count.
   LinearResult set_diagonal_blocks(int particles, const DiagonalBlock& block, int threads);
   // Solves A x = b from x with A x = apply(x), preconditioned by the last set_diagonal_blocks.
-  // Stops at |b - A x| <= tolerance |b|.
+  // Stops at |b - A x| <= tolerance |b|. With `resume`, continues the last solve (which must
+  // have converged, with the same b, x as it left it, A and preconditioner) to this tolerance:
+  // the iterates are those of one solve to this tolerance, at max_iterations more.
   LinearResult solve(const Product& apply, const VecX& b, VecX& x, Real tolerance,
-                     int max_iterations, int threads);
+                     int max_iterations, int threads, bool resume = false);
   const LinearSolverCounters& counters() const;
 
  private:
