@@ -151,3 +151,46 @@ TEST(CgSolver, MisuseIsInvalidInput) {
 
 }  // namespace
 }  // namespace jelly
+
+namespace jelly {
+namespace {
+
+// MatrixFreeCg resumes a converged solve (contact screening's finishing solve): a solve to 1e-3
+// resumed to 1e-10 gives the bits and the total iterations of one solve to 1e-10, for 1 and 2
+// threads; resuming without a converged solve is refused.
+TEST(MatrixFreeCg, ResumingIsOneUninterruptedSolve) {
+  const testing::LinearSystem s =
+      testing::backward_euler_system(6, 1400, 1.0 / 60, DefinitenessFix::kClampCompressed);
+  const int particles = static_cast<int>(s.a.rows() / 3);
+  const MatrixFreeCg::Product apply = [&](const VecX& in, VecX& out) { out = s.a * in; };
+  const auto block = [&](int i, Real d[9]) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) d[3 * r + c] = s.a.coeff(3 * i + r, 3 * i + c);
+  };
+  for (int threads : {1, 2}) {
+    MatrixFreeCg one, two;
+    ASSERT_TRUE(one.set_diagonal_blocks(particles, block, threads).ok());
+    ASSERT_TRUE(two.set_diagonal_blocks(particles, block, threads).ok());
+    VecX x1 = VecX::Zero(s.b.size()), x2 = x1;
+    const LinearResult whole = one.solve(apply, s.b, x1, 1e-10, 1000, threads);
+    const LinearResult loose = two.solve(apply, s.b, x2, 1e-3, 1000, threads);
+    ASSERT_TRUE(whole.ok() && loose.ok());
+    EXPECT_LT(loose.iterations, whole.iterations);
+    const LinearResult rest = two.solve(apply, s.b, x2, 1e-10, 1000, threads, true);
+    ASSERT_TRUE(rest.ok()) << rest.message;
+    EXPECT_EQ(loose.iterations + rest.iterations, whole.iterations);
+    EXPECT_EQ(x1, x2);  // bit for bit
+    EXPECT_LE((s.b - s.a * x2).norm(), 1e-10 * s.b.norm());
+    // A second resume continues from the same stop: nothing left to do.
+    EXPECT_EQ(two.solve(apply, s.b, x2, 1e-10, 1000, threads, true).iterations, 0);
+  }
+  MatrixFreeCg fresh;
+  ASSERT_TRUE(fresh.set_diagonal_blocks(particles, block, 1).ok());
+  VecX x = VecX::Zero(s.b.size());
+  EXPECT_EQ(fresh.solve(apply, s.b, x, 1e-10, 1000, 1, true).status, LinearStatus::kInvalidInput);
+  EXPECT_EQ(fresh.solve(apply, s.b, x, 1e-10, 2, 1).status, LinearStatus::kNotConverged);
+  EXPECT_EQ(fresh.solve(apply, s.b, x, 1e-10, 1000, 1, true).status, LinearStatus::kInvalidInput);
+}
+
+}  // namespace
+}  // namespace jelly
