@@ -57,14 +57,14 @@ struct DeformedCubeSystem {
   BandSystem system;  // points to bands: not copyable, not movable
   const char* error = nullptr;
 
-  DeformedCubeSystem(int n, int threads)
+  DeformedCubeSystem(int n, int threads, bool single_precision = false)
       : model(build_cube([n] {
           CubeSpec spec;
           spec.n = n;
           return spec;
         }())),
         bands(model),
-        system(bands, model.num_particles()) {
+        system(bands, model.num_particles(), single_precision) {
     if (!bands.dense()) {
       error = "the cube's springs do not fill their bands";
       return;
@@ -94,10 +94,11 @@ struct DeformedCubeSystem {
   }
 };
 
-// One product y = A p (the inner loop of implicit_euler's CG); arguments n and the threads.
+// One product y = A p (the inner loop of implicit_euler's CG); arguments n, the threads and
+// whether the coefficients are in single precision (1; implicit_euler's at cg_tolerance >= 1e-6).
 void BM_MatrixFreeProduct(benchmark::State& bench) {
   const int threads = static_cast<int>(bench.range(1));
-  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
+  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads, bench.range(2) != 0);
   if (!cube.usable(bench)) return;
   const VecX p = cube.vector();
   VecX y(p.size());
@@ -111,9 +112,12 @@ void BM_MatrixFreeProduct(benchmark::State& bench) {
       springs, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_MatrixFreeProduct)
-    ->Args({20, 1})
-    ->Args({40, 1})
-    ->Args({40, 2})
+    ->Args({20, 1, 0})
+    ->Args({40, 1, 0})
+    ->Args({40, 2, 0})
+    ->Args({20, 1, 1})
+    ->Args({40, 1, 1})
+    ->Args({40, 2, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -146,10 +150,11 @@ BENCHMARK(BM_MatrixFreeAssembly)
 // A solve of 100 iterations of implicit_euler's matrix-free block-Jacobi CG
 // (solvers/linear/cg_solver.hpp) on the same system from x = 0: 101 products (the starting
 // residual's and one per iteration) plus CG's vector operations, ordered sums and
-// preconditioner; s_per_cg_iteration is the solve's time / 100. Arguments n and the threads.
+// preconditioner; s_per_cg_iteration is the solve's time / 100. Arguments n, the threads and
+// single precision (as BM_MatrixFreeProduct).
 void BM_MatrixFreeCgIterations(benchmark::State& bench) {
   const int threads = static_cast<int>(bench.range(1));
-  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
+  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads, bench.range(2) != 0);
   if (!cube.usable(bench)) return;
   MatrixFreeCg cg;
   const LinearResult blocks = cg.set_diagonal_blocks(
@@ -178,8 +183,10 @@ void BM_MatrixFreeCgIterations(benchmark::State& bench) {
       kIterations, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_MatrixFreeCgIterations)
-    ->Args({40, 1})
-    ->Args({40, 2})
+    ->Args({40, 1, 0})
+    ->Args({40, 2, 0})
+    ->Args({40, 1, 1})
+    ->Args({40, 2, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

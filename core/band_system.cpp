@@ -106,10 +106,12 @@ int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
 
 // Per slot t = B (p_a - p_b) = c1 (u . d) u + c2 d = e1 (e . d) e + c2 d, with e = x_a - x_b
 // (u = e / |e|) recomputed from the positions and e1 = c1 / |e|^2: 16 bytes per slot to read
-// instead of 40 (the product is bound by memory traffic at n = 40; docs/benchmarks.md).
-JELLY_VECTOR_CLONES
-void band_products(int n, Ends x, Ends p, const Real* __restrict e1, const Real* __restrict c2,
-                   Real* __restrict tx, Real* __restrict ty, Real* __restrict tz) {
+// instead of 40 (the product is bound by memory traffic at n = 40; docs/benchmarks.md), 8 with
+// the coefficients in single precision (C = float).
+template <class C>
+__attribute__((always_inline)) inline void band_products_loop(
+    int n, Ends x, Ends p, const C* __restrict e1, const C* __restrict c2, Real* __restrict tx,
+    Real* __restrict ty, Real* __restrict tz) {
   const Real* __restrict xa = x.xa;
   const Real* __restrict ya = x.ya;
   const Real* __restrict za = x.za;
@@ -125,11 +127,25 @@ void band_products(int n, Ends x, Ends p, const Real* __restrict e1, const Real*
   for (int j = 0; j < n; ++j) {
     const Real u0 = xa[j] - xb[j], u1 = ya[j] - yb[j], u2 = za[j] - zb[j];
     const Real d0 = pxa[j] - pxb[j], d1 = pya[j] - pyb[j], d2 = pza[j] - pzb[j];
-    const Real ud = e1[j] * (u0 * d0 + u1 * d1 + u2 * d2);
-    tx[j] = ud * u0 + c2[j] * d0;
-    ty[j] = ud * u1 + c2[j] * d1;
-    tz[j] = ud * u2 + c2[j] * d2;
+    const Real c = static_cast<Real>(c2[j]);
+    const Real ud = static_cast<Real>(e1[j]) * (u0 * d0 + u1 * d1 + u2 * d2);
+    tx[j] = ud * u0 + c * d0;
+    ty[j] = ud * u1 + c * d1;
+    tz[j] = ud * u2 + c * d2;
   }
+}
+
+JELLY_VECTOR_CLONES
+void band_products(int n, Ends x, Ends p, const Real* __restrict e1, const Real* __restrict c2,
+                   Real* __restrict tx, Real* __restrict ty, Real* __restrict tz) {
+  band_products_loop<Real>(n, x, p, e1, c2, tx, ty, tz);
+}
+
+JELLY_VECTOR_CLONES
+void band_products_single(int n, Ends x, Ends p, const float* __restrict e1,
+                          const float* __restrict c2, Real* __restrict tx, Real* __restrict ty,
+                          Real* __restrict tz) {
+  band_products_loop<float>(n, x, p, e1, c2, tx, ty, tz);
 }
 
 // The six entries xx, yy, zz, xy, xz, yz of B = c1 u u^T + c2 I added to d[0..5][j].
@@ -169,13 +185,18 @@ void add_slot_terms(int n, int particle, int len, int q, bool first_end, const R
 
 }  // namespace
 
-BandSystem::BandSystem(const SpringBands& bands, int num_particles)
-    : bands_(&bands), num_particles_(num_particles) {
+BandSystem::BandSystem(const SpringBands& bands, int num_particles, bool single_precision)
+    : bands_(&bands), num_particles_(num_particles), single_(single_precision) {
   for (const SpringBands::Band& band : bands.bands()) {
     Slots s;
     const size_t n = band.spring.size();
-    s.e1.assign(n, 0.0);
-    s.c2.assign(n, 0.0);
+    if (single_) {
+      s.e1_single.assign(n, 0.0F);
+      s.c2_single.assign(n, 0.0F);
+    } else {
+      s.e1.assign(n, 0.0);
+      s.c2.assign(n, 0.0);
+    }
     slots_.push_back(std::move(s));
   }
   for (const auto& band : bands.bands()) slots_total_ += band.slots();
@@ -251,8 +272,13 @@ bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, Defi
       Slots& out = slots_[k];
       if (r.a0 < r.a1) {
         const int q = r.a0 - a, slot = r.a0 - band.first, len = r.a1 - r.a0;
-        std::copy(e1 + q, e1 + q + len, out.e1.data() + slot);
-        std::copy(c2 + q, c2 + q + len, out.c2.data() + slot);
+        if (single_) {  // rounded to the nearest float
+          std::copy(e1 + q, e1 + q + len, out.e1_single.data() + slot);
+          std::copy(c2 + q, c2 + q + len, out.c2_single.data() + slot);
+        } else {
+          std::copy(e1 + q, e1 + q + len, out.e1.data() + slot);
+          std::copy(c2 + q, c2 + q + len, out.c2.data() + slot);
+        }
         add_slot_terms(n, r.a0, len, q, true, c1, c2, ux, uy, uz, tx, ty, tz, acc, diag);
       }
       if (r.b0 < r.b1) {
@@ -296,7 +322,9 @@ void BandSystem::multiply_rows(const VecX& p, const std::vector<int>& particles,
     const Real u0 = sx[a] - sx[b], u1 = sx[n + a] - sx[n + b], u2 = sx[2 * n + a] - sx[2 * n + b];
     const Real d0 = p[3 * a] - p[3 * b], d1 = p[3 * a + 1] - p[3 * b + 1],
                d2 = p[3 * a + 2] - p[3 * b + 2];
-    const Real e1 = slots_[k].e1[slot], c2 = slots_[k].c2[slot];
+    const Slots& coefficients = slots_[k];
+    const Real e1 = single_ ? coefficients.e1_single[slot] : coefficients.e1[slot];
+    const Real c2 = single_ ? coefficients.c2_single[slot] : coefficients.c2[slot];
     const Real ud = e1 * (u0 * d0 + u1 * d1 + u2 * d2);
     t[0] = ud * u0 + c2 * d0;
     t[1] = ud * u1 + c2 * d1;
@@ -365,7 +393,12 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) c
       const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
       const Ends ep{sp + a, sp + n + a, sp + 2 * n + a, sp + b, sp + n + b, sp + 2 * n + b};
       const Slots& s = slots_[k];
-      band_products(r.hi - r.lo, ex, ep, s.e1.data() + r.lo, s.c2.data() + r.lo, tx, ty, tz);
+      if (single_) {
+        band_products_single(r.hi - r.lo, ex, ep, s.e1_single.data() + r.lo,
+                             s.c2_single.data() + r.lo, tx, ty, tz);
+      } else {
+        band_products(r.hi - r.lo, ex, ep, s.e1.data() + r.lo, s.c2.data() + r.lo, tx, ty, tz);
+      }
       band_kernels::add_ends(a, b, r.a0, r.a1, r.b0, r.b1, tx, ty, tz, acc, acc + n, acc + 2 * n);
     }
     for (int i = p0; i < p1; ++i) {

@@ -5,8 +5,8 @@
 // c1 / |e|^2 and c2 with e = x_a - x_b recomputed from the positions kept at assembly, and
 // products A p = M p + sum over springs of +-B (p_a - p_b) computed band by band like the
 // force loop (vectorised, threaded by particle ranges: the same bits for any thread count).
-// 16 bytes per spring instead of about 220 for the full compressed-column matrix (docs/implicit.md,
-// "Matrix-free CG"; docs/benchmarks.md has the products' times).
+// 16 bytes per spring (8 in single precision) instead of about 220 for the full compressed-column
+// matrix (docs/implicit.md, "Matrix-free CG"; docs/benchmarks.md has the products' times).
 #include <vector>
 
 #include <jelly/core/definiteness.hpp>
@@ -27,8 +27,13 @@ class BandSystem {
  public:
   BandSystem() = default;
   // For the springs of `bands` (dense, built for a model of `num_particles` particles); keeps a
-  // pointer to `bands`, which must outlive this object. Allocates.
-  BandSystem(const SpringBands& bands, int num_particles);
+  // pointer to `bands`, which must outlive this object. Allocates. With `single_precision` the
+  // two coefficients per spring are stored as floats (8 bytes per spring instead of 16: faster
+  // products where memory traffic bounds them); A is then exact to their rounding, 6e-8
+  // relative per spring (still symmetric and positive definite), for iterative solves to
+  // tolerances well above that.
+  BandSystem(const SpringBands& bands, int num_particles, bool single_precision = false);
+  bool single_precision() const { return single_; }
 
   bool built_for(const SpringBands& bands) const { return bands_ == &bands; }
   int rows() const { return 3 * num_particles_; }
@@ -54,13 +59,15 @@ class BandSystem {
 
  private:
   struct Slots {
-    std::vector<Real> e1, c2;  // [slots]: c1 / |x_a - x_b|^2 and c2
+    std::vector<Real> e1, c2;                 // [slots]: c1 / |x_a - x_b|^2 and c2
+    std::vector<float> e1_single, c2_single;  // the same, rounded (single precision)
   };
   // The threads of a pass over the slots, with band_ sized for them.
   int team(int threads) const;
 
   const SpringBands* bands_ = nullptr;
   int num_particles_ = 0;
+  bool single_ = false;
   long slots_total_ = 0;         // slots of all bands
   size_t stride_ = 0;            // per-thread buffer length: N + the largest offset
   std::vector<Slots> slots_;     // per band

@@ -29,6 +29,11 @@ double seconds_since(Clock::time_point start) {
 // (docs/implicit.md, "Measured speed"; bench/implicit_benchmark.cpp).
 constexpr int kAutoDirectMaxDofs = 1000;
 
+// At cg_tolerance at or above this the matrix-free system keeps its two coefficients per spring
+// in single precision (BandSystem): A is then exact to 6e-8 relative per spring, 1/16 of this,
+// and the products read half the bytes (docs/implicit.md, "Matrix-free CG on lattices").
+constexpr Real kSingleCoefficientsTolerance = 1e-6;
+
 // Uniform translations are in the null space of K and D, so 1^T A = 1^T M and an exact solve
 // of A y = b changes the momentum by sum(b). An iterative solve misses by the sum of its
 // residual; this shifts y uniformly (which changes nothing else) to restore that identity.
@@ -303,7 +308,8 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       jacobian_.reset();
       solver_.reset();
       a_ = SparseMatrix();
-      band_.emplace(*bands, model.num_particles());
+      band_.emplace(*bands, model.num_particles(),
+                    options_.cg_tolerance >= kSingleCoefficientsTolerance);
       az_.setZero(n);
       size_vectors();
       matrix_free_ = true;
