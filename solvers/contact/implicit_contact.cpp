@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 
@@ -144,8 +145,22 @@ void ImplicitContact::index_contacts() {
     slot_[contacts_[ci].particle] = ci;
 }
 
+template <class Position>
+void ImplicitContact::find_penetrating(const Terrains& terrains, Position&& position,
+                                       Real tolerance) {
+  penetrating_.resize(slot_.size());
+  parallel::for_ranges(threads_, static_cast<long>(slot_.size()), [&](long begin, long end) {
+    for (long i = begin; i < end; ++i) {
+      penetrating_[i] =
+          slot_[i] >= 0 ? -1
+                        : penetrated_terrain(terrains, position(static_cast<int>(i)), tolerance);
+    }
+  });
+}
+
 bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, const State& s0,
-                                 const VecX& f, Real h) {
+                                 const VecX& f, Real h, int threads) {
+  threads_ = threads;
   const bool any = std::any_of(terrains.begin(), terrains.end(),
                                [](const auto& terrain) { return uses_coulomb(*terrain); });
   projected_ = 0;
@@ -185,9 +200,14 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
     is_pinned[c.particle] = 1;
   }
   pinned_ = static_cast<int>(next_.size());
+  const auto predicted_velocity = [&](int i) {
+    return Vec3(particle(v0_, i) + (h / model.mass[i]) * particle(f, i));
+  };
+  find_penetrating(
+      terrains, [&](int i) { return Vec3(particle(x0_, i) + h * predicted_velocity(i)); }, 0);
   for (int i = 0; i < np; ++i) {
     if (is_pinned[i]) continue;
-    const Vec3 v1 = particle(v0_, i) + (h / model.mass[i]) * particle(f, i);
+    const Vec3 v1 = predicted_velocity(i);
     const Vec3 predicted = particle(x0_, i) + h * v1;
     if (slot_[i] >= 0) {
       const Contact& old = contacts_[slot_[i]];
@@ -201,7 +221,8 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
         continue;
       }
     }
-    const int k = penetrated_terrain(terrains, predicted, 0);
+    // A last contact that let go may still be predicted below its surface.
+    const int k = slot_[i] >= 0 ? penetrated_terrain(terrains, predicted, 0) : penetrating_[i];
     if (k >= 0) next_.push_back(make_contact(terrains, i, k, v1, model.mass[i]));
   }
   contacts_.swap(next_);
@@ -466,12 +487,14 @@ bool ImplicitContact::update_impl(const Terrains& terrains, const VecX& dv, bool
     next_.push_back(c);
   }
   // Free particles the solve carried into a terrain.
+  find_penetrating(
+      terrains,
+      [&](int i) { return Vec3(particle(x0_, i) + h_ * (particle(v0_, i) + particle(dv, i))); },
+      kPenetrationTolerance);
   for (int i = 0; i < static_cast<int>(slot_.size()); ++i) {
-    if (slot_[i] >= 0) continue;
-    const Vec3 v1 = particle(v0_, i) + particle(dv, i);
-    const Vec3 x1 = particle(x0_, i) + h_ * v1;
-    const int k = penetrated_terrain(terrains, x1, kPenetrationTolerance);
+    const int k = penetrating_[i];
     if (k >= 0) {
+      const Vec3 v1 = particle(v0_, i) + particle(dv, i);
       next_.push_back(make_contact(terrains, i, k, v1, model_->mass[i]));
       changed = true;
     }

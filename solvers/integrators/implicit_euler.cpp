@@ -528,7 +528,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   const Terrains* terrains = resolves_contact() ? dynamics.terrains() : &kNoTerrains;
   contact_terrains_ = terrains;
   contact_active_ = (resolves_contact() || !model.pins.empty()) &&
-                    contact_.begin_step(model, *terrains, s, f_, h);
+                    contact_.begin_step(model, *terrains, s, f_, h, threads_);
   // One solve of the current set (constrained by the contacts it holds) into dv_, to CG's
   // `tolerance` (0: cg_tolerance); `resume`: the set and the system are the last solve's, whose
   // CG iteration this one continues (rhs_, z_ and the block inverses stay).

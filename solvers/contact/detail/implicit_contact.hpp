@@ -74,9 +74,10 @@ class ImplicitContact {
   // Starts a step of size h from s0 (time s0.t) with forces f(x0, v0): the model's pinned
   // particles, then the last step's contacts still touching their terrain and the particles that
   // the explicit prediction x0 + h (v0 + h f / m) puts below a coulomb terrain. Returns whether
-  // there is anything to constrain: pins, or a terrain that uses the coulomb model.
+  // there is anything to constrain: pins, or a terrain that uses the coulomb model. The
+  // searches over all particles (here and in the updates of this step) run on `threads`.
   bool begin_step(const Model& model, const Terrains& terrains, const State& s0, const VecX& f,
-                  Real h);
+                  Real h, int threads = 1);
   bool has_constraints() const { return !contacts_.empty(); }
 
   // Filters a (full storage, 3x3 blocks, symmetric) in place to S A S + C + I - S after saving
@@ -158,6 +159,10 @@ class ImplicitContact {
                    Impulse&& impulse, Unconstrain&& unconstrain_matrix);
   // The coulomb terrain that position p (at time t1) penetrates deepest, or -1.
   int penetrated_terrain(const Terrains& terrains, const Vec3& p, Real tolerance) const;
+  // penetrating_[i] = penetrated_terrain(terrains, position(i), tolerance) for the particles
+  // without a contact (slot_[i] < 0; -1 for the others), on threads_.
+  template <class Position>
+  void find_penetrating(const Terrains& terrains, Position&& position, Real tolerance);
 
   Real t1_ = 0, h_ = 0;
   const Model* model_ = nullptr;  // of the current step
@@ -169,6 +174,8 @@ class ImplicitContact {
   std::vector<char> pinned_mask_;  // [N]: pinned this step
   std::vector<Real> saved_;        // original values of the constrained columns
   std::vector<int> saved_at_;      // [contacts]: offset into saved_
+  std::vector<int> penetrating_;   // [N]: find_penetrating's terrains
+  int threads_ = 1;
   int projected_ = 0;
   int pinned_ = 0;  // the first pinned_ entries of contacts_ are pins
   Counters counters_;
