@@ -18,6 +18,20 @@ std::optional<std::string> DivergenceGuard::check(const State& s) const {
   const int n = static_cast<int>(s.x.size() / 3);
   const Real speed2 = max_speed * max_speed;
   const Real dist2 = max_distance * max_distance;
+  // One branch-free (vectorised) pass first: every step of every run is checked, and nearly
+  // all of them pass. Anything it flags (a limit, or a non-finite or overflowing square) goes to
+  // the particle by particle loop below, which decides and names the particle.
+  const Real* px = s.x.data();
+  const Real* pv = s.v.data();
+  bool flagged = false;
+  for (int i = 0; i < n; ++i) {
+    const Real v2 =
+        pv[3 * i] * pv[3 * i] + pv[3 * i + 1] * pv[3 * i + 1] + pv[3 * i + 2] * pv[3 * i + 2];
+    const Real x2 =
+        px[3 * i] * px[3 * i] + px[3 * i + 1] * px[3 * i + 1] + px[3 * i + 2] * px[3 * i + 2];
+    flagged |= !(v2 <= speed2 && x2 <= dist2 && std::isfinite(v2) && std::isfinite(x2));
+  }
+  if (!flagged) return std::nullopt;
   for (int i = 0; i < n; ++i) {
     const auto x = particle(s.x, i);
     const auto v = particle(s.v, i);
