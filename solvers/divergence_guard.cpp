@@ -1,6 +1,7 @@
 #include <jelly/solvers/divergence_guard.hpp>
 
 #include <cmath>
+#include <limits>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
@@ -23,13 +24,16 @@ std::optional<std::string> DivergenceGuard::check(const State& s) const {
   // the particle by particle loop below, which decides and names the particle.
   const Real* px = s.x.data();
   const Real* pv = s.v.data();
+  // A little below the limits: these sums may round differently from squaredNorm's below.
+  const Real speed2_low = speed2 * (1 - 8 * std::numeric_limits<Real>::epsilon());
+  const Real dist2_low = dist2 * (1 - 8 * std::numeric_limits<Real>::epsilon());
   bool flagged = false;
   for (int i = 0; i < n; ++i) {
     const Real v2 =
         pv[3 * i] * pv[3 * i] + pv[3 * i + 1] * pv[3 * i + 1] + pv[3 * i + 2] * pv[3 * i + 2];
     const Real x2 =
         px[3 * i] * px[3 * i] + px[3 * i + 1] * px[3 * i + 1] + px[3 * i + 2] * px[3 * i + 2];
-    flagged |= !(v2 <= speed2 && x2 <= dist2 && std::isfinite(v2) && std::isfinite(x2));
+    flagged |= !(v2 <= speed2_low && x2 <= dist2_low && std::isfinite(v2) && std::isfinite(x2));
   }
   if (!flagged) return std::nullopt;
   for (int i = 0; i < n; ++i) {

@@ -30,8 +30,8 @@ class BandSystem {
   // pointer to `bands`, which must outlive this object. Allocates. With `single_precision` the
   // two coefficients per spring are stored as floats (8 bytes per spring instead of 16: faster
   // products where memory traffic bounds them); A is then exact to their rounding, 6e-8
-  // relative per spring (still symmetric and positive definite), for iterative solves to
-  // tolerances well above that.
+  // relative per spring (and still symmetric), for iterative solves to tolerances well above
+  // that.
   BandSystem(const SpringBands& bands, int num_particles, bool single_precision = false);
   bool single_precision() const { return single_; }
 
@@ -51,8 +51,8 @@ class BandSystem {
   // after the first call with this thread count.
   void multiply(const VecX& p, VecX& y, int threads, InputMap input = {}) const;
   // The rows of y = A p at the given particles only (the other rows of y are left as they
-  // are): the same bits as multiply's. Serial; for a few particles (the contacts' impulses)
-  // instead of a whole product.
+  // are): the same bits as multiply's without an input map. Serial; for a few particles (the
+  // contacts' impulses) instead of a whole product.
   void multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y) const;
   // The diagonal 3x3 block of particle i, row-major.
   void diagonal_block(int i, Real out[9]) const;

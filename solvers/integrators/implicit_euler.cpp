@@ -131,7 +131,8 @@ struct ImplicitEuler::Impl {
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
   VecX az_;
-  VecX cg_x_;                      // the last matrix-free CG iterate, for resuming it
+  VecX cg_x_;                      // a loose matrix-free solve's iterate, for resuming it
+  int loose_iterations_ = 0;       // ... and its CG iterations
   std::vector<int> contact_rows_;  // the contacts' particles, for their rows of A dv
   int threads_ = 1;
   VecX f_, kw_, b_, dv_, v1_, x1_, g_, delta_, rhs_, z_, damping_;
@@ -425,9 +426,16 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
       band_->multiply(in, out, threads_, input);
       if (constrained) contact_.filter_output(in, out);
     };
-    if (resume) y = cg_x_;  // the iterate as CG left it (before finish_solve's correction)
-    r = band_cg_.solve(apply, b, y, tolerance, options_.cg_max_iterations, threads_, resume);
-    cg_x_ = y;
+    // Resuming: from the iterate as CG left it (before finish_solve's correction), with the
+    // iterations the loose solve left, so that it is one solve in every respect.
+    if (resume) y = cg_x_;
+    const int done = resume ? loose_iterations_ : 0;
+    r = band_cg_.solve(apply, b, y, tolerance, options_.cg_max_iterations - done, threads_, resume);
+    r.iterations += done;
+    if (!resume && tolerance > options_.cg_tolerance) {  // a loose solve: kept for resuming
+      cg_x_ = y;
+      loose_iterations_ = r.iterations;
+    }
     solve_seconds_ += seconds_since(start);
   }
   return finish_solve(model, r, b, y, constrained, t);

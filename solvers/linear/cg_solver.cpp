@@ -46,16 +46,18 @@ struct CgWork {
   int threads = 1;
   std::vector<Real> partials;
   VecX r, z, p, q;
-  // Where the last solve stopped converged, for resuming it: |b|, |r|, and when it had started
-  // iterating (block Jacobi), r^T z of the last direction and of the new residual (the
-  // direction not yet updated with it).
+  // Where the last solve stopped converged, for resuming it (MatrixFreeCg; CgSolver never
+  // resumes): |b|, |r|, and when it has a search direction (block Jacobi), r^T z of that
+  // direction and of the new residual (the direction not yet updated with it). Cleared by a
+  // new size or preconditioner.
   struct Stop {
-    bool resumable = false, started = false;
+    bool resumable = false, has_direction = false;
     Real b_norm = 0, r_norm = 0, rz = 0, rz_next = 0;
   } stop;
 
   void resize(Eigen::Index n) {
     if (r.size() == n) return;
+    stop = {};
     r.setZero(n);
     z.setZero(n);
     p.setZero(n);
@@ -194,11 +196,16 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
   if (resume && !stop.resumable)
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CG: resume without a solve that stopped converged");
+  const CgWork::Stop resumed = stop;  // kept when a resume has nothing to do
   stop.resumable = false;
   Real b_norm, r_norm;
   if (resume) {
     b_norm = stop.b_norm;
     r_norm = stop.r_norm;
+    if (b_norm == 0) {  // x = 0 solved it
+      stop = resumed;
+      return result;
+    }
   } else {
     b_norm = std::sqrt(sum([&](long begin, long end) {
       Real s = 0;
@@ -239,7 +246,7 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
   };
   if (r_norm > target) {
     Real rz;
-    if (resume && stop.started) {  // end the iteration the stop left, as one solve would
+    if (resume && stop.has_direction) {  // end the iteration the stop left, as one solve would
       rz = stop.rz;
       if (!(stop.rz_next > 0))
         return LinearResult::failure(LinearStatus::kNotPositiveDefinite,
@@ -298,8 +305,11 @@ LinearResult cg_run(CgWork& work, Real tolerance, Apply&& multiply, Precondition
       next_direction(rz, dot(pr, pz));
     }
   }
-  if (result.ok() && r_norm <= target && !stop.resumable)
+  if (resume && k == 0 && result.ok()) {
+    stop = resumed;  // nothing done: the same stop, direction included
+  } else if (result.ok() && r_norm <= target && !stop.resumable) {
     stop = {true, false, b_norm, r_norm, 0, 0};
+  }
   counters.cg_iterations += k;
   result.iterations = k;
   result.residual = r_norm / b_norm;
@@ -558,6 +568,7 @@ const LinearSolverCounters& MatrixFreeCg::counters() const { return impl_->count
 
 LinearResult MatrixFreeCg::set_diagonal_blocks(int particles, const DiagonalBlock& block,
                                                int threads) {
+  impl_->work.stop = {};  // a new preconditioner: the last solve cannot be resumed
   return impl_->blocks.invert(particles, std::max(1, threads), [&](long i, Eigen::Matrix3d& b) {
     Real d[9];
     block(static_cast<int>(i), d);

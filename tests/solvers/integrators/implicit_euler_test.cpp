@@ -108,6 +108,35 @@ TEST(ImplicitEuler, ContactScreeningKeepsTheRunCloseToTheUnscreenedOne) {
   EXPECT_TRUE(b.x.allFinite() && b.v.allFinite());
 }
 
+// Where the contacts' set never changes (a squeezed jelly falling above a coulomb slope), every
+// screened solve is resumed to cg_tolerance: the run is the unscreened run bit for bit, with
+// the same CG iterations (the loose and the resumed parts add up), in twice the solves.
+TEST(ImplicitEuler, ScreeningWithoutSetChangesIsTheUnscreenedRun) {
+  Model model = build_cube(testing::small_cube(8, 1.0, Vec3(0, 6, 0)));  // 1,536 unknowns
+  State start = rest_state(model);
+  for (int i = 0; i < start.x.size(); ++i) start.x[i] += 0.02 * std::sin(0.7 * i);
+  const auto run = [&](Real screening, Statistics* statistics) {
+    IntegratorOptions o;
+    o.implicit.contact_screening_tolerance = screening;
+    Simulator sim = Simulator(model, start, make_integrator("implicit_euler", o),
+                              SimulatorOptions{1.0 / 60, 0, {}});
+    sim.add_terrain(std::make_unique<Plane>(Plane::slope(20)));  // coulomb contact
+    const RunReport report = sim.run_until(0.3);
+    EXPECT_TRUE(report.ok()) << report.reason;
+    *statistics = report.statistics;
+    return sim.state();
+  };
+  Statistics plain, screened;
+  const State a = run(0, &plain);
+  const State b = run(1e-3, &screened);
+  EXPECT_GT(plain.at("cg_iterations"), 0);
+  EXPECT_EQ(screened.at("cg_iterations"), plain.at("cg_iterations"));
+  EXPECT_EQ(screened.at("linear_solves"), 2 * plain.at("linear_solves"));
+  EXPECT_EQ(screened.at("contact_extra_solves"), 0);
+  EXPECT_TRUE(a.x == b.x);
+  EXPECT_TRUE(a.v == b.v);
+}
+
 // Above 1000 unknowns on a lattice, auto solves matrix-free (block-Jacobi CG on the force loop's
 // bands, no sparse matrix): the same trajectory as CHOLMOD's exact solves, with contact and
 // friction on a slope, to the CG tolerance.

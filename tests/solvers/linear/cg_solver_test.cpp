@@ -149,12 +149,6 @@ TEST(CgSolver, MisuseIsInvalidInput) {
   EXPECT_EQ(cg.analyze(SparseMatrix(3, 4)).status, LinearStatus::kInvalidInput);
 }
 
-}  // namespace
-}  // namespace jelly
-
-namespace jelly {
-namespace {
-
 // MatrixFreeCg resumes a converged solve (contact screening's finishing solve): a solve to 1e-3
 // resumed to 1e-10 gives the bits and the total iterations of one solve to 1e-10, for 1 and 2
 // threads; resuming without a converged solve is refused.
@@ -181,8 +175,38 @@ TEST(MatrixFreeCg, ResumingIsOneUninterruptedSolve) {
     EXPECT_EQ(loose.iterations + rest.iterations, whole.iterations);
     EXPECT_EQ(x1, x2);  // bit for bit
     EXPECT_LE((s.b - s.a * x2).norm(), 1e-10 * s.b.norm());
-    // A second resume continues from the same stop: nothing left to do.
+    // Resuming to a tolerance already met does nothing and keeps the stop: a further resume to
+    // 1e-12 is still one solve to 1e-12 (direction and all).
     EXPECT_EQ(two.solve(apply, s.b, x2, 1e-10, 1000, threads, true).iterations, 0);
+    VecX x3 = VecX::Zero(s.b.size());
+    const LinearResult tight = one.solve(apply, s.b, x3, 1e-12, 1000, threads);
+    const LinearResult tighter = two.solve(apply, s.b, x2, 1e-12, 1000, threads, true);
+    ASSERT_TRUE(tight.ok() && tighter.ok());
+    EXPECT_GT(tighter.iterations, 0);
+    EXPECT_EQ(loose.iterations + rest.iterations + tighter.iterations, tight.iterations);
+    EXPECT_EQ(x2, x3);
+  }
+  // b = 0: x = 0, and resuming it has nothing to do (residual 0, not 0 / 0).
+  {
+    MatrixFreeCg cg;
+    ASSERT_TRUE(cg.set_diagonal_blocks(particles, block, 1).ok());
+    const VecX zero = VecX::Zero(s.b.size());
+    VecX x = VecX::Ones(s.b.size());
+    ASSERT_TRUE(cg.solve(apply, zero, x, 1e-3, 1000, 1).ok());
+    const LinearResult again = cg.solve(apply, zero, x, 1e-10, 1000, 1, true);
+    EXPECT_TRUE(again.ok());
+    EXPECT_EQ(again.iterations, 0);
+    EXPECT_EQ(again.residual, 0);
+    EXPECT_EQ(x, zero);
+  }
+  // A new preconditioner ends what could be resumed.
+  {
+    MatrixFreeCg cg;
+    ASSERT_TRUE(cg.set_diagonal_blocks(particles, block, 1).ok());
+    VecX x = VecX::Zero(s.b.size());
+    ASSERT_TRUE(cg.solve(apply, s.b, x, 1e-3, 1000, 1).ok());
+    ASSERT_TRUE(cg.set_diagonal_blocks(particles, block, 1).ok());
+    EXPECT_EQ(cg.solve(apply, s.b, x, 1e-10, 1000, 1, true).status, LinearStatus::kInvalidInput);
   }
   MatrixFreeCg fresh;
   ASSERT_TRUE(fresh.set_diagonal_blocks(particles, block, 1).ok());
