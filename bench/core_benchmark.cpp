@@ -55,6 +55,8 @@ struct DeformedCubeSystem {
   Model model;
   SpringBands bands;
   BandSystem system;  // points to bands: not copyable, not movable
+  State state;        // the deformed cube, at rest
+  VecX kw;            // K v of the last assembly
   const char* error = nullptr;
 
   DeformedCubeSystem(int n, int threads, bool single_precision = false)
@@ -69,16 +71,29 @@ struct DeformedCubeSystem {
       error = "the cube's springs do not fill their bands";
       return;
     }
-    State s = rest_state(model);
-    for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
-    const Real h = 1.0 / 60;
-    VecX kw(model.num_dofs());
-    if (!system.assemble(model, s.x, s.v, DefinitenessFix::kClampCompressed, h, h * h, s.v, kw,
-                         threads))
-      error = "a spring collapsed";
+    state = rest_state(model);
+    for (int i = 0; i < state.x.size(); ++i) state.x[i] += 1e-3 * std::sin(0.37 * i);
+    kw.resize(model.num_dofs());
+    if (!assemble(threads)) error = "a spring collapsed";
   }
   DeformedCubeSystem(const DeformedCubeSystem&) = delete;
   DeformedCubeSystem& operator=(const DeformedCubeSystem&) = delete;
+
+  // Assembles A = M - h D - h^2 K at `state` (h = 1/60 s) and K v; false when a spring
+  // collapsed.
+  bool assemble(int threads) {
+    const Real h = 1.0 / 60;
+    return system.assemble(model, state.x, state.v, DefinitenessFix::kClampCompressed, h, h * h,
+                           state.v, kw, threads);
+  }
+
+  // The counters of a pass over the springs: their number and the time per spring.
+  void count_springs(benchmark::State& bench) const {
+    const double springs = static_cast<double>(model.springs.size());
+    bench.counters["springs"] = springs;
+    bench.counters["s_per_spring"] = benchmark::Counter(
+        springs, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  }
 
   // False (and the benchmark skipped, saying why) when the system could not be built.
   bool usable(benchmark::State& bench) const {
@@ -106,18 +121,10 @@ void BM_MatrixFreeProduct(benchmark::State& bench) {
     cube.system.multiply(p, y, threads);
     benchmark::DoNotOptimize(y.data());
   }
-  const double springs = static_cast<double>(cube.model.springs.size());
-  bench.counters["springs"] = springs;
-  bench.counters["s_per_spring"] = benchmark::Counter(
-      springs, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  cube.count_springs(bench);
 }
 BENCHMARK(BM_MatrixFreeProduct)
-    ->Args({20, 1, 0})
-    ->Args({40, 1, 0})
-    ->Args({40, 2, 0})
-    ->Args({20, 1, 1})
-    ->Args({40, 1, 1})
-    ->Args({40, 2, 1})
+    ->ArgsProduct({{20, 40}, {1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -127,22 +134,15 @@ void BM_MatrixFreeAssembly(benchmark::State& bench) {
   const int threads = static_cast<int>(bench.range(1));
   DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
   if (!cube.usable(bench)) return;
-  State s = rest_state(cube.model);
-  for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
-  const VecX v = 0.1 * cube.vector();
-  VecX kw(cube.model.num_dofs());
-  const Real h = 1.0 / 60;
+  cube.state.v = 0.1 * cube.vector();  // moving: the dampers' terms too
   for (auto _ : bench) {
-    if (!cube.system.assemble(cube.model, s.x, v, DefinitenessFix::kClampCompressed, h, h * h, v,
-                              kw, threads)) {
+    if (!cube.assemble(threads)) {
       bench.SkipWithError("a spring collapsed");
       break;
     }
-    benchmark::DoNotOptimize(kw.data());
+    benchmark::DoNotOptimize(cube.kw.data());
   }
-  const double springs = static_cast<double>(cube.model.springs.size());
-  bench.counters["s_per_spring"] = benchmark::Counter(
-      springs, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  cube.count_springs(bench);
 }
 BENCHMARK(BM_MatrixFreeAssembly)
     ->Args({40, 1})
@@ -186,10 +186,7 @@ void BM_MatrixFreeCgIterations(benchmark::State& bench) {
       kIterations, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_MatrixFreeCgIterations)
-    ->Args({40, 1, 0})
-    ->Args({40, 2, 0})
-    ->Args({40, 1, 1})
-    ->Args({40, 2, 1})
+    ->ArgsProduct({{40}, {1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

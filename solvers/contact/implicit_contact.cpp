@@ -206,7 +206,8 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
   find_penetrating(
       terrains, [&](int i) { return Vec3(particle(x0_, i) + h * predicted_velocity(i)); }, 0);
   for (int i = 0; i < np; ++i) {
-    if (is_pinned[i]) continue;
+    // (A free particle that the prediction keeps above every terrain has nothing to add.)
+    if (is_pinned[i] || (slot_[i] < 0 && penetrating_[i] < 0)) continue;
     const Vec3 v1 = predicted_velocity(i);
     const Vec3 predicted = particle(x0_, i) + h * v1;
     if (slot_[i] >= 0) {
