@@ -28,10 +28,11 @@ void BM_ComputeForces(benchmark::State& bench) {
 }
 BENCHMARK(BM_ComputeForces)->Arg(10)->Arg(20)->Unit(benchmark::kMicrosecond);
 
-// The same through SpringBands (the loop the Simulator uses).
+// The same through SpringBands (the loop the Simulator uses), on range(1) threads.
 void BM_ComputeForcesBanded(benchmark::State& bench) {
   CubeSpec spec;
   spec.n = static_cast<int>(bench.range(0));
+  const int threads = static_cast<int>(bench.range(1));
   const Model model = build_cube(spec);
   const SpringBands bands(model);
   if (!bands.dense()) bench.SkipWithError("the cube's springs do not fill their bands");
@@ -39,14 +40,16 @@ void BM_ComputeForcesBanded(benchmark::State& bench) {
   for (int i = 0; i < s.x.size(); ++i) s.x[i] += 1e-3 * std::sin(0.37 * i);
   VecX f(model.num_dofs());
   for (auto _ : bench) {
-    bands.compute_forces(model, s.x, s.v, f);
+    bands.compute_forces(model, s.x, s.v, f, threads);
     benchmark::DoNotOptimize(f.data());
   }
   bench.counters["springs"] = model.springs.size();
   bench.counters["springs_per_s"] = benchmark::Counter(
       static_cast<double>(model.springs.size()), benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_ComputeForcesBanded)->Arg(10)->Arg(20)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ComputeForcesBanded)
+    ->ArgsProduct({{10, 20, 40}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond);
 
 // implicit_euler's matrix-free backward-Euler matrix (core/detail/band_system.hpp) of the n^3
 // seed cube, slightly deformed, at dt = 1/60 s, assembled on `threads` threads. `error` says

@@ -122,6 +122,14 @@ int main(int argc, char** argv) {
   speed_cmd->add_option("--threads", speed.threads, "thread counts, one row each (0 = all cores)")
       ->delimiter(',')
       ->capture_default_str();
+  speed_cmd->add_flag("--interleave", speed.interleave,
+                      "run the thread counts in alternation (blocks of steps in turn): a change "
+                      "of the machine's speed falls on all of them alike; the peak memory then "
+                      "covers them together");
+  speed_cmd
+      ->add_option("--interleave-block", speed.interleave_block,
+                   "steps of one thread count before the next one's, with --interleave")
+      ->capture_default_str();
 
   SeedOptions seed;
   CLI::App* seed_cmd = app.add_subcommand("seed", "the seed report's stability claims");

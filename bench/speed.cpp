@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include <jelly/bench/memory.hpp>
 #include <jelly/bench/scenes.hpp>
@@ -22,6 +23,7 @@ void SpeedOptions::validate() const {
   require(warmup_steps >= 0, "--warmup-steps", warmup_steps, "an integer >= 0");
   require(!threads.empty(), "--threads", "(empty)", "at least one thread count");
   for (int t : threads) require(t >= 0, "--threads", t, "thread counts >= 0 (0 = all cores)");
+  require(interleave_block >= 1, "--interleave-block", interleave_block, "an integer >= 1");
 }
 
 namespace {
@@ -30,6 +32,110 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
+
+// One row of the table (integrator, size, thread count): its scene, its state and its timers.
+struct SpeedRun {
+  std::vector<Cell> head;
+  int threads = 1;
+  bool memory_reset = false;
+  SceneParts parts;
+  std::unique_ptr<Integrator> method;
+  ContactSolver contacts;
+  std::unique_ptr<const SpringBands> bands;  // the force loop the Simulator uses
+  DivergenceGuard guard;
+  State before;
+  VecX f;
+  double integrator_seconds = 0, contact_seconds = 0, force_probe_seconds = 0;
+  long evaluations = 0;
+  std::string status = "completed";
+  int taken = 0;  // steps, the warm-up included
+  int timed = 0;
+  Statistics before_timing;
+
+  SpeedRun(std::vector<Cell> row_head, const std::string& integrator, int n, int thread_count)
+      : head(std::move(row_head)), threads(thread_count) {
+    SceneSpec spec;
+    spec.name = "slope";
+    spec.n = n;
+    parts = build_scene(spec);
+    // Lower the cube onto the slope: the deepest particle 1 mm below the surface.
+    Real lowest = INFINITY;
+    for (int i = 0; i < parts.model.num_particles(); ++i)
+      lowest =
+          std::min(lowest, parts.terrains.front()->signed_distance(particle(parts.state.x, i), 0));
+    const Vec3 normal = parts.terrains.front()->normal(Vec3::Zero(), 0);
+    for (int i = 0; i < parts.model.num_particles(); ++i)
+      particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
+    method = make_integrator(integrator);
+    bands = std::make_unique<const SpringBands>(parts.model);
+    f.resize(parts.model.num_dofs());
+  }
+
+  bool finished(const SpeedOptions& o) const {
+    return status != "completed" || taken >= o.warmup_steps + o.steps;
+  }
+
+  // Up to `count` more steps (fewer when the run ends).
+  void advance(const SpeedOptions& o, int count) {
+    const Model& model = parts.model;
+    State& state = parts.state;
+    for (int k = 0; k < count && !finished(o); ++k, ++taken) {
+      const bool timing = taken >= o.warmup_steps;
+      if (taken == o.warmup_steps) before_timing = method->statistics();
+      parallel::copy(threads, state.x, before.x);
+      parallel::copy(threads, state.v, before.v);
+      const Dynamics dynamics(model, contacts, &parts.terrains, bands.get(), nullptr, threads);
+      auto start = Clock::now();
+      const StepResult result = method->step(dynamics, state, o.dt);
+      const double step_time = seconds_since(start);
+      start = Clock::now();
+      if (result.ok)
+        resolve_contact_after_step(*method, contacts, model, parts.terrains, before, state, o.dt,
+                                   threads);
+      const double contact_time = seconds_since(start);
+      if (timing) {
+        integrator_seconds += step_time;
+        contact_seconds += contact_time;
+        evaluations += dynamics.force_evaluations();
+        ++timed;
+        // One force evaluation (model forces and the seed contact terms), timed between the
+        // steps so that it sees the same load and caches as the steps around it.
+        start = Clock::now();
+        bands->compute_forces(model, state.x, state.v, f, threads);
+        contacts.add_forces(state.v, f);
+        force_probe_seconds += seconds_since(start);
+      }
+      if (!result.ok) {
+        status = "solver_failed";
+      } else if (guard.check(model, state, threads)) {
+        status = "diverged";
+      }
+    }
+  }
+
+  // The row of the "speed" table and those of "speed_statistics".
+  void add_rows(Real o_dt, Table& speed, Table& stats) const {
+    const Model& model = parts.model;
+    const double force_eval = timed > 0 ? force_probe_seconds / timed : NAN;
+    const double per_step = timed > 0 ? 1.0 / timed : NAN;
+    const double evals_per_step = evaluations * per_step;
+    std::vector<Cell> row = head;
+    row.insert(
+        row.end(),
+        {static_cast<double>(model.num_particles()), static_cast<double>(model.springs.size()),
+         o_dt, static_cast<double>(timed), status, static_cast<double>(contacts.contact_count()),
+         (integrator_seconds + contact_seconds) * per_step, integrator_seconds * per_step,
+         evals_per_step * force_eval, contact_seconds * per_step, evals_per_step,
+         model.springs.size() / force_eval, peak_memory_bytes(), memory_reset ? 1.0 : 0.0});
+    speed.add_row(row);
+    // Counters over the timed steps only (the warm-up subtracted).
+    for (const auto& [key, value] : method->statistics()) {
+      const auto it = before_timing.find(key);
+      const double timed_value = value - (it == before_timing.end() ? 0.0 : it->second);
+      stats.add_row({head[0], head[1], head[2], head[3], key, timed_value, timed_value * per_step});
+    }
+  }
+};
 
 }  // namespace
 
@@ -52,6 +158,8 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
   long item = 0;
   for (const std::string& integrator : integrators) {
     for (int n : o.sizes) {
+      // The rows of this integrator and size that this shard owns.
+      std::vector<std::unique_ptr<SpeedRun>> runs;
       for (int requested_threads : o.threads) {
         const long this_item = item++;
         if (!o.shard.owns(this_item)) continue;
@@ -65,88 +173,25 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
           speed.add_row(row);
           continue;
         }
-        const bool reset = reset_peak_memory();
-        SceneSpec spec;
-        spec.name = "slope";
-        spec.n = n;
-        SceneParts parts = build_scene(spec);
-        // Lower the cube onto the slope: the deepest particle 1 mm below the surface.
-        Real lowest = INFINITY;
-        for (int i = 0; i < parts.model.num_particles(); ++i)
-          lowest = std::min(lowest,
-                            parts.terrains.front()->signed_distance(particle(parts.state.x, i), 0));
-        const Vec3 normal = parts.terrains.front()->normal(Vec3::Zero(), 0);
-        for (int i = 0; i < parts.model.num_particles(); ++i)
-          particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
-        const Model& model = parts.model;
-        State& state = parts.state;
-        auto method = make_integrator(integrator);
-        ContactSolver contacts;
-        const SpringBands bands(model);  // the force loop the Simulator uses
-        const DivergenceGuard guard;
-        State before;
-        double integrator_seconds = 0, contact_seconds = 0, force_probe_seconds = 0;
-        VecX f(model.num_dofs());
-        long evaluations = 0;
-        std::string status = "completed";
-        int timed = 0;
-        Statistics before_timing;
-        for (int k = 0; k < o.warmup_steps + o.steps; ++k) {
-          const bool timing = k >= o.warmup_steps;
-          if (k == o.warmup_steps) before_timing = method->statistics();
-          before.x = state.x;
-          before.v = state.v;
-          const Dynamics dynamics(model, contacts, &parts.terrains, &bands, nullptr, threads);
-          auto start = Clock::now();
-          const StepResult result = method->step(dynamics, state, o.dt);
-          const double step_time = seconds_since(start);
-          start = Clock::now();
-          if (result.ok)
-            resolve_contact_after_step(*method, contacts, model, parts.terrains, before, state,
-                                       o.dt, threads);
-          const double contact_time = seconds_since(start);
-          if (timing) {
-            integrator_seconds += step_time;
-            contact_seconds += contact_time;
-            evaluations += dynamics.force_evaluations();
-            ++timed;
-            // One force evaluation (model forces and the seed contact terms), timed between the
-            // steps so that it sees the same load and caches as the steps around it.
-            start = Clock::now();
-            bands.compute_forces(model, state.x, state.v, f, threads);
-            contacts.add_forces(state.v, f);
-            force_probe_seconds += seconds_since(start);
-          }
-          if (!result.ok) {
-            status = "solver_failed";
-            break;
-          }
-          if (guard.check(model, state)) {
-            status = "diverged";
-            break;
-          }
+        if (o.interleave) {
+          runs.push_back(std::make_unique<SpeedRun>(head, integrator, n, threads));
+          continue;
         }
-        const double force_eval = timed > 0 ? force_probe_seconds / timed : NAN;
-        const double per_step = timed > 0 ? 1.0 / timed : NAN;
-        const double evals_per_step = evaluations * per_step;
-        std::vector<Cell> row = head;
-        row.insert(
-            row.end(),
-            {static_cast<double>(model.num_particles()), static_cast<double>(model.springs.size()),
-             o.dt, static_cast<double>(timed), status,
-             static_cast<double>(contacts.contact_count()),
-             (integrator_seconds + contact_seconds) * per_step, integrator_seconds * per_step,
-             evals_per_step * force_eval, contact_seconds * per_step, evals_per_step,
-             model.springs.size() / force_eval, peak_memory_bytes(), reset ? 1.0 : 0.0});
-        speed.add_row(row);
-        // Counters over the timed steps only (the warm-up subtracted).
-        for (const auto& [key, value] : method->statistics()) {
-          const auto it = before_timing.find(key);
-          const double timed_value = value - (it == before_timing.end() ? 0.0 : it->second);
-          stats.add_row({static_cast<double>(this_item), integrator, static_cast<double>(n),
-                         static_cast<double>(threads), key, timed_value, timed_value * per_step});
+        const bool reset = reset_peak_memory();
+        SpeedRun run(head, integrator, n, threads);
+        run.memory_reset = reset;
+        run.advance(o, o.warmup_steps + o.steps);
+        run.add_rows(o.dt, speed, stats);
+      }
+      // Interleaved: blocks of steps of each row in turn, until all are done.
+      for (bool more = !runs.empty(); more;) {
+        more = false;
+        for (auto& run : runs) {
+          run->advance(o, o.interleave_block);
+          more = more || !run->finished(o);
         }
       }
+      for (const auto& run : runs) run->add_rows(o.dt, speed, stats);
     }
   }
   return {speed, stats};

@@ -20,6 +20,12 @@ struct SpeedOptions {
   Real dt = 1e-3;
   int warmup_steps = 20;
   int steps = 200;
+  // Run the thread counts of each integrator and size in alternation, `interleave_block` steps
+  // each in turn, so that a change of the machine's speed during the measurement falls on all of
+  // them alike (the scaling table). Their scenes are then in memory together: the peak memory
+  // covers them all (memory_per_configuration 0).
+  bool interleave = false;
+  int interleave_block = 20;
   Shard shard;
   void validate() const;
 };

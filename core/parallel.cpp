@@ -19,6 +19,16 @@ int available_cores() {
 
 int resolve_threads(int requested) { return requested > 0 ? requested : available_cores(); }
 
+void copy(int threads, const VecX& from, VecX& to) {
+  if (to.size() != from.size()) to.resize(from.size());
+  const Real* src = from.data();
+  Real* dst = to.data();
+  run(team_size(threads, from.size()), [&](int part, int parts) {
+    const Range r = split(from.size(), part, parts, 3);
+    std::copy(src + r.begin, src + r.end, dst + r.begin);
+  });
+}
+
 namespace {
 
 // OpenBLAS's thread-count functions, when libjelly runs with OpenBLAS (looked up, not linked:

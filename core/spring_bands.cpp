@@ -19,12 +19,23 @@ struct BandEnds {
   const Real *xb, *yb, *zb, *ub, *vb, *wb;
 };
 
+// A band's coefficients per slot: rest lengths always; ks and kd per slot, or (uniform) one
+// ks and one kd for every slot whose rest length is > 0 (the springs; 0 in empty slots).
+struct BandCoefficients {
+  const Real* rest;
+  const Real* ks;
+  const Real* kd;
+  Real uniform_ks, uniform_kd;
+};
+
 // Force on the first particle of each slot into fx, fy, fz. Returns the number of collapsed
-// springs (shorter than kDegenerateLength l0; then the caller falls back).
-JELLY_VECTOR_CLONES
-int band_forces(int n, BandEnds e, const Real* __restrict rest, const Real* __restrict ks,
-                const Real* __restrict kd, Real* __restrict fx, Real* __restrict fy,
-                Real* __restrict fz) {
+// springs (shorter than kDegenerateLength l0; then the caller falls back). A template on
+// uniform coefficients: a band of one ks and kd reads 8 bytes per slot instead of 24.
+template <bool Uniform>
+__attribute__((always_inline)) inline int band_forces_loop(int n, const BandEnds& e,
+                                                           const BandCoefficients& c,
+                                                           Real* __restrict fx, Real* __restrict fy,
+                                                           Real* __restrict fz) {
   const Real* __restrict xa = e.xa;
   const Real* __restrict ya = e.ya;
   const Real* __restrict za = e.za;
@@ -37,20 +48,34 @@ int band_forces(int n, BandEnds e, const Real* __restrict rest, const Real* __re
   const Real* __restrict ub = e.ub;
   const Real* __restrict vb = e.vb;
   const Real* __restrict wb = e.wb;
+  const Real* __restrict rest = c.rest;
+  const Real* __restrict ks = c.ks;
+  const Real* __restrict kd = c.kd;
+  const Real uniform_ks = c.uniform_ks, uniform_kd = c.uniform_kd;
   int collapsed = 0;
   for (int j = 0; j < n; ++j) {
+    // (Uniform: the same values as the per-slot arrays hold, 0 in empty slots.)
+    const Real k_s = Uniform ? (rest[j] > 0 ? uniform_ks : 0.0) : ks[j];
+    const Real k_d = Uniform ? (rest[j] > 0 ? uniform_kd : 0.0) : kd[j];
     const Real dx = xa[j] - xb[j], dy = ya[j] - yb[j], dz = za[j] - zb[j];
     const Real length = std::sqrt(dx * dx + dy * dy + dz * dz);
     // + tiny: a slot without a spring may join two coincident particles (its coefficients are 0).
     const Real inv = 1.0 / (length + 1e-300);
     const Real closing = ((ua[j] - ub[j]) * dx + (va[j] - vb[j]) * dy + (wa[j] - wb[j]) * dz) * inv;
-    const Real magnitude = (-ks[j] * (length - rest[j]) - kd[j] * closing) * inv;
+    const Real magnitude = (-k_s * (length - rest[j]) - k_d * closing) * inv;
     fx[j] = magnitude * dx;
     fy[j] = magnitude * dy;
     fz[j] = magnitude * dz;
     collapsed += length < kDegenerateLength * rest[j];
   }
   return collapsed;
+}
+
+JELLY_VECTOR_CLONES
+int band_forces(int n, const BandEnds& e, const BandCoefficients& c, Real* __restrict fx,
+                Real* __restrict fy, Real* __restrict fz) {
+  if (c.ks == nullptr) return band_forces_loop<true>(n, e, c, fx, fy, fz);
+  return band_forces_loop<false>(n, e, c, fx, fy, fz);
 }
 
 // Springs per thread below which another thread costs more than it saves.
@@ -170,7 +195,6 @@ SpringBands::SpringBands(const Model& model)
     return;
   }
   copy_coefficients(model);
-  scratch_.assign(9 * static_cast<size_t>(particles_), 0.0);
 }
 
 bool SpringBands::fits(const Model& model) const {
@@ -184,93 +208,150 @@ void SpringBands::copy_coefficients(const Model& model) {
     band.rest.assign(slots, 0.0);
     band.ks.assign(slots, 0.0);
     band.kd.assign(slots, 0.0);
+    bool seen = false;
+    band.uniform = true;
     for (size_t j = 0; j < slots; ++j) {
       const int k = band.spring[j];
       if (k < 0) continue;
       band.rest[j] = s.rest_length[k];
       band.ks[j] = s.ks[k];
       band.kd[j] = s.kd[k];
+      if (!seen) band.uniform_ks = s.ks[k], band.uniform_kd = s.kd[k], seen = true;
+      band.uniform = band.uniform && s.rest_length[k] > 0 && s.ks[k] == band.uniform_ks &&
+                     s.kd[k] == band.uniform_kd;
     }
   }
 }
 
 void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f,
                                  int threads) const {
+  evaluate(model, x, v, f, threads, false);
+}
+
+void SpringBands::compute_accelerations(const Model& model, const VecX& x, const VecX& v, VecX& a,
+                                        int threads) const {
+  evaluate(model, x, v, a, threads, true);
+}
+
+namespace {
+// f = M^-1 f, as Dynamics divides (times the inverse mass).
+void divide_by_masses(const Model& model, VecX& f) {
+  const Real* m = model.mass.data();
+  for (int i = 0; i < model.num_particles(); ++i) {
+    const Real inv = 1.0 / m[i];
+    f[3 * i] *= inv;
+    f[3 * i + 1] *= inv;
+    f[3 * i + 2] *= inv;
+  }
+}
+}  // namespace
+
+void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, VecX& f, int threads,
+                           bool accelerations) const {
   if (!dense_ || !fits(model)) {
     ::jelly::compute_forces(model, x, v, f);
+    if (accelerations) divide_by_masses(model, f);
     return;
   }
   const int n = particles_;
   const int team = parallel::team_size(threads, springs_, kMinSpringsPerThread);
-  // Per thread: the slots of its particles' springs, at most n + max_offset_ (one thread).
-  const size_t stride = 3 * (static_cast<size_t>(n) + static_cast<size_t>(max_offset_));
-  if (band_force_.size() < static_cast<size_t>(team) * stride) {
-    band_force_.assign(static_cast<size_t>(team) * stride, 0.0);
-    collapsed_.assign(team, 0);
+  if (static_cast<int>(workspaces_.size()) != team) {
+    workspaces_.assign(team, {});
+    for (int part = 0; part < team; ++part) {
+      const parallel::Range range = parallel::split(n, part, team);
+      const long own = range.end - range.begin;
+      const long reach = std::min<long>(n, own + 2L * max_offset_);
+      // x, y, z, u, v, w of the particles within reach; the band forces of the slots touching
+      // its own particles (at most own + max_offset); the sums of its own particles.
+      workspaces_[part].data.assign(6 * reach + 3 * (own + max_offset_) + 3 * own, 0.0);
+    }
   }
-  Real* px = scratch_.data();
-  Real* py = px + n;
-  Real* pz = py + n;
-  Real* pu = pz + n;
-  Real* pv = pu + n;
-  Real* pw = pv + n;
-  Real* ax = pw + n;
-  Real* ay = ax + n;
-  Real* az = ay + n;
   const Real* m = model.mass.data();
   const Vec3 g = model.gravity;
-  bool any_collapsed = false;
+  // Each thread copies the positions and velocities of every particle its slots reach (its own
+  // and max_offset on either side) into its own arrays: no thread waits for another.
   parallel::run(team, [&](int part, int parts) {
     const parallel::Range range = parallel::split(n, part, parts);
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
-    for (int i = p0; i < p1; ++i) {
-      px[i] = x[3 * i];
-      py[i] = x[3 * i + 1];
-      pz[i] = x[3 * i + 2];
-      pu[i] = v[3 * i];
-      pv[i] = v[3 * i + 1];
-      pw[i] = v[3 * i + 2];
-      ax[i] = m[i] * g.x();
-      ay[i] = m[i] * g.y();
-      az[i] = m[i] * g.z();
+    const int e0 = std::max(0, p0 - max_offset_), e1 = std::min(n, p1 + max_offset_);
+    const int reach = e1 - e0, own = p1 - p0;
+    Workspace& w = workspaces_[part];
+    Real* px = w.data.data();
+    Real* py = px + reach;
+    Real* pz = py + reach;
+    Real* pu = pz + reach;
+    Real* pv = pu + reach;
+    Real* pw = pv + reach;
+    Real* fx = pw + reach;
+    Real* fy = fx + (own + max_offset_);
+    Real* fz = fy + (own + max_offset_);
+    Real* ax = fz + (own + max_offset_);
+    Real* ay = ax + own;
+    Real* az = ay + own;
+    const Real* xs = x.data();
+    const Real* vs = v.data();
+    for (int i = e0; i < e1; ++i) {
+      const int k = i - e0;
+      px[k] = xs[3 * i];
+      py[k] = xs[3 * i + 1];
+      pz[k] = xs[3 * i + 2];
+      pu[k] = vs[3 * i];
+      pv[k] = vs[3 * i + 1];
+      pw[k] = vs[3 * i + 2];
     }
-#pragma omp barrier
-    Real* fx = band_force_.data() + static_cast<size_t>(part) * stride;
-    Real* fy = fx + stride / 3;
-    Real* fz = fy + stride / 3;
+    for (int i = p0; i < p1; ++i) {
+      ax[i - p0] = m[i] * g.x();
+      ay[i - p0] = m[i] * g.y();
+      az[i - p0] = m[i] * g.z();
+    }
     int collapsed = 0;
     for (const Band& band : bands_) {
       const Band::Reach r = band.reach(p0, p1);
       if (r.lo >= r.hi) continue;
-      const int a = band.first + r.lo, b = a + band.offset;
+      const int a = band.first + r.lo - e0, b = a + band.offset;
       const BandEnds ends{px + a, py + a, pz + a, pu + a, pv + a, pw + a,
                           px + b, py + b, pz + b, pu + b, pv + b, pw + b};
-      collapsed += band_forces(r.hi - r.lo, ends, band.rest.data() + r.lo, band.ks.data() + r.lo,
-                               band.kd.data() + r.lo, fx, fy, fz);
+      const BandCoefficients coefficients{
+          band.rest.data() + r.lo, band.uniform ? nullptr : band.ks.data() + r.lo,
+          band.uniform ? nullptr : band.kd.data() + r.lo, band.uniform_ks, band.uniform_kd};
+      collapsed += band_forces(r.hi - r.lo, ends, coefficients, fx, fy, fz);
       // As the serial loop: + on particle a of every slot, then - on particle b.
       if (r.a0 < r.a1) {
-        const int k = r.a0 - a;
-        band_kernels::add(r.a1 - r.a0, fx + k, fy + k, fz + k, ax + r.a0, ay + r.a0, az + r.a0);
+        const int k = r.a0 - (band.first + r.lo);
+        band_kernels::add(r.a1 - r.a0, fx + k, fy + k, fz + k, ax + (r.a0 - p0), ay + (r.a0 - p0),
+                          az + (r.a0 - p0));
       }
       if (r.b0 < r.b1) {
-        const int k = r.b0 - b;
-        band_kernels::subtract(r.b1 - r.b0, fx + k, fy + k, fz + k, ax + r.b0, ay + r.b0,
-                               az + r.b0);
+        const int k = r.b0 - (band.first + r.lo + band.offset);
+        band_kernels::subtract(r.b1 - r.b0, fx + k, fy + k, fz + k, ax + (r.b0 - p0),
+                               ay + (r.b0 - p0), az + (r.b0 - p0));
       }
     }
-    collapsed_[part] = collapsed;
-#pragma omp barrier
-#pragma omp single
-    for (int t = 0; t < parts; ++t) any_collapsed = any_collapsed || collapsed_[t] > 0;
-    // (the implicit barrier of single: every thread sees any_collapsed)
-    if (any_collapsed) return;
-    for (int i = p0; i < p1; ++i) {
-      f[3 * i] = ax[i];
-      f[3 * i + 1] = ay[i];
-      f[3 * i + 2] = az[i];
+    w.collapsed = collapsed;
+    // Written even when a spring collapsed somewhere: the fallback below then overwrites f.
+    Real* pf = f.data();
+    if (accelerations) {
+      for (int i = p0; i < p1; ++i) {
+        const Real inv = 1.0 / m[i];
+        pf[3 * i] = ax[i - p0] * inv;
+        pf[3 * i + 1] = ay[i - p0] * inv;
+        pf[3 * i + 2] = az[i - p0] * inv;
+      }
+    } else {
+      for (int i = p0; i < p1; ++i) {
+        pf[3 * i] = ax[i - p0];
+        pf[3 * i + 1] = ay[i - p0];
+        pf[3 * i + 2] = az[i - p0];
+      }
     }
   });
-  if (any_collapsed) ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: rest direction
+  for (const Workspace& w : workspaces_) {
+    if (w.collapsed > 0) {
+      ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: its rest direction
+      if (accelerations) divide_by_masses(model, f);
+      return;
+    }
+  }
 }
 
 }  // namespace jelly

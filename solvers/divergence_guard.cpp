@@ -3,10 +3,16 @@
 #include <cmath>
 #include <limits>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 
 namespace jelly {
+
+namespace {
+// Particles per thread below which another thread costs more than it saves.
+constexpr long kMinParticlesPerThread = 1024;
+}  // namespace
 
 void DivergenceGuard::validate() const {
   require(max_speed > 0, "divergence.max_speed", max_speed, "a speed > 0 m/s");
@@ -15,7 +21,7 @@ void DivergenceGuard::validate() const {
           "an energy in J (infinite = not checked)");
 }
 
-std::optional<std::string> DivergenceGuard::check(const State& s) const {
+std::optional<std::string> DivergenceGuard::check(const State& s, int threads) const {
   const int n = static_cast<int>(s.x.size() / 3);
   const Real speed2 = max_speed * max_speed;
   const Real dist2 = max_distance * max_distance;
@@ -27,14 +33,24 @@ std::optional<std::string> DivergenceGuard::check(const State& s) const {
   // A little below the limits: these sums may round differently from squaredNorm's below.
   const Real speed2_low = speed2 * (1 - 8 * std::numeric_limits<Real>::epsilon());
   const Real dist2_low = dist2 * (1 - 8 * std::numeric_limits<Real>::epsilon());
+  // (On the threads of the step, over the same particle ranges as the step's loops: each
+  // thread reads what it wrote.)
   bool flagged = false;
-  for (int i = 0; i < n; ++i) {
-    const Real v2 =
-        pv[3 * i] * pv[3 * i] + pv[3 * i + 1] * pv[3 * i + 1] + pv[3 * i + 2] * pv[3 * i + 2];
-    const Real x2 =
-        px[3 * i] * px[3 * i] + px[3 * i + 1] * px[3 * i + 1] + px[3 * i + 2] * px[3 * i + 2];
-    flagged |= !(v2 <= speed2_low && x2 <= dist2_low && std::isfinite(v2) && std::isfinite(x2));
-  }
+  parallel::run(parallel::team_size(threads, n, kMinParticlesPerThread), [&](int part, int parts) {
+    const parallel::Range r = parallel::split(n, part, parts);
+    bool mine = false;
+    for (long i = r.begin; i < r.end; ++i) {
+      const Real v2 =
+          pv[3 * i] * pv[3 * i] + pv[3 * i + 1] * pv[3 * i + 1] + pv[3 * i + 2] * pv[3 * i + 2];
+      const Real x2 =
+          px[3 * i] * px[3 * i] + px[3 * i + 1] * px[3 * i + 1] + px[3 * i + 2] * px[3 * i + 2];
+      mine |= !(v2 <= speed2_low && x2 <= dist2_low && std::isfinite(v2) && std::isfinite(x2));
+    }
+    if (mine) {
+#pragma omp atomic write
+      flagged = true;
+    }
+  });
   if (!flagged) return std::nullopt;
   for (int i = 0; i < n; ++i) {
     const auto x = particle(s.x, i);
@@ -54,8 +70,9 @@ std::optional<std::string> DivergenceGuard::check(const State& s) const {
   return std::nullopt;
 }
 
-std::optional<std::string> DivergenceGuard::check(const Model& model, const State& s) const {
-  if (auto why = check(s)) return why;
+std::optional<std::string> DivergenceGuard::check(const Model& model, const State& s,
+                                                  int threads) const {
+  if (auto why = check(s, threads)) return why;
   if (std::isfinite(max_energy)) {
     const Real e = total_energy(model, s);
     if (!(e <= max_energy)) {

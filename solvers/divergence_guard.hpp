@@ -21,9 +21,10 @@ struct DivergenceGuard {
 
   void validate() const;
   // The reason the state counts as diverged, or nothing. Without the model the energy is not
-  // checked.
-  std::optional<std::string> check(const State& state) const;
-  std::optional<std::string> check(const Model& model, const State& state) const;
+  // checked. The particles are scanned on up to `threads` threads (the same answer for any
+  // count: the first offending particle is named).
+  std::optional<std::string> check(const State& state, int threads = 1) const;
+  std::optional<std::string> check(const Model& model, const State& state, int threads = 1) const;
 };
 
 }  // namespace jelly

@@ -66,6 +66,10 @@ class Dynamics {
   int threads() const { return threads_; }
 
  private:
+  // True when the forces are the bands' alone (gravity, springs, dampers): no anchors, external
+  // forces or seed contact terms.
+  bool springs_only() const;
+
   const Model* model_;
   const ContactSolver* contacts_;
   const Terrains* terrains_;

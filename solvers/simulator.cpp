@@ -226,8 +226,8 @@ StepResult Simulator::step() {
   const bool bodies = body_contact_.active(model_);
   const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_, threads,
                           bodies ? &body_contact_ : nullptr);
-  before_.x = state_.x;
-  before_.v = state_.v;
+  parallel::copy(threads, state_.x, before_.x);
+  parallel::copy(threads, state_.v, before_.v);
   StepResult result = integrator_->step(dynamics, state_, options_.dt);
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
@@ -273,7 +273,8 @@ RunReport Simulator::run_until(Real t_end) {
       break;
     }
     ++report.steps;
-    if (auto why = options_.divergence.check(model_, state_)) {
+    if (auto why = options_.divergence.check(model_, state_,
+                                             parallel::resolve_threads(options_.threads))) {
       report.status = RunStatus::kDiverged;
       report.reason = *why;
       break;

@@ -46,7 +46,7 @@ inline Range split(long n, int part, int parts, long align = 1) {
 // the size of the team OpenMP gave (it may give fewer threads than asked). `#pragma omp
 // barrier` inside body synchronises the team.
 template <class Body>
-void run(int threads, Body&& body) {
+void run([[maybe_unused]] int threads, Body&& body) {
 #ifdef _OPENMP
   if (threads > 1) {
 #pragma omp parallel num_threads(threads)
@@ -65,6 +65,10 @@ void for_ranges(int threads, long n, Body&& body, long min_items = kMinItemsPerT
     if (r.begin < r.end) body(r.begin, r.end);
   });
 }
+
+// to = from (resized when it differs in size), on up to `threads` threads split at multiples
+// of 3 as the particle loops are split: each thread copies the particles it wrote.
+void copy(int threads, const VecX& from, VecX& to);
 
 // Sums of a fixed partition of [0, n) into chunks of kSumChunk items (one chunk when n is
 // smaller), added in chunk order: the same value for any number of threads.

@@ -26,6 +26,10 @@ class SpringBands {
     int first = 0;                   // first particle a of slot 0
     std::vector<int> spring;         // [slots]: spring index, or -1
     std::vector<Real> rest, ks, kd;  // [slots]: 0 where no spring
+    // True when every spring of the band has the same ks and kd (and a rest length > 0): the
+    // force loop then reads uniform_ks and uniform_kd instead of the arrays.
+    bool uniform = false;
+    Real uniform_ks = 0, uniform_kd = 0;
     int slots() const { return static_cast<int>(spring.size()); }
 
     // For a thread that owns the particles [p0, p1): the slots [lo, hi) whose first particle
@@ -55,8 +59,15 @@ class SpringBands {
   // this thread count. Not for concurrent calls on one object (it keeps its scratch arrays).
   void compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f,
                       int threads = 1) const;
+  // a = M^-1 f with f as compute_forces (each thread divides the sums it made: one pass less);
+  // the same bits as compute_forces followed by a *= 1 / m.
+  void compute_accelerations(const Model& model, const VecX& x, const VecX& v, VecX& a,
+                             int threads = 1) const;
 
  private:
+  // compute_forces, or compute_accelerations when `accelerations`.
+  void evaluate(const Model& model, const VecX& x, const VecX& v, VecX& f, int threads,
+                bool accelerations) const;
   // Copies rest lengths, ks and kd from the model into the bands.
   void copy_coefficients(const Model& model);
 
@@ -65,11 +76,13 @@ class SpringBands {
   int springs_ = 0;
   int max_offset_ = 0;
   bool dense_ = false;
-  // Scratch: x, y, z, u, v, w, force x, y, z per particle; per thread, the band force x, y, z
-  // of its particles' slots; per thread, its count of collapsed springs.
-  mutable std::vector<Real> scratch_;
-  mutable std::vector<Real> band_force_;
-  mutable std::vector<int> collapsed_;
+  // Per thread of the last call's team: the copies of x and v within its slots' reach, the band
+  // forces of its slots, the sums of its particles, and its count of collapsed springs.
+  struct Workspace {
+    std::vector<Real> data;
+    int collapsed = 0;
+  };
+  mutable std::vector<Workspace> workspaces_;
 };
 
 }  // namespace jelly

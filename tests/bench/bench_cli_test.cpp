@@ -94,6 +94,36 @@ TEST_F(BenchCli, QuickKeepsOptionsGivenExplicitly) {
   EXPECT_THAT(csv, HasSubstr("\n0,rk4,3,1,27,185,0.001,7,completed,"));
 }
 
+// --interleave runs the thread counts in alternation: the same rows, every one completed with
+// its steps (n = 5: a block of 3 steps at a time, the last block short), and the same
+// trajectories as without it (the contact count is a function of the state).
+TEST_F(BenchCli, InterleavedThreadCountsGiveTheSameRows) {
+  const std::string common = "speed --sizes 5 --steps 10 --threads 1,2 --integrators rk4 ";
+  Result r = bench(common + "--out '" + (dir_ / "plain").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = bench(common + "--interleave --interleave-block 3 --out '" + (dir_ / "alt").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string plain = read_file(dir_ / "plain" / "speed.csv");
+  const std::string alt = read_file(dir_ / "alt" / "speed.csv");
+  for (const std::string row : {"\n0,rk4,5,1,125,", "\n1,rk4,5,2,125,"}) {
+    const auto in_plain = plain.find(row), in_alt = alt.find(row);
+    ASSERT_NE(in_plain, std::string::npos) << row;
+    ASSERT_NE(in_alt, std::string::npos) << row;
+    // particles, springs, dt, steps, status and contacts agree.
+    const auto fields = [](const std::string& csv, std::size_t at) {
+      std::string line = csv.substr(at + 1, csv.find('\n', at + 1) - at - 1);
+      std::size_t pos = 0;
+      for (int comma = 0; comma < 10; ++comma) pos = line.find(',', pos) + 1;
+      return line.substr(0, pos);
+    };
+    EXPECT_EQ(fields(alt, in_alt), fields(plain, in_plain));
+    EXPECT_THAT(fields(alt, in_alt), HasSubstr(",10,completed,"));
+  }
+  r = bench(common + "--interleave --interleave-block 0 --out '" + (dir_ / "bad").string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--interleave-block = 0 is invalid"));
+}
+
 // The `cores` of a table's metadata are the ones the run could use (its CPU affinity: taskset,
 // a Slurm task's allocation), which its default thread count follows; `hardware_cores` the
 // machine's.

@@ -3,9 +3,9 @@
 
 #include <random>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/geometry/cube.hpp>
 
 #include "support/systems.hpp"
 
@@ -42,6 +42,58 @@ TEST_P(BandedCube, SameForcesAsComputeForces) {
   ASSERT_TRUE(bands.dense());  // every cube spring sits in a band
   for (unsigned seed = 1; seed <= 3; ++seed)
     EXPECT_LT(relative_difference(m, bands, moving(m, seed, 0.1)), 1e-13) << seed;
+}
+
+// A band whose springs share ks and kd reads them once (uniform). One spring with its own kd makes
+// its band read per slot again: with both ends of that spring at rest its damper adds nothing, so
+// the forces must be the uniform band's, bit for bit, and they stay those of compute_forces.
+TEST(SpringBands, UniformBandsGiveTheBitsOfPerSlotCoefficients) {
+  CubeSpec spec = testing::small_cube(6);
+  spec.springs[1] = {2500, 7};
+  const Model uniform_model = build_cube(spec);
+  const SpringBands uniform(uniform_model);
+  for (const SpringBands::Band& band : uniform.bands()) EXPECT_TRUE(band.uniform) << band.offset;
+  Model mixed_model = uniform_model;
+  const int spring = 10;
+  mixed_model.springs.kd[spring] *= 2;
+  const SpringBands mixed(mixed_model);
+  int per_slot = 0;
+  for (const SpringBands::Band& band : mixed.bands()) per_slot += !band.uniform;
+  EXPECT_EQ(per_slot, 1);
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    State s = moving(uniform_model, seed, 0.1);
+    particle(s.v, uniform_model.springs.a[spring]).setZero();
+    particle(s.v, uniform_model.springs.b[spring]).setZero();
+    VecX f(uniform_model.num_dofs()), g(uniform_model.num_dofs());
+    uniform.compute_forces(uniform_model, s.x, s.v, f);
+    mixed.compute_forces(mixed_model, s.x, s.v, g);
+    EXPECT_TRUE(f == g) << seed;
+    EXPECT_LT(relative_difference(mixed_model, mixed, s), 1e-13) << seed;
+  }
+}
+
+// The threads split the particles (a cube of 14^3 particles, 37,000 springs: up to 4 threads);
+// every split gives the same bits, and compute_accelerations is compute_forces times 1 / m.
+TEST(SpringBands, ThreadsAndAccelerationsGiveTheSameBits) {
+  const Model m = build_cube(testing::small_cube(14));
+  const SpringBands bands(m);
+  ASSERT_TRUE(bands.dense());
+  const State s = moving(m, 7, 0.05);
+  VecX f1(m.num_dofs());
+  bands.compute_forces(m, s.x, s.v, f1, 1);
+  EXPECT_LT(relative_difference(m, bands, s), 1e-13);
+  VecX a1 = f1;
+  for (int i = 0; i < m.num_particles(); ++i) {
+    const Real inv = 1.0 / m.mass[i];
+    for (int d = 0; d < 3; ++d) a1[3 * i + d] *= inv;
+  }
+  for (int threads : {1, 2, 3, 4}) {
+    VecX f(m.num_dofs()), a(m.num_dofs());
+    bands.compute_forces(m, s.x, s.v, f, threads);
+    bands.compute_accelerations(m, s.x, s.v, a, threads);
+    EXPECT_TRUE(f == f1) << threads << " threads";
+    EXPECT_TRUE(a == a1) << threads << " threads";
+  }
 }
 
 // Two particles projected onto one point: compute_forces pushes along the rest direction, and so

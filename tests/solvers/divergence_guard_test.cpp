@@ -42,6 +42,25 @@ TEST(DivergenceGuard, NonFinitePositionsAndVelocities) {
   }
 }
 
+// On threads the scan names the same particle: the first one, wherever the threads' ranges split
+// the particles (a cube of 4,096 particles: up to 4 threads scan it).
+TEST(DivergenceGuard, ThreadsNameTheFirstParticle) {
+  const Model model = build_cube(testing::small_cube(16));
+  ASSERT_EQ(model.num_particles(), 4096);
+  const DivergenceGuard guard;
+  State s = resting_cube(model);
+  for (int threads : {1, 2, 3, 4}) EXPECT_EQ(guard.check(s, threads), std::nullopt) << threads;
+  particle(s.v, 3500) = Vec3(0, 600, 0);  // in the last thread's range
+  for (int threads : {1, 2, 3, 4}) {
+    EXPECT_TRUE(contains(guard.check(s, threads), "particle 3500 moves at")) << threads;
+  }
+  s.x[3 * 1500] = std::numeric_limits<Real>::quiet_NaN();  // and one before it
+  for (int threads : {1, 2, 3, 4}) {
+    EXPECT_TRUE(contains(guard.check(model, s, threads), "particle 1500 has a non-finite"))
+        << threads;
+  }
+}
+
 // The limits are strict: exactly at the limit passes, beyond it is divergence, and the reason
 // names the particle, the value and the limit.
 TEST(DivergenceGuard, RunawaySpeed) {
