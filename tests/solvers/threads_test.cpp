@@ -28,7 +28,8 @@ struct Outcome {
   int contacts = 0;
 };
 
-Model two_bodies() {
+// The jelly alone: 14^3 particles, about 37,000 springs, under gravity.
+Model lone_jelly() {
   Model model;
   const int n = 14;
   const CubeSpec spec = testing::small_cube(n, (n - 1) * 4.0 / 9);
@@ -36,6 +37,12 @@ Model two_bodies() {
   jelly.shape = spec.shape();
   jelly.material = spec.material();
   add_body(model, jelly, "bodies[0].");
+  model.gravity = spec.gravity;
+  return model;
+}
+
+Model two_bodies() {
+  Model model = lone_jelly();
   BodySpec hanging;
   hanging.name = "hanging";
   CubeShape shape;
@@ -59,7 +66,6 @@ Model two_bodies() {
   push.vector = Vec3(0, 20, 0);
   hanging.forces = {wind, push};
   add_body(model, hanging, "bodies[1].");
-  model.gravity = spec.gravity;
   return model;
 }
 
@@ -137,14 +143,7 @@ INSTANTIATE_TEST_SUITE_P(Registry, EveryIntegratorThreads, ::testing::ValuesIn(i
 // A lone jelly with gravity and springs alone: the force loop divides by the masses as it writes
 // its sums (Dynamics' springs-only evaluation), on every split of the particles the same bits.
 TEST(Threads, SpringsOnlyJellySameTrajectoryOnOneTwoAndThreeThreads) {
-  Model model;
-  const int n = 14;
-  const CubeSpec spec = testing::small_cube(n, (n - 1) * 4.0 / 9);
-  BodySpec jelly;
-  jelly.shape = spec.shape();
-  jelly.material = spec.material();
-  add_body(model, jelly, "bodies[0].");
-  model.gravity = spec.gravity;
+  const Model model = lone_jelly();
   ASSERT_TRUE(SpringBands(model).dense());
   for (const char* integrator : {"explicit_euler", "symplectic_euler", "midpoint", "rk4"}) {
     const Outcome one = run(model, integrator, 1);
