@@ -23,7 +23,7 @@ struct SpeedOptions {
   // Run the thread counts of each integrator and size in alternation, `interleave_block` steps
   // each in turn, so that a change of the machine's speed during the measurement falls on all of
   // them alike (the scaling table). Their scenes are then in memory together: the peak memory
-  // covers them all (memory_per_configuration 0).
+  // is the process's peak so far (memory_per_configuration 0).
   bool interleave = false;
   int interleave_block = 20;
   Shard shard;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 #include <jelly/core/detail/band_kernels.hpp>
@@ -217,8 +218,10 @@ void SpringBands::copy_coefficients(const Model& model) {
       band.ks[j] = s.ks[k];
       band.kd[j] = s.kd[k];
       if (!seen) band.uniform_ks = s.ks[k], band.uniform_kd = s.kd[k], seen = true;
-      band.uniform = band.uniform && s.rest_length[k] > 0 && s.ks[k] == band.uniform_ks &&
-                     s.kd[k] == band.uniform_kd;
+      // (Bit patterns: +0 and -0 are not the same coefficient.)
+      band.uniform = band.uniform && s.rest_length[k] > 0 &&
+                     std::memcmp(&s.ks[k], &band.uniform_ks, sizeof(Real)) == 0 &&
+                     std::memcmp(&s.kd[k], &band.uniform_kd, sizeof(Real)) == 0;
     }
   }
 }
@@ -255,17 +258,8 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
   }
   const int n = particles_;
   const int team = parallel::team_size(threads, springs_, kMinSpringsPerThread);
-  if (static_cast<int>(workspaces_.size()) != team) {
-    workspaces_.assign(team, {});
-    for (int part = 0; part < team; ++part) {
-      const parallel::Range range = parallel::split(n, part, team);
-      const long own = range.end - range.begin;
-      const long reach = std::min<long>(n, own + 2L * max_offset_);
-      // x, y, z, u, v, w of the particles within reach; the band forces of the slots touching
-      // its own particles (at most own + max_offset); the sums of its own particles.
-      workspaces_[part].data.assign(6 * reach + 3 * (own + max_offset_) + 3 * own, 0.0);
-    }
-  }
+  if (static_cast<int>(workspaces_.size()) != team) workspaces_.assign(team, {});
+  int parts_used = 1;
   const Real* m = model.mass.data();
   const Vec3 g = model.gravity;
   // Each thread copies the positions and velocities of every particle its slots reach (its own
@@ -275,7 +269,14 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
     const int e0 = std::max(0, p0 - max_offset_), e1 = std::min(n, p1 + max_offset_);
     const int reach = e1 - e0, own = p1 - p0;
+    if (part == 0) parts_used = parts;
     Workspace& w = workspaces_[part];
+    // x, y, z, u, v, w of the particles within reach; the band forces of the slots touching its
+    // own particles (at most own + max_offset); the sums of its own particles. Sized on the first
+    // call with this team (and again if OpenMP gives fewer threads than asked: larger ranges).
+    const size_t size = 6 * static_cast<size_t>(reach) +
+                        3 * static_cast<size_t>(own + max_offset_) + 3 * static_cast<size_t>(own);
+    if (w.data.size() < size) w.data.assign(size, 0.0);
     Real* px = w.data.data();
     Real* py = px + reach;
     Real* pz = py + reach;
@@ -345,8 +346,8 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
       }
     }
   });
-  for (const Workspace& w : workspaces_) {
-    if (w.collapsed > 0) {
+  for (int part = 0; part < parts_used; ++part) {
+    if (workspaces_[part].collapsed > 0) {
       ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: its rest direction
       if (accelerations) divide_by_masses(model, f);
       return;

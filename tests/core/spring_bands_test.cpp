@@ -3,6 +3,7 @@
 
 #include <random>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/geometry/cube.hpp>
@@ -94,6 +95,28 @@ TEST(SpringBands, ThreadsAndAccelerationsGiveTheSameBits) {
     EXPECT_TRUE(f == f1) << threads << " threads";
     EXPECT_TRUE(a == a1) << threads << " threads";
   }
+}
+
+// OpenMP may start fewer threads than asked (here none: inside SerialLibraries a region gets a
+// team of one): the one thread then owns every particle, its workspace grows to match, and the
+// threads of an earlier, larger team (one of which saw a collapsed spring) are not consulted.
+TEST(SpringBands, FewerThreadsThanAskedGiveTheSameBits) {
+  const Model m = build_cube(testing::small_cube(14));
+  const SpringBands bands(m);
+  const State s = moving(m, 3, 0.05);
+  VecX f1(m.num_dofs()), f(m.num_dofs());
+  bands.compute_forces(m, s.x, s.v, f1, 1);
+  State collapsed = s;
+  const int last = m.num_particles() - 1;
+  particle(collapsed.x, last) = particle(collapsed.x, last - 1);  // in the last thread's range
+  bands.compute_forces(m, collapsed.x, collapsed.v, f, 4);
+  {
+    const parallel::SerialLibraries one_thread;
+    bands.compute_forces(m, s.x, s.v, f, 4);
+  }
+  EXPECT_TRUE(f == f1);
+  bands.compute_forces(m, s.x, s.v, f, 4);
+  EXPECT_TRUE(f == f1);
 }
 
 // Two particles projected onto one point: compute_forces pushes along the rest direction, and so

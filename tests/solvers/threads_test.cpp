@@ -2,6 +2,8 @@
 // (docs/threads.md): fixed partitions, sums in a fixed order.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/body_spec.hpp>
@@ -153,6 +155,35 @@ TEST(Threads, SpringsOnlyJellySameTrajectoryOnOneTwoAndThreeThreads) {
       EXPECT_TRUE(other.state.x == one.state.x) << integrator << ", " << threads << " threads";
       EXPECT_TRUE(other.state.v == one.state.v) << integrator << ", " << threads << " threads";
     }
+  }
+}
+
+// Dynamics' springs-only evaluation (accelerations from the force loop, then the pins' paths)
+// gives the bits of forces() divided by the masses, with pinned particles on their paths.
+TEST(Threads, SpringsOnlyAccelerationsAreTheForcesOverTheMasses) {
+  Model model = lone_jelly();
+  model.pins.add_fixed(0, particle(rest_state(model).x, 0));
+  model.pins.add_fixed(5, particle(rest_state(model).x, 5));
+  const SpringBands bands(model);
+  ContactSolver contacts;
+  State s = rest_state(model);
+  for (int i = 0; i < s.x.size(); ++i) {
+    s.x[i] += 1e-3 * std::sin(0.37 * i);
+    s.v[i] = 0.1 * std::cos(0.11 * i);
+  }
+  for (int threads : {1, 2, 3}) {
+    const Dynamics dynamics(model, contacts, nullptr, &bands, nullptr, threads);
+    VecX a(model.num_dofs()), f(model.num_dofs());
+    dynamics.acceleration(0.1, s.x, s.v, a);
+    dynamics.forces(0.1, s.x, s.v, f);
+    for (int i = 0; i < model.num_particles(); ++i) {
+      const Real inv = 1.0 / model.mass[i];
+      for (int d = 0; d < 3; ++d) f[3 * i + d] *= inv;
+    }
+    model.pins.apply_acceleration(0.1, f);
+    EXPECT_TRUE(a == f) << threads << " threads";
+    EXPECT_EQ(Vec3(particle(a, 5)), Vec3::Zero());
+    EXPECT_EQ(dynamics.force_evaluations(), 2);
   }
 }
 
