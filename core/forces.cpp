@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <jelly/core/detail/parallel.hpp>
+
 namespace jelly {
 
 void add_spring_forces(const Model& model, const VecX& x, const VecX& v, VecX& f) {
@@ -64,6 +66,22 @@ void add_spring_forces(const Model& model, const VecX& x, const VecX& v, VecX& f
   pf[current] += sum_x;
   pf[current + 1] += sum_y;
   pf[current + 2] += sum_z;
+}
+
+void divide_by_masses(const Model& model, VecX& f, int threads) {
+  const Real* m = model.mass.data();
+  Real* pf = f.data();
+  parallel::for_ranges(
+      threads, model.num_particles(),
+      [&](long begin, long end) {
+        for (long i = begin; i < end; ++i) {
+          const Real inv = 1.0 / m[i];
+          pf[3 * i] *= inv;
+          pf[3 * i + 1] *= inv;
+          pf[3 * i + 2] *= inv;
+        }
+      },
+      parallel::kMinParticlesPerThread);
 }
 
 void compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f) {

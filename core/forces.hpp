@@ -18,4 +18,8 @@ void compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f);
 // Adds only the spring and damper forces to f.
 void add_spring_forces(const Model& model, const VecX& x, const VecX& v, VecX& f);
 
+// f = M^-1 f in place (each entry times 1 / m of its particle), on up to `threads` threads: the
+// one definition of the accelerations' division (the same bits for any thread count).
+void divide_by_masses(const Model& model, VecX& f, int threads = 1);
+
 }  // namespace jelly

@@ -23,10 +23,10 @@ void copy(int threads, const VecX& from, VecX& to) {
   if (to.size() != from.size()) to.resize(from.size());
   const Real* src = from.data();
   Real* dst = to.data();
-  run(team_size(threads, from.size()), [&](int part, int parts) {
-    const Range r = split(from.size(), part, parts, 3);
-    std::copy(src + r.begin, src + r.end, dst + r.begin);
-  });
+  for_ranges(
+      threads, from.size(),
+      [&](long begin, long end) { std::copy(src + begin, src + end, dst + begin); },
+      kMinItemsPerThread, 3);
 }
 
 namespace {

@@ -236,24 +236,11 @@ void SpringBands::compute_accelerations(const Model& model, const VecX& x, const
   evaluate(model, x, v, a, threads, true);
 }
 
-namespace {
-// f = M^-1 f, as Dynamics divides (times the inverse mass).
-void divide_by_masses(const Model& model, VecX& f) {
-  const Real* m = model.mass.data();
-  for (int i = 0; i < model.num_particles(); ++i) {
-    const Real inv = 1.0 / m[i];
-    f[3 * i] *= inv;
-    f[3 * i + 1] *= inv;
-    f[3 * i + 2] *= inv;
-  }
-}
-}  // namespace
-
 void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, VecX& f, int threads,
                            bool accelerations) const {
   if (!dense_ || !fits(model)) {
     ::jelly::compute_forces(model, x, v, f);
-    if (accelerations) divide_by_masses(model, f);
+    if (accelerations) divide_by_masses(model, f, threads);
     return;
   }
   const int n = particles_;
@@ -331,7 +318,7 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
     w.collapsed = collapsed;
     // Written even when a spring collapsed somewhere: the fallback below then overwrites f.
     Real* pf = f.data();
-    if (accelerations) {
+    if (accelerations) {  // as divide_by_masses, on the sums still in this thread's cache
       for (int i = p0; i < p1; ++i) {
         const Real inv = 1.0 / m[i];
         pf[3 * i] = ax[i - p0] * inv;
@@ -349,7 +336,7 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
   for (int part = 0; part < parts_used; ++part) {
     if (workspaces_[part].collapsed > 0) {
       ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: its rest direction
-      if (accelerations) divide_by_masses(model, f);
+      if (accelerations) divide_by_masses(model, f, threads);
       return;
     }
   }

@@ -9,11 +9,6 @@
 
 namespace jelly {
 
-namespace {
-// Particles per thread below which another thread costs more than it saves.
-constexpr long kMinParticlesPerThread = 1024;
-}  // namespace
-
 void DivergenceGuard::validate() const {
   require(max_speed > 0, "divergence.max_speed", max_speed, "a speed > 0 m/s");
   require(max_distance > 0, "divergence.max_distance", max_distance, "a distance > 0 m");
@@ -36,21 +31,23 @@ std::optional<std::string> DivergenceGuard::check(const State& s, int threads) c
   // (On the threads of the step, over the same particle ranges as the step's loops: each
   // thread reads what it wrote.)
   bool flagged = false;
-  parallel::run(parallel::team_size(threads, n, kMinParticlesPerThread), [&](int part, int parts) {
-    const parallel::Range r = parallel::split(n, part, parts);
-    bool mine = false;
-    for (long i = r.begin; i < r.end; ++i) {
-      const Real v2 =
-          pv[3 * i] * pv[3 * i] + pv[3 * i + 1] * pv[3 * i + 1] + pv[3 * i + 2] * pv[3 * i + 2];
-      const Real x2 =
-          px[3 * i] * px[3 * i] + px[3 * i + 1] * px[3 * i + 1] + px[3 * i + 2] * px[3 * i + 2];
-      mine |= !(v2 <= speed2_low && x2 <= dist2_low && std::isfinite(v2) && std::isfinite(x2));
-    }
-    if (mine) {
+  parallel::for_ranges(
+      threads, n,
+      [&](long begin, long end) {
+        bool mine = false;
+        for (long i = begin; i < end; ++i) {
+          const Real v2 =
+              pv[3 * i] * pv[3 * i] + pv[3 * i + 1] * pv[3 * i + 1] + pv[3 * i + 2] * pv[3 * i + 2];
+          const Real x2 =
+              px[3 * i] * px[3 * i] + px[3 * i + 1] * px[3 * i + 1] + px[3 * i + 2] * px[3 * i + 2];
+          mine |= !(v2 <= speed2_low && x2 <= dist2_low && std::isfinite(v2) && std::isfinite(x2));
+        }
+        if (mine) {
 #pragma omp atomic write
-      flagged = true;
-    }
-  });
+          flagged = true;
+        }
+      },
+      parallel::kMinParticlesPerThread);
   if (!flagged) return std::nullopt;
   for (int i = 0; i < n; ++i) {
     const auto x = particle(s.x, i);

@@ -20,25 +20,9 @@ void Dynamics::forces(Real t, const VecX& x, const VecX& v, VecX& f) const {
 }
 
 namespace {
-// Particles per thread below which another thread costs more than it saves (the forces' own
-// loop split the particles alike: each thread finishes what it summed).
-constexpr long kMinParticlesPerThread = 1024;
-
 // a = M^-1 f in place, then the pinned particles' path accelerations.
 void finish_acceleration(const Model& model, int threads, Real t, VecX& a) {
-  const Real* m = model.mass.data();
-  Real* pa = a.data();
-  parallel::for_ranges(
-      threads, model.num_particles(),
-      [&](long begin, long end) {
-        for (long i = begin; i < end; ++i) {
-          const Real inv = 1.0 / m[i];
-          pa[3 * i] *= inv;
-          pa[3 * i + 1] *= inv;
-          pa[3 * i + 2] *= inv;
-        }
-      },
-      kMinParticlesPerThread);
+  divide_by_masses(model, a, threads);
   if (!model.pins.empty()) model.pins.apply_acceleration(t, a);
 }
 }  // namespace

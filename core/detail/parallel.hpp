@@ -23,6 +23,8 @@ int resolve_threads(int requested);
 
 // Below this many items a loop is not worth waking a second thread for.
 constexpr long kMinItemsPerThread = 4096;
+// The same for a loop over particles (about 3 vector entries and some arithmetic each).
+constexpr long kMinParticlesPerThread = 1024;
 
 // The number of threads to use for n items: at most `threads`, at least 1, and no more than
 // one per kMinItemsPerThread items (`min_items`).
@@ -57,11 +59,13 @@ void run([[maybe_unused]] int threads, Body&& body) {
   body(0, 1);
 }
 
-// body(begin, end) over a static split of [0, n) between up to `threads` threads.
+// body(begin, end) over a static split of [0, n) between up to `threads` threads, at
+// multiples of `align` (3: a vector of 3 entries per particle, split as the particle loops are).
 template <class Body>
-void for_ranges(int threads, long n, Body&& body, long min_items = kMinItemsPerThread) {
+void for_ranges(int threads, long n, Body&& body, long min_items = kMinItemsPerThread,
+                long align = 1) {
   run(team_size(threads, n, min_items), [&](int part, int parts) {
-    const Range r = split(n, part, parts);
+    const Range r = split(n, part, parts, align);
     if (r.begin < r.end) body(r.begin, r.end);
   });
 }

@@ -76,9 +76,6 @@ bool resolve_seed(const Terrain& terrain, const ContactParams& c, Real m1, Real 
   return true;
 }
 
-// Particles per thread below which another thread costs more than it saves.
-constexpr long kMinParticlesPerThread = 1024;
-
 }  // namespace
 
 void ContactSolver::resolve(const Model& model, const Terrains& terrains, const State& before,
@@ -86,7 +83,7 @@ void ContactSolver::resolve(const Model& model, const Terrains& terrains, const 
   seed_contacts_.clear();
   contact_count_ = 0;
   const int np = model.num_particles();
-  const int team = parallel::team_size(threads, np, kMinParticlesPerThread);
+  const int team = parallel::team_size(threads, np, parallel::kMinParticlesPerThread);
   if (static_cast<int>(part_count_.size()) < team) {
     part_seed_.resize(team);
     part_count_.resize(team);

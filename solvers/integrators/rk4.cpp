@@ -55,11 +55,13 @@ StepResult RungeKutta4::do_step(const Dynamics& dynamics, State& s, Real h) {
   const Real half = 0.5 * h, sixth = h / 6;
   // One threaded pass per update, split as the force loop splits the particles.
   const auto pass = [&](auto&& update, Real c) {
-    parallel::run(parallel::team_size(dynamics.threads(), n), [&](int part, int parts) {
-      const parallel::Range r = parallel::split(n, part, parts, 3);
-      update(r.begin, r.end, c, s.x.data(), s.v.data(), a_.data(), x_stage_.data(),
-             v_stage_.data(), dx_.data(), dv_.data());
-    });
+    parallel::for_ranges(
+        dynamics.threads(), n,
+        [&](long begin, long end) {
+          update(begin, end, c, s.x.data(), s.v.data(), a_.data(), x_stage_.data(), v_stage_.data(),
+                 dx_.data(), dv_.data());
+        },
+        parallel::kMinItemsPerThread, 3);
   };
   // Each stage's dx/dt is its velocity after its own evaluation, which a seed_framework terrain
   // may reflect (stage 1: the step's own velocity, as in the course framework).
