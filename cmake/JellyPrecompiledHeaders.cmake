@@ -37,12 +37,15 @@ function(jelly_precompile_headers target)
   cmake_parse_arguments(PARSE_ARGV 1 arg "" "" "FIRST")
   target_precompile_headers(${target} PRIVATE ${arg_FIRST} ${JELLY_PCH_HEADERS}
                                               ${arg_UNPARSED_ARGUMENTS})
+  # clang writes the headers' modification times into the .pch by default, so that ccache
+  # misses every compile that uses it in a new build directory (ccache's manual).
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    target_compile_options(${target} PRIVATE "SHELL:-Xclang -fno-pch-timestamp")
+  endif()
 endfunction()
 
 # ccache caches compiles that use a precompiled header only with this sloppiness (ccache's
-# manual, "Precompiled headers"); without it every such compile is a miss. (With clang, a new
-# build directory still misses: its .pch carries a timestamp, which CMake 3.25 does not turn off
-# with -fno-pch-timestamp. Rebuilds in place hit.)
+# manual, "Precompiled headers"); without it every such compile is a miss.
 if(JELLY_PRECOMPILE_HEADERS AND CMAKE_CXX_COMPILER_LAUNCHER MATCHES "(^|/)ccache$")
   set(jelly_ccache_sloppiness "CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime")
   foreach(lang C CXX)
