@@ -89,7 +89,8 @@ std::array<Real, K> ordered_sums(int threads, long n, long chunk, std::vector<Re
   const long chunks = std::max<long>(1, (n + chunk - 1) / chunk);
   if (static_cast<long>(partials.size()) != static_cast<long>(K) * chunks)
     partials.assign(K * chunks, 0.0);
-  run(team_size(threads, chunks, 1), [&](int part, int parts) {
+  // A thread per chunk, and no more than one per kMinItemsPerThread items.
+  run(std::min(team_size(threads, chunks, 1), team_size(threads, n)), [&](int part, int parts) {
     const Range r = split(chunks, part, parts);
     for (long c = r.begin; c < r.end; ++c) {
       const std::array<Real, K> s = chunk_sums(c * chunk, std::min(n, (c + 1) * chunk));

@@ -63,18 +63,23 @@ struct CgWork {
     p.setZero(n);
     q.setZero(n);
   }
-  // Sum of f(begin, end) over fixed chunks of [0, n), in chunk order (parallel::ordered_sum).
+  // The sums below run over fixed chunks of kChunk entries (whole particles), added in chunk
+  // order. Small enough that two threads get equal shares at n = 20 (24,000 entries: 16 chunks;
+  // chunks of 8,192 gave one thread 1 and the other 2 of 3), large enough that a chunk's partial
+  // sum costs nothing beside its loop.
+  static constexpr long kChunk = 3 * 512;
+  // Sum of f(begin, end) over the chunks of [0, n).
   template <class ChunkSum>
   Real sum(ChunkSum&& f) {
-    return parallel::ordered_sum(threads, r.size(), partials, f);
+    return parallel::ordered_sums<1>(
+        threads, r.size(), kChunk, partials,
+        [&](long begin, long end) { return std::array<Real, 1>{f(begin, end)}; })[0];
   }
-  // The two sums of f(begin, end) -> {a, b} over fixed chunks of whole particles (kPairChunk
-  // entries), in chunk order.
-  static constexpr long kPairChunk = 3 * 2731;
+  // The two sums of f(begin, end) -> {a, b} over the chunks.
   std::vector<Real> pair_partials;
   template <class ChunkSums>
   std::array<Real, 2> sum2(ChunkSums&& f) {
-    return parallel::ordered_sums<2>(threads, r.size(), kPairChunk, pair_partials, f);
+    return parallel::ordered_sums<2>(threads, r.size(), kChunk, pair_partials, f);
   }
   // body(begin, end) over a static split of [0, n) (boundaries multiples of 3).
   template <class Body>
