@@ -1,6 +1,7 @@
 #include <jelly/core/detail/band_system.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <jelly/core/detail/band_kernels.hpp>
@@ -365,8 +366,13 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) c
   const Real* sx = positions_.data();
   Real* sp = scratch_.data();
   Real* acc = sp + 3 * static_cast<size_t>(n);
+  int parts_used = 1;
+  // The particles split between the threads as fast as each got through its part last time
+  // (parallel::BalancedSplit: a particle's row is the same bits whichever thread computes it).
+  using Clock = std::chrono::steady_clock;
   parallel::run(team, [&](int part, int parts) {
-    const parallel::Range range = parallel::split(n, part, parts);
+    auto start = Clock::now();
+    const parallel::Range range = split_.range(n, part, parts);
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
     for (int i = p0; i < p1; ++i) {
       Real q[3] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
@@ -381,7 +387,9 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) c
         acc[c * n + i] = mass_[i] * q[c];
       }
     }
+    double seconds = std::chrono::duration<double>(Clock::now() - start).count();
 #pragma omp barrier
+    start = Clock::now();
     Real* tx = band_.data() + static_cast<size_t>(part) * kBuffers * stride;
     Real* ty = tx + stride;
     Real* tz = ty + stride;
@@ -404,7 +412,11 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) c
     for (int i = p0; i < p1; ++i) {
       for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c * n + i];
     }
+    seconds += std::chrono::duration<double>(Clock::now() - start).count();
+    split_.record(part, seconds);  // (without the wait at the barrier)
+    if (part == 0) parts_used = parts;
   });
+  split_.update(parts_used);
 }
 
 }  // namespace jelly

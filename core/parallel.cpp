@@ -3,6 +3,8 @@
 #include <dlfcn.h>
 #include <sched.h>
 
+#include <algorithm>
+#include <cmath>
 #include <thread>
 
 namespace jelly::parallel {
@@ -27,6 +29,50 @@ void copy(int threads, const VecX& from, VecX& to) {
       threads, from.size(),
       [&](long begin, long end) { std::copy(src + begin, src + end, dst + begin); },
       kMinItemsPerThread, 3);
+}
+
+Range BalancedSplit::range(long n, int part, int parts, long align) const {
+  if (equal_ || static_cast<int>(share_.size()) != parts) return split(n, part, parts, align);
+  const long units = (n + align - 1) / align;
+  double before = 0;
+  for (int k = 0; k < part; ++k) before += share_[k];
+  const auto boundary = [&](double fraction) {
+    return std::min(units, std::max(0L, std::lround(fraction * static_cast<double>(units))));
+  };
+  const long b = part == 0 ? 0 : boundary(before);
+  const long e = part == parts - 1 ? units : boundary(before + share_[part]);
+  return {std::min(b * align, n), std::min(e * align, n)};
+}
+
+void BalancedSplit::record(int part, double seconds) {
+  if (part < static_cast<int>(seconds_.size())) seconds_[part] = seconds;
+}
+
+void BalancedSplit::update(int parts) {
+  if (static_cast<int>(share_.size()) != parts) {
+    share_.assign(parts, 1.0 / parts);
+    seconds_.assign(parts, 0.0);
+    equal_ = true;
+    return;
+  }
+  // The shares that would have taken equal times (each part's speed: its share per second).
+  double total = 0;
+  for (int k = 0; k < parts; ++k) {
+    if (!(seconds_[k] > 0) || !std::isfinite(seconds_[k])) return;
+    total += share_[k] / seconds_[k];
+  }
+  // Halfway there, or less where a share would leave [1/2, 3/2] of an equal share: the shares
+  // still add up to 1.
+  const double lo = 0.5 / parts, hi = 1.5 / parts;
+  double step = 0.5;
+  for (int k = 0; k < parts; ++k) {
+    const double move = share_[k] / seconds_[k] / total - share_[k];
+    if (move > 0) step = std::min(step, (hi - share_[k]) / move);
+    if (move < 0) step = std::min(step, (share_[k] - lo) / -move);
+  }
+  step = std::max(0.0, step);
+  equal_ = false;
+  for (int k = 0; k < parts; ++k) share_[k] += step * (share_[k] / seconds_[k] / total - share_[k]);
 }
 
 namespace {

@@ -1,6 +1,7 @@
 #include <jelly/core/detail/spring_bands.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -251,8 +252,11 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
   const Vec3 g = model.gravity;
   // Each thread copies the positions and velocities of every particle its slots reach (its own
   // and max_offset on either side) into its own arrays: no thread waits for another.
+  // The particles split between the threads as fast as each got through its part last time
+  // (parallel::BalancedSplit: each particle's forces are the same bits whichever thread sums them).
   parallel::run(team, [&](int part, int parts) {
-    const parallel::Range range = parallel::split(n, part, parts);
+    const auto start = std::chrono::steady_clock::now();
+    const parallel::Range range = split_.range(n, part, parts);
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
     const int e0 = std::max(0, p0 - max_offset_), e1 = std::min(n, p1 + max_offset_);
     const int reach = e1 - e0, own = p1 - p0;
@@ -260,9 +264,11 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
     Workspace& w = workspaces_[part];
     // x, y, z, u, v, w of the particles within reach; the band forces of the slots touching its
     // own particles (at most own + max_offset); the sums of its own particles. Sized on the first
-    // call with this team (and again if OpenMP gives fewer threads than asked: larger ranges).
-    const size_t size = 6 * static_cast<size_t>(reach) +
-                        3 * static_cast<size_t>(own + max_offset_) + 3 * static_cast<size_t>(own);
+    // call with this team for the largest part the split gives (and again if OpenMP gives fewer
+    // threads than asked: larger ranges).
+    const size_t largest = std::min<size_t>(n, parallel::BalancedSplit::largest(n, parts));
+    const size_t size = 6 * std::min<size_t>(n, largest + 2 * max_offset_) +
+                        3 * (largest + max_offset_) + 3 * largest;
     if (w.data.size() < size) w.data.assign(size, 0.0);
     Real* px = w.data.data();
     Real* py = px + reach;
@@ -316,6 +322,8 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
       }
     }
     w.collapsed = collapsed;
+    split_.record(part,
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     // Written even when a spring collapsed somewhere: the fallback below then overwrites f.
     Real* pf = f.data();
     if (accelerations) {  // as divide_by_masses, on the sums still in this thread's cache
@@ -333,6 +341,7 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
       }
     }
   });
+  split_.update(parts_used);
   for (int part = 0; part < parts_used; ++part) {
     if (workspaces_[part].collapsed > 0) {
       ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: its rest direction

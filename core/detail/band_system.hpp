@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <jelly/core/definiteness.hpp>
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/model.hpp>
 
@@ -78,6 +79,7 @@ class BandSystem {
   mutable std::vector<Real> scratch_;
   mutable std::vector<Real> band_;
   mutable std::vector<int> collapsed_;
+  mutable parallel::BalancedSplit split_;  // multiply's particles of each thread
 };
 
 }  // namespace jelly

@@ -44,6 +44,31 @@ inline Range split(long n, int part, int parts, long align = 1) {
   return {std::min(b, n), std::min(e, n)};
 }
 
+// A split of [0, n) between a team's threads that follows how fast each thread got through its
+// part last time: for a loop whose every item comes out the same whichever thread computes it
+// (the force loop, the matrix-free product: each particle's sum in one fixed order), so that a
+// core slowed by its neighbours on the host does not keep the other waiting at the region's
+// end. Each thread asks for its range and reports its time; after the region, update() moves the
+// boundaries part of the way toward equal times. Not for concurrent regions on one object.
+class BalancedSplit {
+ public:
+  // Part `part` of `parts` of [0, n), boundaries at multiples of `align`.
+  Range range(long n, int part, int parts, long align = 1) const;
+  // At least the size of any part of n items among `parts` with align 1 (no part is given more
+  // than 3/2 of an equal share, + 2 items for rounding).
+  static long largest(long n, int parts) { return (3 * n + 2 * parts - 1) / (2 * parts) + 2; }
+  // The seconds `part` took for its range (each thread its own entry).
+  void record(int part, double seconds);
+  // After the region: the next split from the times recorded (a team of another size starts
+  // from equal parts).
+  void update(int parts);
+
+ private:
+  std::vector<double> share_;    // [parts]: the fraction of the items of each part
+  std::vector<double> seconds_;  // [parts]: the last region's times
+  bool equal_ = true;            // equal shares: split()'s ranges
+};
+
 // Runs body(part, parts) on a team of `threads` threads (inline when threads <= 1); `parts` is
 // the size of the team OpenMP gave (it may give fewer threads than asked). `#pragma omp
 // barrier` inside body synchronises the team.

@@ -14,6 +14,7 @@
 // computed by both) and adds them in the serial loop's order (docs/threads.md).
 #include <vector>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/model.hpp>
 
 namespace jelly {
@@ -83,6 +84,7 @@ class SpringBands {
     int collapsed = 0;
   };
   mutable std::vector<Workspace> workspaces_;
+  mutable parallel::BalancedSplit split_;  // the particles of each thread
 };
 
 }  // namespace jelly
