@@ -20,10 +20,10 @@ namespace {
 class EveryIntegratorThreads : public ::testing::TestWithParam<std::string> {};
 
 // Two bodies: a jelly big enough for every threaded loop to split (about 37,000 springs, 8,232
-// unknowns: two sum chunks), dropped spinning and squeezed onto a 20-degree coulomb slope; and a
-// small cube above the slope, pinned by its top face to a path that moves it, in a gusty wind
-// and pushed up by a constant force. The force loop, the pins and the external forces all take
-// part.
+// unknowns: two chunks of parallel::ordered_sum, six of CG's sums), dropped spinning and squeezed
+// onto a 20-degree coulomb slope; and a small cube above the slope, pinned by its top face to a
+// path that moves it, in a gusty wind and pushed up by a constant force. The force loop, the pins
+// and the external forces all take part.
 struct Outcome {
   State state;
   Statistics statistics;
