@@ -322,8 +322,6 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
       }
     }
     w.collapsed = collapsed;
-    split_.record(part,
-                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     // Written even when a spring collapsed somewhere: the fallback below then overwrites f.
     Real* pf = f.data();
     if (accelerations) {  // as divide_by_masses, on the sums still in this thread's cache
@@ -340,6 +338,8 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
         pf[3 * i + 2] = az[i - p0];
       }
     }
+    split_.record(part,
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   });
   split_.update(parts_used);
   for (int part = 0; part < parts_used; ++part) {
