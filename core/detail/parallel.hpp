@@ -47,9 +47,10 @@ inline Range split(long n, int part, int parts, long align = 1) {
 // A split of [0, n) between a team's threads that follows how fast each thread got through its
 // part last time: for a loop whose every item comes out the same whichever thread computes it
 // (the force loop, the matrix-free product: each particle's sum in one fixed order), so that a
-// core slowed by its neighbours on the host does not keep the other waiting at the region's
-// end. Each thread asks for its range and reports its time; after the region, update() moves the
-// boundaries part of the way toward equal times. Not for concurrent regions on one object.
+// thread that runs slower (on these virtual machines, often the one on CPU 0) does not keep the
+// other waiting at the region's end. Each thread asks for its range and reports its time; after
+// the region, update() moves the boundaries part of the way toward equal times. Not for
+// concurrent regions on one object.
 class BalancedSplit {
  public:
   // Part `part` of `parts` of [0, n), boundaries at multiples of `align`.
