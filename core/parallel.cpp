@@ -31,17 +31,15 @@ void copy(int threads, const VecX& from, VecX& to) {
       kMinItemsPerThread, 3);
 }
 
-Range BalancedSplit::range(long n, int part, int parts, long align) const {
-  if (equal_ || static_cast<int>(share_.size()) != parts) return split(n, part, parts, align);
-  const long units = (n + align - 1) / align;
+Range BalancedSplit::range(long n, int part, int parts) const {
+  if (equal_ || static_cast<int>(share_.size()) != parts) return split(n, part, parts);
   double before = 0;
   for (int k = 0; k < part; ++k) before += share_[k];
   const auto boundary = [&](double fraction) {
-    return std::min(units, std::max(0L, std::lround(fraction * static_cast<double>(units))));
+    return std::min(n, std::max(0L, std::lround(fraction * static_cast<double>(n))));
   };
-  const long b = part == 0 ? 0 : boundary(before);
-  const long e = part == parts - 1 ? units : boundary(before + share_[part]);
-  return {std::min(b * align, n), std::min(e * align, n)};
+  return {part == 0 ? 0 : boundary(before),
+          part == parts - 1 ? n : boundary(before + share_[part])};
 }
 
 void BalancedSplit::record(int part, double seconds) {

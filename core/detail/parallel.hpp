@@ -53,10 +53,10 @@ inline Range split(long n, int part, int parts, long align = 1) {
 // concurrent regions on one object.
 class BalancedSplit {
  public:
-  // Part `part` of `parts` of [0, n), boundaries at multiples of `align`.
-  Range range(long n, int part, int parts, long align = 1) const;
-  // At least the size of any part of n items among `parts` with align 1 (no part is given more
-  // than 3/2 of an equal share, + 2 items for rounding).
+  // Part `part` of `parts` of [0, n).
+  Range range(long n, int part, int parts) const;
+  // At least the size of any part of n items among `parts` (no part is given more than 3/2 of
+  // an equal share, + 2 items for rounding).
   static long largest(long n, int parts) { return (3 * n + 2 * parts - 1) / (2 * parts) + 2; }
   // The seconds `part` took for its range (each thread its own entry).
   void record(int part, double seconds);
@@ -129,10 +129,11 @@ std::array<Real, K> ordered_sums(int threads, long n, long chunk, std::vector<Re
   return total;
 }
 
-// The sum over chunks of kSumChunk items of chunk_sum(begin, end) (ordered_sums with one sum).
+// The sum over chunks of `chunk` items of chunk_sum(begin, end) (ordered_sums with one sum).
 template <class ChunkSum>
-Real ordered_sum(int threads, long n, std::vector<Real>& partials, ChunkSum&& chunk_sum) {
-  return ordered_sums<1>(threads, n, kSumChunk, partials, [&](long begin, long end) {
+Real ordered_sum(int threads, long n, std::vector<Real>& partials, ChunkSum&& chunk_sum,
+                 long chunk = kSumChunk) {
+  return ordered_sums<1>(threads, n, chunk, partials, [&](long begin, long end) {
     return std::array<Real, 1>{chunk_sum(begin, end)};
   })[0];
 }

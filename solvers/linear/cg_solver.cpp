@@ -71,9 +71,7 @@ struct CgWork {
   // Sum of f(begin, end) over the chunks of [0, n).
   template <class ChunkSum>
   Real sum(ChunkSum&& f) {
-    return parallel::ordered_sums<1>(
-        threads, r.size(), kChunk, partials,
-        [&](long begin, long end) { return std::array<Real, 1>{f(begin, end)}; })[0];
+    return parallel::ordered_sum(threads, r.size(), partials, f, kChunk);
   }
   // The two sums of f(begin, end) -> {a, b} over the chunks.
   std::vector<Real> pair_partials;
