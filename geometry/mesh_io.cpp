@@ -14,22 +14,14 @@
 #include <assimp/Importer.hpp>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/detail/mesh_file.hpp>
 
 namespace jelly {
 
 namespace {
 
-// Meshes larger than this are refused before reading (a mistaken path to a huge file).
-constexpr std::uintmax_t kMaxMeshFileBytes = 1ull << 30;
-
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
+using detail::lower_extension;
+using detail::quoted;
 
 // Index of each distinct position, in order of first appearance; -0 and +0 are the same.
 class Welder {
@@ -136,14 +128,7 @@ MeshFile read_mesh(const std::string& path, const std::string& field) {
   const std::string ext = lower_extension(path);
   require(ext == ".obj" || ext == ".stl" || ext == ".ply", field, value,
           "a mesh file ending in .obj, .stl or .ply");
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  require(fs::exists(status), field, value, "an existing mesh file (not found)");
-  require(fs::is_regular_file(status), field, value, "a regular file (this is not one)");
-  const std::uintmax_t bytes = fs::file_size(path, ec);
-  require(!ec && bytes <= kMaxMeshFileBytes, field, value,
-          "a mesh file of at most 1 GiB (this one has " + std::to_string(bytes) + " bytes)");
-  require(static_cast<bool>(std::ifstream(path)), field, value, "a readable file");
+  detail::require_mesh_file(path, field, value);
 
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate);

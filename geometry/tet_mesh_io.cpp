@@ -11,34 +11,15 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/detail/gmsh_session.hpp>
+#include <jelly/geometry/detail/mesh_file.hpp>
 
 namespace jelly {
 
 namespace {
 
-constexpr std::uintmax_t kMaxMeshFileBytes = 1ull << 30;
-
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
-// Throws unless `path` is an existing, readable, regular file of reasonable size; `value` is
-// what the message shows as the field's value.
-void require_file(const std::string& path, const std::string& field, const std::string& value) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  require(fs::exists(status), field, value, "an existing mesh file (not found: " + path + ")");
-  require(fs::is_regular_file(status), field, value, "a regular file (" + path + " is not one)");
-  const std::uintmax_t bytes = fs::file_size(path, ec);
-  require(!ec && bytes <= kMaxMeshFileBytes, field, value, "a mesh file of at most 1 GiB");
-  require(static_cast<bool>(std::ifstream(path)), field, value, "a readable file");
-}
+using detail::lower_extension;
+using detail::quoted;
+using detail::require_mesh_file;
 
 TetMesh read_gmsh(const std::string& path, const std::string& field) {
   const std::string value = quoted(path);
@@ -89,8 +70,8 @@ TetMesh read_tetgen(const std::string& path, const std::string& field) {
   const std::string value = quoted(path);
   const std::filesystem::path base = std::filesystem::path(path).replace_extension();
   const std::string node_path = base.string() + ".node", ele_path = base.string() + ".ele";
-  require_file(node_path, field, value);
-  require_file(ele_path, field, value);
+  require_mesh_file(node_path, field, value);
+  require_mesh_file(ele_path, field, value);
 
   TetMesh mesh;
   std::map<long, std::vector<int>> markers, regions;
@@ -170,7 +151,7 @@ TetMesh read_tet_mesh(const std::string& path, const std::string& field) {
           "a tetrahedral mesh file ending in .msh (Gmsh) or .node/.ele (TetGen)");
   TetMesh mesh;
   if (ext == ".msh") {
-    require_file(path, field, value);
+    require_mesh_file(path, field, value);
     mesh = read_gmsh(path, field);
   } else {
     mesh = read_tetgen(path, field);

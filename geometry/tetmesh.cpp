@@ -6,18 +6,19 @@
 #include <cstdint>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/detail/mesh_file.hpp>
 #include <jelly/geometry/tet_mesh_io.hpp>
 
 namespace jelly {
 
 namespace {
 
+using detail::quoted;
+
 // Six times the signed volume of tet (a, b, c, d).
 Real six_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return (b - a).dot((c - a).cross(d - a));
 }
-
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
 }  // namespace
 

@@ -13,18 +13,6 @@ namespace jelly {
 
 namespace {
 
-std::vector<std::string> member_names(hid_t group) {
-  std::vector<std::string> names;
-  H5Literate(
-      group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
-      [](hid_t, const char* name, const H5L_info_t*, void* out) -> herr_t {
-        static_cast<std::vector<std::string>*>(out)->emplace_back(name);
-        return 0;
-      },
-      &names);
-  return names;
-}
-
 std::map<std::string, std::string> attributes_of(hid_t object) {
   std::map<std::string, std::string> map;
   for (auto& [name, value] : h5::read_attributes_as_text(object)) map[name] = value;
@@ -62,7 +50,7 @@ struct BodyGroup {
 std::vector<BodyGroup> body_groups(hid_t file) {
   h5::Handle particles = h5::open_group(file, "/particles");
   std::vector<BodyGroup> bodies;
-  for (const std::string& name : member_names(particles.get())) {
+  for (const std::string& name : h5::member_names(particles.get())) {
     BodyGroup b{name, -1};
     h5::Handle g = h5::open_group(particles.get(), name);
     if (h5::has_attribute(g.get(), "first_particle")) {
@@ -218,7 +206,7 @@ Recording read(hid_t file) {
   r.velocity.resize(frames);
 
   h5::Handle observables = h5::open_group(file, "/observables");
-  for (const std::string& name : member_names(observables.get())) {
+  for (const std::string& name : h5::member_names(observables.get())) {
     const std::vector<double> v =
         h5::read_doubles(observables.get(), name + "/value", &dims, kReadable);
     expect(dims.size() == 1 || (dims.size() == 2 && dims[1] == 3), "/observables/" + name,
@@ -230,7 +218,7 @@ Recording read(hid_t file) {
             v.data(), rows, cols);
   }
   h5::Handle terrain = h5::open_group(file, "/terrain");
-  for (const std::string& name : member_names(terrain.get())) {
+  for (const std::string& name : h5::member_names(terrain.get())) {
     TerrainTrack track;
     track.name = name;
     h5::Handle g = h5::open_group(terrain.get(), name);
@@ -334,11 +322,11 @@ std::string describe_recording(const std::string& path) {
     out << '\n';
     h5::Handle observables = h5::open_group(f, "/observables");
     out << "observables:  ";
-    for (const std::string& name : member_names(observables.get())) out << ' ' << name;
+    for (const std::string& name : h5::member_names(observables.get())) out << ' ' << name;
     out << '\n';
     h5::Handle terrain = h5::open_group(f, "/terrain");
     out << "terrains:     ";
-    const auto names = member_names(terrain.get());
+    const auto names = h5::member_names(terrain.get());
     if (names.empty()) out << " none";
     for (const std::string& name : names) out << ' ' << name;
     out << '\n';

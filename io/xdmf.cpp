@@ -30,6 +30,7 @@ namespace {
 
 using h5::check;
 using h5::Handle;
+using h5::member_names;
 
 constexpr long kLayoutVersion = 2;    // of /xdmf; a group of another version is rebuilt
 constexpr hsize_t kBlockFrames = 32;  // frames read and derived at a time, at most
@@ -48,19 +49,6 @@ constexpr int kStrainDigits = 5;
 
 // ---------------------------------------------------------------------------------------------
 // HDF5 helpers
-
-std::vector<std::string> member_names(hid_t group) {
-  std::vector<std::string> names;
-  check(H5Literate(
-            group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
-            [](hid_t, const char* name, const H5L_info_t*, void* out) -> herr_t {
-              static_cast<std::vector<std::string>*>(out)->emplace_back(name);
-              return 0;
-            },
-            &names),
-        "list group members");
-  return names;
-}
 
 bool is_group(hid_t parent, const std::string& name) {
   if (H5Lexists(parent, name.c_str(), H5P_DEFAULT) <= 0) return false;
@@ -253,7 +241,7 @@ struct Observable {
   std::vector<double> values;  // frames x width
 };
 
-struct Recording {
+struct RecordingLayout {
   std::string h5_name;  // the file name as the sidecar names it (it sits beside the file)
   hsize_t frames = 0;
   std::vector<double> time;
@@ -315,8 +303,8 @@ void read_surface(hid_t file, const std::string& h5_path, RecordedBody& body) {
   body.surface_vertices = v;
 }
 
-Recording inspect(hid_t file, const std::string& h5_path) {
-  Recording r;
+RecordingLayout inspect(hid_t file, const std::string& h5_path) {
+  RecordingLayout r;
   const size_t slash = h5_path.find_last_of('/');
   r.h5_name = slash == std::string::npos ? h5_path : h5_path.substr(slash + 1);
   if (!is_group(file, "particles")) not_a_recording(h5_path, "no /particles group");
@@ -525,8 +513,8 @@ void write_body_springs(hid_t file, const RecordedBody& body, hid_t group) {
 
 // Speed and strain of the frames not derived yet, the views of every new frame, and the
 // bounding box of the positions read.
-void update_body(hid_t file, const Recording& r, const RecordedBody& body, hsize_t first_new_view,
-                 const XdmfOptions& options, Bounds& bounds) {
+void update_body(hid_t file, const RecordingLayout& r, const RecordedBody& body,
+                 hsize_t first_new_view, const XdmfOptions& options, Bounds& bounds) {
   Handle group = open_or_create_group(file, body_path(body));
   write_body_springs(file, body, group.get());
   const hsize_t n = body.count, m = body.springs.size();
@@ -610,7 +598,7 @@ void update_body(hid_t file, const Recording& r, const RecordedBody& body, hsize
 
 // The speed of every surface vertex for the frames not derived yet (|sum of weights times the
 // velocities of its particles|), and the views of every new frame.
-void update_surface(hid_t file, const Recording& r, const RecordedBody& body,
+void update_surface(hid_t file, const RecordingLayout& r, const RecordedBody& body,
                     hsize_t first_new_view, const XdmfOptions& options) {
   if (!body.surface) return;
   Handle group = open_or_create_group(file, surface_path(body));
@@ -723,7 +711,8 @@ Vec3 placed(const TerrainInfo& t, hsize_t f, const Vec3& at) {
 
 // The terrain's mesh (and, when it moves, its vertices and speed at every frame with views).
 // Returns false for a terrain the sidecar cannot draw.
-bool update_terrain(hid_t file, const Recording& r, const TerrainInfo& t, const Bounds& bounds) {
+bool update_terrain(hid_t file, const RecordingLayout& r, const TerrainInfo& t,
+                    const Bounds& bounds) {
   const Mesh mesh = terrain_mesh(t, bounds);
   if (mesh.vertices.empty()) return false;
   Handle terrains = open_or_create_group(file, "/xdmf/terrain");
@@ -869,7 +858,7 @@ class Writer {
   std::ostringstream out_;
 };
 
-void body_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody& body,
+void body_grids(Writer& w, hid_t file, const RecordingLayout& r, const RecordedBody& body,
                 bool observables, const XdmfOptions& options) {
   const std::string own = body_path(body);
   const std::string springs = body.all_springs ? "/connectivity" : own;
@@ -917,7 +906,7 @@ void body_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody& b
 }
 
 // The body's render surface: its triangles over the recorded vertex positions, frame by frame.
-void surface_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody& body) {
+void surface_grids(Writer& w, hid_t file, const RecordingLayout& r, const RecordedBody& body) {
   const std::string own = surface_path(body);
   const Item triangles = item_of(file, body.group() + "/surface/triangles");
   const std::string faces = triangles.dims.substr(0, triangles.dims.find(' '));
@@ -941,7 +930,7 @@ void surface_grids(Writer& w, hid_t file, const Recording& r, const RecordedBody
   out << "    </Grid>\n";
 }
 
-void terrain_grids(Writer& w, hid_t file, const Recording& r, const TerrainInfo& t) {
+void terrain_grids(Writer& w, hid_t file, const RecordingLayout& r, const TerrainInfo& t) {
   const std::string own = terrain_path(t);
   const Item triangles = item_of(file, own + "/triangles");
   const std::string faces = triangles.dims.substr(0, triangles.dims.find(' '));
@@ -977,7 +966,7 @@ void terrain_grids(Writer& w, hid_t file, const Recording& r, const TerrainInfo&
 
 std::string update_xdmf(hid_t file, const std::string& h5_path, const XdmfOptions& options) {
   options.validate();
-  const Recording r = inspect(file, h5_path);
+  const RecordingLayout r = inspect(file, h5_path);
 
   Handle root = open_or_create_group(file, "xdmf");
   if (!h5::has_attribute(root.get(), "version") ||

@@ -4,18 +4,19 @@
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/detail/mesh_file.hpp>
 #include <jelly/geometry/mesh_io.hpp>
 
 namespace jelly {
 
 namespace {
 
+using detail::quoted;
+
 std::uint64_t next_serial() {
   static std::atomic<std::uint64_t> counter{0};
   return ++counter;
 }
-
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
 // The last query of this thread: which shape, the point in its frame, the answer.
 struct LastQuery {

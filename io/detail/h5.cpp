@@ -223,6 +223,19 @@ Handle open_dataset(hid_t parent, const std::string& name) {
   return Handle(H5Dopen2(parent, name.c_str(), H5P_DEFAULT), "open dataset " + name);
 }
 
+std::vector<std::string> member_names(hid_t group) {
+  std::vector<std::string> names;
+  check(H5Literate(
+            group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
+            [](hid_t, const char* name, const H5L_info_t*, void* out) -> herr_t {
+              static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+              return 0;
+            },
+            &names),
+        "list group members");
+  return names;
+}
+
 bool exists(hid_t parent, const std::string& path) {
   std::string prefix;
   std::istringstream parts(path);

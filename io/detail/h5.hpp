@@ -62,6 +62,8 @@ Handle create_group(hid_t parent, const std::string& name);
 Handle open_group(hid_t parent, const std::string& name);
 Handle open_dataset(hid_t parent, const std::string& name);
 bool exists(hid_t parent, const std::string& path);  // every link along the path exists
+// The names of a group's members, in name order.
+std::vector<std::string> member_names(hid_t group);
 void hard_link(hid_t target_parent, const std::string& target, hid_t link_parent,
                const std::string& link);
 

@@ -8,34 +8,33 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/solvers/contact/detail/friction.hpp>
 #include <jelly/solvers/contact/detail/restitution.hpp>
 
 namespace jelly {
 
 namespace {
 
+using friction::kStickViscosity;
+using friction::tangential;
+
 using Mat3 = Eigen::Matrix3d;
 using Clock = std::chrono::steady_clock;
 
 // A carried pair whose explicit prediction ends at most this far apart stays active.
-constexpr Real kTouchTolerance = 1e-6;  // m
+constexpr Real kPairTouchTolerance = 1e-6;  // m
 // A candidate whose end gap a solve makes smaller than -this fraction of r_i + r_j becomes
 // active and the step solves again; a shallower overlap is left to the next step (whose
 // prediction makes the pair active), which saves most of those solves.
-constexpr Real kPenetrationTolerance = 1e-3;
+constexpr Real kPairPenetrationFraction = 1e-3;
 // The largest overlap, as a fraction of r_i + r_j, a step may end with: deeper ones (the pair
 // spring's compliance under a whole body's momentum at a landing) are projected out after the
 // solve. Resting loads compress a pair far less.
 constexpr Real kLargestOverlap = 5e-3;
 constexpr int kProjectionPasses = 4;
-// A sliding pair whose friction viscosity reaches this many times its reduced mass has all but
-// stopped sliding: it sticks (as for the terrains).
-constexpr Real kStickViscosity = 100;
 // Candidates: each radius grown by this fraction besides the distance travelled in the step, so
 // that the matrix pattern (the union of the candidates) rarely needs a new pair.
 constexpr Real kCandidateMargin = 0.25;
-
-Vec3 tangential(const Vec3& w, const Vec3& n) { return w - w.dot(n) * n; }
 
 // Adds `block` to the 3x3 block (row particle r, column particle c) of a full-storage matrix of
 // dense 3x3 blocks with sorted rows.
@@ -95,7 +94,7 @@ bool ImplicitBodyContact::begin_step(const Model& model, BodyContact& contact, c
                                       });
     const bool was_active = old != carried_.end() && old->i == i && old->j == j;
     p.kappa = kStiffness;
-    if (was_active && predicted_gap <= kTouchTolerance) {
+    if (was_active && predicted_gap <= kPairTouchTolerance) {
       p.active = true;
       p.mode = old->mode;
       p.viscosity = old->viscosity;
@@ -166,7 +165,7 @@ bool ImplicitBodyContact::update(const VecX& dv, bool commit) {
     const Vec3 w1 = particle(v0_, p.j) + particle(dv, p.j) - particle(v0_, p.i) - particle(dv, p.i);
     if (!p.active) {
       const Real gap1 = p.gap0 + h_ * p.normal.dot(w1);
-      if (gap1 >= -kPenetrationTolerance * p.reach) continue;
+      if (gap1 >= -kPairPenetrationFraction * p.reach) continue;
       changed = true;
       if (!commit) continue;
       p.active = true;

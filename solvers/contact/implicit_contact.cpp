@@ -7,10 +7,14 @@
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/solvers/contact/detail/friction.hpp>
 
 namespace jelly {
 
 namespace {
+
+using friction::kStickViscosity;
+using friction::tangential;
 
 using Mat3 = Eigen::Matrix3d;
 
@@ -20,9 +24,6 @@ constexpr Real kPenetrationTolerance = 1e-9;  // m
 constexpr Real kTouchTolerance = 1e-6;        // m
 // A prescribed normal velocity above -this is "not moving towards the surface" (round-off).
 constexpr Real kTouchSpeed = 1e-9;  // m/s
-// A sliding contact whose friction viscosity reaches this many times its mass has all but
-// stopped (its tangential speed is under 1 % of the free one): it sticks.
-constexpr Real kStickViscosity = 100;
 
 // The three columns of particle j in a full-storage matrix of dense 3x3 blocks: entry
 // (3 i + r, 3 j + q) of the block in slot k (row particle i) is values[start + q stride + 3 k + r].
@@ -57,9 +58,6 @@ void write_block(Real* values, const BlockColumn& col, int k, const Mat3& b) {
   for (int q = 0; q < 3; ++q)
     for (int r = 0; r < 3; ++r) values[col.start + q * col.stride + 3 * k + r] = b(r, q);
 }
-
-// The part of w in the plane normal to the unit vector n.
-Vec3 tangential(const Vec3& w, const Vec3& n) { return w - w.dot(n) * n; }
 
 bool uses_coulomb(const Terrain& terrain) {
   return terrain.contact().model == ContactModel::kCoulomb;

@@ -4,15 +4,16 @@
 #include <cmath>
 
 #include <jelly/core/measures.hpp>
+#include <jelly/solvers/contact/detail/friction.hpp>
 
 namespace jelly {
 
 namespace {
 
+using friction::tangential;
+
 // Slips shorter than this (m) have no direction of their own.
 constexpr Real kTinySlip = 1e-12;
-
-Vec3 tangential(const Vec3& w, const Vec3& n) { return w - w.dot(n) * n; }
 
 }  // namespace
 

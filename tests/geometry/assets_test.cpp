@@ -22,17 +22,12 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using testing::input_error;
+using testing::occupied;
 using testing::TempDir;
 using testing::write_text;
 
 std::string asset(const std::string& name) {
   return std::string(JELLY_SOURCE_DIR) + "/assets/" + name;
-}
-
-int occupied(const LatticeGrid& grid) {
-  int n = 0;
-  for (char c : grid.occupied) n += c;
-  return n;
 }
 
 TEST(Assets, ClosedManifoldOutwardWithTheSolidsVolumes) {

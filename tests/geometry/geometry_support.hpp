@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/lattice.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 
 #include "support/temp_dir.hpp"
@@ -29,6 +30,13 @@ std::string input_error(F&& f) {
   }
   ADD_FAILURE() << "no InputError thrown";
   return "";
+}
+
+// The number of occupied cells of a lattice grid.
+inline int occupied(const LatticeGrid& grid) {
+  int n = 0;
+  for (char c : grid.occupied) n += c;
+  return n;
 }
 
 }  // namespace jelly::testing

@@ -16,14 +16,9 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::input_error;
+using testing::occupied;
 using testing::TempDir;
 using testing::write_text;
-
-int occupied(const LatticeGrid& grid) {
-  int n = 0;
-  for (char c : grid.occupied) n += c;
-  return n;
-}
 
 // A sphere with a part of a capsule sticking out of it: overlapping closed meshes, as the
 // gummy bear is made.

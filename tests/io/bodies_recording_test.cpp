@@ -37,12 +37,12 @@ Scene three_bodies(const std::string& integrator, Real dt) {
     "duration": 1, "output_interval": 0.02})");
 }
 
-struct Frames {
+struct CollectedFrames {
   std::vector<Real> t;
   std::vector<VecX> x, v;
 };
 
-auto collect(Frames& out) {
+auto collect(CollectedFrames& out) {
   return testing::Probe([&out](const Simulator& s) {
     out.t.push_back(s.state().t);
     out.x.push_back(s.state().x);
@@ -56,7 +56,7 @@ TEST(BodiesRecording, EachBodyItsGroupAndSurface) {
   TempDir dir;
   const std::string path = dir.file("bodies.h5");
   const Scene scene = three_bodies("rk4", 1e-3);
-  Frames frames;
+  CollectedFrames frames;
   Model model;
   {
     Simulator sim = make_simulator(scene);
@@ -144,7 +144,7 @@ INSTANTIATE_TEST_SUITE_P(Integrators, BodiesRestart,
 TEST_P(BodiesRestart, ContinuesBitForBit) {
   TempDir dir;
   const Scene scene = three_bodies(GetParam().first, GetParam().second);
-  Frames whole;
+  CollectedFrames whole;
   {
     Simulator sim = make_simulator(scene);
     auto probe = collect(whole);
@@ -163,7 +163,7 @@ TEST_P(BodiesRestart, ContinuesBitForBit) {
   }
   Simulator sim = make_simulator(scene);
   restore(sim, read_checkpoint(path));
-  Frames resumed;
+  CollectedFrames resumed;
   auto probe = collect(resumed);
   sim.add_observer(probe);
   ASSERT_TRUE(sim.run_until(1.0).ok());

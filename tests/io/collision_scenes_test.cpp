@@ -14,14 +14,13 @@
 #include <jelly/solvers/contact/broad_phase.hpp>
 #include <jelly/terrain/mesh_obstacle.hpp>
 
+#include "scene_files.hpp"
 #include "support/systems.hpp"
 
 namespace jelly {
 namespace {
 
-std::string scene_path(const std::string& name) {
-  return std::string(JELLY_SCENES_DIR) + "/" + name;
-}
+using testing::scene_path;
 
 // The pairs of particles no spring joins that are closer than `fraction` of their radii's sum.
 class CloseNonNeighbours {

@@ -27,7 +27,8 @@ using ::testing::StartsWith;
 const std::string kMinimal = R"({"integrator": {"name": "rk4"}, "duration": 1})";
 
 // The InputError message of parsing `text` with `overrides`, or "" when it parses.
-std::string error_of(const std::string& text, const std::vector<std::string>& overrides = {}) {
+std::string error_naming_file(const std::string& text,
+                              const std::vector<std::string>& overrides = {}) {
   try {
     parse_scene(text, overrides, "scene.json");
   } catch (const InputError& e) {
@@ -42,17 +43,19 @@ TEST(JsonParse, DeepNestingIsRefusedNotAStackOverflow) {
   // 100,000 levels overflowed the stack when printed or copied.
   const std::string deep =
       R"({"description": )" + nested(100000) + R"(, "integrator": {"name": "rk4"}, "duration": 1})";
-  EXPECT_THAT(error_of(deep),
+  EXPECT_THAT(error_naming_file(deep),
               StartsWith("scene.json is not valid JSON: it nests arrays and objects deeper than "
                          "64 levels at description[0][0]"));
   // The limit itself: 64 levels parse (and fail validation as a wrong type), 65 do not.
-  EXPECT_THAT(error_of(R"({"description": )" + nested(63) + "}"), StartsWith("description = [[[["));
-  EXPECT_THAT(error_of(R"({"description": )" + nested(64) + "}"), HasSubstr("deeper than 64"));
+  EXPECT_THAT(error_naming_file(R"({"description": )" + nested(63) + "}"),
+              StartsWith("description = [[[["));
+  EXPECT_THAT(error_naming_file(R"({"description": )" + nested(64) + "}"),
+              HasSubstr("deeper than 64"));
 }
 
 TEST(JsonParse, DeepSetValuesAndAppliedOverridesAreRefused) {
   // Messages quote a long assignment cut short.
-  EXPECT_EQ(error_of(kMinimal, {"description=" + nested(100000)}),
+  EXPECT_EQ(error_naming_file(kMinimal, {"description=" + nested(100000)}),
             "--set 'description=" + std::string(65, '[') +
                 "...' is not valid JSON: it nests arrays and objects deeper than 32 levels at "
                 "[0][0][0][0][0][0][0][0][0][0][0][0][0][0][0][0][0][0][0]... (a scene needs 4)");
@@ -64,48 +67,50 @@ TEST(JsonParse, DeepSetValuesAndAppliedOverridesAreRefused) {
   // A path of 60,000 keys created objects 60,000 deep (a crash when printed).
   std::string long_path;
   for (int i = 0; i < 60000; ++i) long_path += "a.";
-  EXPECT_THAT(error_of(kMinimal, {long_path + "a=1"}), HasSubstr("' has more than 32 steps"));
+  EXPECT_THAT(error_naming_file(kMinimal, {long_path + "a=1"}),
+              HasSubstr("' has more than 32 steps"));
   // Unbalanced brackets are refused as soon as they are too deep, before the end of the text.
-  EXPECT_THAT(error_of(kMinimal, {"description=" + std::string(100000, '[')}),
+  EXPECT_THAT(error_naming_file(kMinimal, {"description=" + std::string(100000, '[')}),
               HasSubstr("deeper than 32 levels"));
   // Text that is not JSON is a string value, which validation then checks.
-  EXPECT_EQ(error_of(kMinimal, {"description=[[[", "duration=[["}),
+  EXPECT_EQ(error_naming_file(kMinimal, {"description=[[[", "duration=[["}),
             "duration = \"[[\" is invalid: a number");
 }
 
 TEST(JsonParse, RepeatedKeysNameTheObject) {
-  EXPECT_EQ(error_of(R"({"integrator": {"name": "rk4"}, "duration": 1, "duration": 2})"),
+  EXPECT_EQ(error_naming_file(R"({"integrator": {"name": "rk4"}, "duration": 1, "duration": 2})"),
             "scene.json is not valid JSON: the key \"duration\" appears twice in the top-level "
             "object (only one value could count: remove the other)");
-  EXPECT_THAT(error_of(R"({"terrains": [{"kind": "plane"}, {"kind": "plane", "contact":
+  EXPECT_THAT(error_naming_file(R"({"terrains": [{"kind": "plane"}, {"kind": "plane", "contact":
                             {"friction": 1, "friction": 0}}],
                           "integrator": {"name": "rk4"}, "duration": 1})"),
               HasSubstr("the key \"friction\" appears twice in terrains[1].contact "));
   // The same key in two different objects is fine.
-  EXPECT_EQ(error_of(R"({"springs": {"shear": {"ks": 1}, "bending": {"ks": 1}},
+  EXPECT_EQ(error_naming_file(R"({"springs": {"shear": {"ks": 1}, "bending": {"ks": 1}},
                          "integrator": {"name": "rk4"}, "duration": 1})"),
             "");
-  EXPECT_THAT(error_of(kMinimal, {R"(springs={"shear": {"ks": 1, "ks": 2}})"}),
+  EXPECT_THAT(error_naming_file(kMinimal, {R"(springs={"shear": {"ks": 1, "ks": 2}})"}),
               HasSubstr("the key \"ks\" appears twice in shear"));
 }
 
 TEST(JsonParse, NumbersBeyondADoubleAreInputErrors) {
-  EXPECT_EQ(error_of(R"({"integrator": {"name": "rk4"}, "duration": 1e999})"),
+  EXPECT_EQ(error_naming_file(R"({"integrator": {"name": "rk4"}, "duration": 1e999})"),
             "scene.json is not valid JSON: number overflow parsing '1e999' at duration (numbers "
             "must be within a double's range, about +-1.8e308)");
-  EXPECT_THAT(error_of(kMinimal, {"springs.shear.ks=-1e400"}),
+  EXPECT_THAT(error_naming_file(kMinimal, {"springs.shear.ks=-1e400"}),
               StartsWith("--set 'springs.shear.ks=-1e400' is not valid JSON: number overflow"));
   // An integer too long for 64 bits is read as a double, and a tiny number underflows to 0.
-  EXPECT_THAT(error_of(kMinimal, {"cube.n=100000000000000000000000"}), StartsWith("cube.n = "));
-  EXPECT_EQ(error_of(kMinimal, {"springs.shear.kd=1e-400"}), "");
+  EXPECT_THAT(error_naming_file(kMinimal, {"cube.n=100000000000000000000000"}),
+              StartsWith("cube.n = "));
+  EXPECT_EQ(error_naming_file(kMinimal, {"springs.shear.kd=1e-400"}), "");
 }
 
 TEST(JsonParse, SetValuesThatAreNotUtf8AreRefused) {
-  EXPECT_EQ(error_of(kMinimal, {"description=\xff\xfe"}),
+  EXPECT_EQ(error_naming_file(kMinimal, {"description=\xff\xfe"}),
             "--set 'description=\xff\xfe': the value is not valid UTF-8 text");
   // A path with such bytes became an object key, and the unknown-key message dumped it: an
   // uncaught JSON exception (jelly_set_fuzzer under make test-sanitize).
-  EXPECT_EQ(error_of(kMinimal, {"cube.\xff\xff.origin=[1,2,3]"}),
+  EXPECT_EQ(error_naming_file(kMinimal, {"cube.\xff\xff.origin=[1,2,3]"}),
             "--set 'cube.\xff\xff.origin=[1,2,3]': the path is not valid UTF-8 text");
 }
 

@@ -24,7 +24,7 @@ using ::testing::HasSubstr;
 using testing::TempDir;
 
 // A short slope run recorded to `path` (27 particles, 185 springs, 26 frames).
-void record(const std::string& path) {
+void record_slope_run(const std::string& path) {
   Simulator sim = testing::slope_sim(ContactModel::kSeed);
   RecorderOptions options;
   options.write_xdmf = false;
@@ -93,7 +93,7 @@ std::string checkpoint_error(const std::string& path) {
 
 class DamagedRecording : public ::testing::Test {
  protected:
-  void SetUp() override { record(path_); }
+  void SetUp() override { record_slope_run(path_); }
   TempDir dir_;
   const std::string path_ = dir_.file("run.h5");
 };

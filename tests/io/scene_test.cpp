@@ -17,15 +17,15 @@
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
+#include "scene_files.hpp"
+
 namespace jelly {
 namespace {
 
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
-std::string scene_path(const std::string& name) {
-  return std::string(JELLY_SCENES_DIR) + "/" + name;
-}
+using testing::scene_path;
 
 // Every scene file the project ships.
 std::vector<std::string> shipped_scenes() {

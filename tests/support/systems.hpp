@@ -4,7 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <string>
 
+#include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
 #include <jelly/core/measures.hpp>
@@ -147,6 +149,44 @@ inline RestWatch run_watching_rest(Simulator& sim, const Terrain& terrain, Real 
   w.report = sim.run_until(until);
   sim.remove_observer(probe);
   return w;
+}
+
+// The time step for the small cubes of the contact tests. Explicit Euler updates positions with
+// the velocity from before the contact impulses, and at dt >= 5e-4 the bottom layer of these
+// cubes settles into a buzz of about 0.1 m/s (a known limitation, docs/contact.md); a quarter
+// step is quiet.
+inline Real contact_dt(const std::string& integrator) {
+  return integrator == "explicit_euler" ? 2.5e-4 : 1e-3;
+}
+
+// A run's total energy (kinetic + elastic + gravitational) from step to step: its largest rise
+// in one step, its scale (|E| + the kinetic energy at the start), and the deepest point below
+// a terrain (where the terrain can touch it) at any step.
+struct EnergyTrace {
+  Real worst_growth = 0, scale = 0, deepest = 0;
+};
+
+// Steps `sim` to t_end, tracing its energy (every step must succeed).
+inline EnergyTrace run_traced(Simulator& sim, Real t_end) {
+  EnergyTrace trace;
+  Real previous = total_energy(sim.model(), sim.state());
+  trace.scale = std::abs(previous) + kinetic_energy(sim.model(), sim.state());
+  while (sim.state().t < t_end - 0.5 * sim.options().dt) {
+    const StepResult r = sim.step();
+    EXPECT_TRUE(r.ok) << r.message;
+    if (!r.ok) break;
+    const Real e = total_energy(sim.model(), sim.state());
+    trace.worst_growth = std::max(trace.worst_growth, e - previous);
+    previous = e;
+    for (const auto& terrain : sim.terrains()) {
+      for (int i = 0; i < sim.model().num_particles(); ++i) {
+        const Vec3 p = particle(sim.state().x, i);
+        if (terrain->can_contact(p, sim.state().t))
+          trace.deepest = std::min(trace.deepest, terrain->signed_distance(p, sim.state().t));
+      }
+    }
+  }
+  return trace;
 }
 
 }  // namespace jelly::testing

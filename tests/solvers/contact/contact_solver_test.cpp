@@ -13,6 +13,7 @@
 namespace jelly {
 namespace {
 
+using testing::contact_dt;
 using testing::cube_on_slope;
 using testing::make_sim;
 using testing::max_speed;
@@ -24,13 +25,6 @@ using testing::single_particle;
 class ContactEveryIntegrator : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Registry, ContactEveryIntegrator, ::testing::ValuesIn(integrator_names()),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
-
-// The time step for the small cubes below. Explicit Euler updates positions with the velocity
-// from before the contact impulses, and at dt >= 5e-4 the bottom layer of these cubes settles
-// into a buzz of about 0.1 m/s (a known limitation, docs/contact.md); a quarter step is quiet.
-Real contact_dt(const std::string& integrator) {
-  return integrator == "explicit_euler" ? 2.5e-4 : 1e-3;
-}
 
 // A jelly dropped on the floor comes to rest on it: it never sinks below it, and in the end it
 // neither moves nor jitters.

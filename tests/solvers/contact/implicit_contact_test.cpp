@@ -22,6 +22,7 @@ namespace jelly {
 namespace {
 
 using testing::cube_on_slope;
+using testing::run_traced;
 
 // A 3x3x3 cube 1 mm above the floor, falling at 1 m/s, and one step of 10 ms: the bottom layer
 // must be stopped on the floor.
@@ -123,33 +124,6 @@ TEST(ImplicitContact, RestitutionIsBoundedByTheEnergyTheStepLost) {
   }
 }
 
-// Total energy (kinetic + elastic + gravitational) at every step, and the deepest point below
-// the terrain.
-struct Trace {
-  Real worst_growth = 0, scale = 0, deepest = 0;
-};
-
-Trace run_traced(Simulator& sim, Real t_end) {
-  Trace trace;
-  const Terrain& terrain = *sim.terrains()[0];
-  Real previous = total_energy(sim.model(), sim.state());
-  trace.scale = std::abs(previous) + kinetic_energy(sim.model(), sim.state());
-  while (sim.state().t < t_end - 0.5 * sim.options().dt) {
-    const StepResult r = sim.step();
-    EXPECT_TRUE(r.ok) << r.message;
-    if (!r.ok) break;
-    const Real e = total_energy(sim.model(), sim.state());
-    trace.worst_growth = std::max(trace.worst_growth, e - previous);
-    previous = e;
-    for (int i = 0; i < sim.model().num_particles(); ++i) {
-      const Vec3 p = particle(sim.state().x, i);
-      if (terrain.can_contact(p, sim.state().t))
-        trace.deepest = std::min(trace.deepest, terrain.signed_distance(p, sim.state().t));
-    }
-  }
-  return trace;
-}
-
 class LargeSteps : public ::testing::TestWithParam<Real> {};
 INSTANTIATE_TEST_SUITE_P(ImplicitContact, LargeSteps, ::testing::Values(1.0 / 60, 1.0 / 30),
                          [](const ::testing::TestParamInfo<Real>& p) {
@@ -186,11 +160,11 @@ TEST_P(LargeSteps, DroppedJellyRestsOnTheFloor) {
   const Model m = build_cube(testing::small_cube(4, 1.0, Vec3(0, 0.5, 0)));
   Simulator sim = testing::make_sim(m, rest_state(m), "implicit_euler", GetParam());
   sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitY()));
-  const Trace trace = run_traced(sim, 4.0);
+  const testing::EnergyTrace trace = run_traced(sim, 4.0);
   EXPECT_GE(trace.deepest, -1e-9);
   EXPECT_LE(trace.worst_growth, 1e-9 * trace.scale);
   const Vec3 com = center_of_mass(m, sim.state());
-  const Trace rest = run_traced(sim, 5.0);
+  const testing::EnergyTrace rest = run_traced(sim, 5.0);
   EXPECT_LT((center_of_mass(m, sim.state()) - com).norm(), 1e-3);
   EXPECT_LE(rest.worst_growth, 1e-9 * trace.scale);
   EXPECT_NEAR(com.y(), 0.5, 0.05);
@@ -211,9 +185,9 @@ Simulator on_slope_with_friction(Real mu, Real dt) {
 TEST_P(LargeSteps, SticksOnSlopeWhenFrictionHolds) {
   Simulator sim = on_slope_with_friction(0.6, GetParam());
   const Model& m = sim.model();
-  const Trace settle = run_traced(sim, 0.5);
+  const testing::EnergyTrace settle = run_traced(sim, 0.5);
   const Vec3 settled = center_of_mass(m, sim.state());
-  const Trace rest = run_traced(sim, 2.0);
+  const testing::EnergyTrace rest = run_traced(sim, 2.0);
   EXPECT_LT((center_of_mass(m, sim.state()) - settled).norm(), 1e-3);
   EXPECT_GE(std::min(settle.deepest, rest.deepest), -1e-9);
   EXPECT_LE(std::max(settle.worst_growth, rest.worst_growth), 1e-9 * settle.scale);
@@ -230,7 +204,7 @@ TEST_P(LargeSteps, SlidesOnSlopeWithCoulombAcceleration) {
   };
   run_traced(sim, 0.5);
   const Real v1 = speed_along();
-  const Trace trace = run_traced(sim, 1.5);
+  const testing::EnergyTrace trace = run_traced(sim, 1.5);
   const Real expected = 9.8 * (std::sin(a) - 0.15 * std::cos(a));
   EXPECT_NEAR(speed_along() - v1, expected, 0.03 * expected);
   EXPECT_GE(trace.deepest, -1e-9);
@@ -243,7 +217,7 @@ TEST_P(LargeSteps, RidesTheElevator) {
   Simulator sim = testing::make_sim(m, rest_state(m), "implicit_euler", GetParam());
   sim.add_terrain(std::make_unique<Elevator>());
   const auto& elevator = static_cast<const Elevator&>(*sim.terrains()[0]);
-  const Trace trace = run_traced(sim, 1.9);
+  const testing::EnergyTrace trace = run_traced(sim, 1.9);
   EXPECT_GE(trace.deepest, -1e-9);
   const Real platform_v = elevator.surface_velocity(Vec3::Zero(), sim.state().t).y();
   EXPECT_NEAR(linear_momentum(m, sim.state()).y() / m.mass.sum(), platform_v, 0.1);
@@ -262,7 +236,7 @@ TEST(ImplicitContact, NewtonConvergesInContact) {
   Simulator sim(m, cube_on_slope(m, 20), make_integrator("implicit_euler", o),
                 SimulatorOptions{1.0 / 60, 0, {}});
   sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), c)));
-  const Trace trace = run_traced(sim, 1.0);
+  const testing::EnergyTrace trace = run_traced(sim, 1.0);
   const Statistics st = sim.integrator().statistics();
   EXPECT_EQ(st.at("newton_not_converged"), 0);
   EXPECT_GE(trace.deepest, -1e-9);

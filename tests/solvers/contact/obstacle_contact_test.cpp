@@ -15,19 +15,16 @@
 namespace jelly {
 namespace {
 
+using testing::contact_dt;
 using testing::make_sim;
 using testing::max_speed;
 using testing::min_distance;
+using testing::run_traced;
 using testing::single_particle;
 
 class ObstacleEveryIntegrator : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Registry, ObstacleEveryIntegrator, ::testing::ValuesIn(integrator_names()),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
-
-// As in contact_solver_test.cpp: explicit Euler needs a quarter of the step to rest quietly.
-Real contact_dt(const std::string& integrator) {
-  return integrator == "explicit_euler" ? 2.5e-4 : 1e-3;
-}
 
 std::unique_ptr<Obstacle> sphere(Real radius, const Vec3& center, const ContactParams& c) {
   ObstacleSpec s;
@@ -169,38 +166,17 @@ INSTANTIATE_TEST_SUITE_P(ImplicitEuler, ObstacleLargeSteps, ::testing::Values(1.
                                   std::to_string(static_cast<int>(std::round(1 / p.param)));
                          });
 
-struct Trace {
-  Real worst_growth = 0, scale = 0, deepest = 0;
-};
-
-Trace run_traced(Simulator& sim, Real t_end) {
-  Trace trace;
-  Real previous = total_energy(sim.model(), sim.state());
-  trace.scale = std::abs(previous) + kinetic_energy(sim.model(), sim.state());
-  while (sim.state().t < t_end - 0.5 * sim.options().dt) {
-    const StepResult r = sim.step();
-    EXPECT_TRUE(r.ok) << r.message;
-    if (!r.ok) break;
-    const Real e = total_energy(sim.model(), sim.state());
-    trace.worst_growth = std::max(trace.worst_growth, e - previous);
-    previous = e;
-    for (const auto& t : sim.terrains())
-      trace.deepest = std::min(trace.deepest, min_distance(sim, *t));
-  }
-  return trace;
-}
-
 TEST_P(ObstacleLargeSteps, JellyDroppedOnASphereComesToRestOnIt) {
   const Model m = build_cube(testing::small_cube(4, 1.0, Vec3(-0.5, 2.2, -0.5)));
   Simulator sim = make_sim(m, rest_state(m), "implicit_euler", GetParam());
   ContactParams c;
   c.friction = c.static_friction = 0.8;
   sim.add_terrain(sphere(2.0, Vec3::Zero(), c));
-  const Trace trace = run_traced(sim, 3.0);
+  const testing::EnergyTrace trace = run_traced(sim, 3.0);
   EXPECT_GE(trace.deepest, -1e-3);
   EXPECT_LE(trace.worst_growth, 1e-9 * trace.scale);
   const Vec3 com = center_of_mass(m, sim.state());
-  const Trace rest = run_traced(sim, 4.0);
+  const testing::EnergyTrace rest = run_traced(sim, 4.0);
   EXPECT_GE(rest.deepest, -1e-3);
   EXPECT_LT((center_of_mass(m, sim.state()) - com).norm(), 1e-3);
   EXPECT_GT(com.y(), 2.2);  // on top of the sphere
@@ -220,7 +196,7 @@ TEST_P(ObstacleLargeSteps, SlidesDownATiltedBoxWithCoulombAcceleration) {
   };
   run_traced(sim, 0.5);
   const Real v1 = speed_along();
-  const Trace trace = run_traced(sim, 1.5);
+  const testing::EnergyTrace trace = run_traced(sim, 1.5);
   const Real expected = 9.8 * (std::sin(a) - 0.15 * std::cos(a));
   EXPECT_NEAR(speed_along() - v1, expected, 0.03 * expected);
   EXPECT_GE(trace.deepest, -1e-9);

@@ -1,0 +1,18 @@
+#pragma once
+// What the readers of mesh files share (triangle meshes, tet meshes, mesh obstacles): the checks
+// before a file is read and the pieces of their messages.
+#include <string>
+
+namespace jelly::detail {
+
+// s in double quotes, as messages show a file name.
+std::string quoted(const std::string& s);
+
+// The extension of path in lower case, with its dot (".obj"), or "" when it has none.
+std::string lower_extension(const std::string& path);
+
+// Throws InputError(field, value, ...) unless path is an existing, readable, regular file of at
+// most 1 GiB (a larger one is most likely a mistaken path).
+void require_mesh_file(const std::string& path, const std::string& field, const std::string& value);
+
+}  // namespace jelly::detail
