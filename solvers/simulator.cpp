@@ -191,7 +191,8 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
   require(std::isfinite(s.t), "snapshot.state.t", s.t, "a finite time");
   require(std::isfinite(snapshot.next_output), "snapshot.next_output", snapshot.next_output,
           "a finite time");
-  require(snapshot.total_steps >= 0, "snapshot.total_steps", snapshot.total_steps, ">= 0");
+  require(snapshot.total_steps >= 0 && snapshot.total_steps <= SimulatorSnapshot::kMaxTotalSteps,
+          "snapshot.total_steps", snapshot.total_steps, "an integer in [0, 2^53]");
   for (const ContactSolver::SeedContact& c : snapshot.seed_contacts) {
     require(c.particle >= 0 && c.particle < model_.num_particles(),
             "snapshot.seed_contacts.particle", c.particle, "a particle index of the model");

@@ -104,10 +104,13 @@ struct SimulatorOptions {
 // simulator restored from it continues bit for bit (for integrators that keep no state between
 // steps, which all explicit ones do).
 struct SimulatorSnapshot {
+  // The largest step count a snapshot may carry: 2^53 (exact as a double; no run takes that many
+  // steps, and counting on from it cannot overflow).
+  static constexpr long kMaxTotalSteps = 1L << 53;
   State state;
   std::vector<ContactSolver::SeedContact> seed_contacts;  // active during the next step
   int contact_count = 0;
-  long total_steps = 0;
+  long total_steps = 0;  // at most kMaxTotalSteps (the count goes on from there)
   // Time of the next observer frame (taken inside on_frame: that frame's own time, which the
   // frame restore() emits first moves on as the original run did).
   Real next_output = 0;

@@ -1,5 +1,7 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -127,6 +129,29 @@ TEST(Simulator, StateBuffersKeepTheirAddressAndInPlaceChangesAreSeen) {
   ASSERT_TRUE(drift.step().ok);
   EXPECT_EQ(drift.total_steps(), steps + 1);
   EXPECT_NEAR(drift.state().x[0] - rest_state(free).x[0], 0.001, 1e-12);
+}
+
+// A snapshot's step count must leave room to count on (the checkpoint fuzzer's find: a count of
+// 2^63 - 1 overflowed at the next step).
+TEST(Simulator, RestoreRefusesAStepCountOutOfRange) {
+  const Model m = build_cube(testing::small_cube(3));
+  Simulator sim = testing::make_sim(m, rest_state(m), "rk4", 0.001);
+  SimulatorSnapshot snap = sim.snapshot();
+  for (long steps :
+       {-1L, SimulatorSnapshot::kMaxTotalSteps + 1, std::numeric_limits<long>::max()}) {
+    snap.total_steps = steps;
+    try {
+      sim.restore(snap);
+      ADD_FAILURE() << "restored a snapshot of " << steps << " steps";
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), ::testing::HasSubstr("snapshot.total_steps"));
+      EXPECT_THAT(e.what(), ::testing::HasSubstr("[0, 2^53]"));
+    }
+  }
+  snap.total_steps = SimulatorSnapshot::kMaxTotalSteps;
+  sim.restore(snap);
+  ASSERT_TRUE(sim.step().ok);
+  EXPECT_EQ(sim.total_steps(), SimulatorSnapshot::kMaxTotalSteps + 1);
 }
 
 // Explicit Euler far past its stability limit: the guard stops the run and says why.
