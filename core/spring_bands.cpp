@@ -125,10 +125,25 @@ void add_difference(int n, const Real* __restrict ux, const Real* __restrict uy,
   }
 }
 
-void add_ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx, const Real* ty,
-              const Real* tz, Real* ax, Real* ay, Real* az) {
-  // Particles in both ranges: one pass, t_first - t_second. Elsewhere +t or -t alone, which
-  // are the same bits as the difference with a zero term (x - 0 = x, acc + -x = acc - x).
+JELLY_VECTOR_CLONES
+void add_then_subtract(int n, const Real* __restrict ux, const Real* __restrict uy,
+                       const Real* __restrict uz, const Real* __restrict wx,
+                       const Real* __restrict wy, const Real* __restrict wz, Real* __restrict ax,
+                       Real* __restrict ay, Real* __restrict az) {
+  for (int j = 0; j < n; ++j) {
+    ax[j] = (ax[j] + ux[j]) - wx[j];
+    ay[j] = (ay[j] + uy[j]) - wy[j];
+    az[j] = (az[j] + uz[j]) - wz[j];
+  }
+}
+
+namespace {
+
+// The ranges of add_ends and add_then_subtract_ends: `both` for the particles in both ranges,
+// add or subtract alone elsewhere.
+template <class Both>
+void ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx, const Real* ty,
+          const Real* tz, Real* ax, Real* ay, Real* az, Both both) {
   const int o0 = std::max(a0, b0), o1 = std::min(a1, b1);
   const auto first_ends = [&](int i0, int i1) {
     if (i0 < i1)
@@ -143,12 +158,26 @@ void add_ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx, cons
     second_ends(b0, b1);
     return;
   }
-  add_difference(o1 - o0, tx + (o0 - a), ty + (o0 - a), tz + (o0 - a), tx + (o0 - b), ty + (o0 - b),
-                 tz + (o0 - b), ax + o0, ay + o0, az + o0);
+  both(o1 - o0, tx + (o0 - a), ty + (o0 - a), tz + (o0 - a), tx + (o0 - b), ty + (o0 - b),
+       tz + (o0 - b), ax + o0, ay + o0, az + o0);
   first_ends(a0, o0);
   first_ends(o1, a1);
   second_ends(b0, o0);
   second_ends(o1, b1);
+}
+
+}  // namespace
+
+void add_ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx, const Real* ty,
+              const Real* tz, Real* ax, Real* ay, Real* az) {
+  // Elsewhere than in both ranges +t or -t alone, which are the same bits as the difference
+  // with a zero term (x - 0 = x, acc + -x = acc - x).
+  ends(a, b, a0, a1, b0, b1, tx, ty, tz, ax, ay, az, add_difference);
+}
+
+void add_then_subtract_ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx,
+                            const Real* ty, const Real* tz, Real* ax, Real* ay, Real* az) {
+  ends(a, b, a0, a1, b0, b1, tx, ty, tz, ax, ay, az, add_then_subtract);
 }
 
 }  // namespace band_kernels
@@ -229,19 +258,24 @@ void SpringBands::copy_coefficients(const Model& model) {
 
 void SpringBands::compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f,
                                  int threads) const {
-  evaluate(model, x, v, f, threads, false);
+  evaluate(model, x, v, f, threads, false, nullptr);
 }
 
 void SpringBands::compute_accelerations(const Model& model, const VecX& x, const VecX& v, VecX& a,
-                                        int threads) const {
-  evaluate(model, x, v, a, threads, true);
+                                        int threads, const RangeTerms* terms) const {
+  evaluate(model, x, v, a, threads, true, terms);
 }
 
 void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, VecX& f, int threads,
-                           bool accelerations) const {
-  if (!dense_ || !fits(model)) {
+                           bool accelerations, const RangeTerms* terms) const {
+  // Without the bands, or after a collapsed spring: the serial loop, the terms, the division.
+  const auto serial = [&] {
     ::jelly::compute_forces(model, x, v, f);
+    if (terms != nullptr) terms->add(0, model.num_particles(), f);
     if (accelerations) divide_by_masses(model, f, threads);
+  };
+  if (!dense_ || !fits(model)) {
+    serial();
     return;
   }
   const int n = particles_;
@@ -309,22 +343,29 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
           band.rest.data() + r.lo, band.uniform ? nullptr : band.ks.data() + r.lo,
           band.uniform ? nullptr : band.kd.data() + r.lo, band.uniform_ks, band.uniform_kd};
       collapsed += band_forces(r.hi - r.lo, ends, coefficients, fx, fy, fz);
-      // As the serial loop: + on particle a of every slot, then - on particle b.
-      if (r.a0 < r.a1) {
-        const int k = r.a0 - (band.first + r.lo);
-        band_kernels::add(r.a1 - r.a0, fx + k, fy + k, fz + k, ax + (r.a0 - p0), ay + (r.a0 - p0),
-                          az + (r.a0 - p0));
-      }
-      if (r.b0 < r.b1) {
-        const int k = r.b0 - (band.first + r.lo + band.offset);
-        band_kernels::subtract(r.b1 - r.b0, fx + k, fy + k, fz + k, ax + (r.b0 - p0),
-                               ay + (r.b0 - p0), az + (r.b0 - p0));
-      }
+      // As the serial loop: + on particle a of every slot, then - on particle b (one pass).
+      // Indices relative to p0: slot lo's first end is band.first + lo.
+      const int a_rel = band.first + r.lo - p0;
+      band_kernels::add_then_subtract_ends(a_rel, a_rel + band.offset, r.a0 - p0, r.a1 - p0,
+                                           r.b0 - p0, r.b1 - p0, fx, fy, fz, ax, ay, az);
     }
     w.collapsed = collapsed;
     // Written even when a spring collapsed somewhere: the fallback below then overwrites f.
     Real* pf = f.data();
-    if (accelerations) {  // as divide_by_masses, on the sums still in this thread's cache
+    if (accelerations && terms != nullptr) {  // the sums, the terms, then the division
+      for (int i = p0; i < p1; ++i) {
+        pf[3 * i] = ax[i - p0];
+        pf[3 * i + 1] = ay[i - p0];
+        pf[3 * i + 2] = az[i - p0];
+      }
+      terms->add(p0, p1, f);
+      for (int i = p0; i < p1; ++i) {
+        const Real inv = 1.0 / m[i];
+        pf[3 * i] *= inv;
+        pf[3 * i + 1] *= inv;
+        pf[3 * i + 2] *= inv;
+      }
+    } else if (accelerations) {  // as divide_by_masses, on the sums still in this thread's cache
       for (int i = p0; i < p1; ++i) {
         const Real inv = 1.0 / m[i];
         pf[3 * i] = ax[i - p0] * inv;
@@ -344,8 +385,7 @@ void SpringBands::evaluate(const Model& model, const VecX& x, const VecX& v, Vec
   split_.update(parts_used);
   for (int part = 0; part < parts_used; ++part) {
     if (workspaces_[part].collapsed > 0) {
-      ::jelly::compute_forces(model, x, v, f);  // a collapsed spring: its rest direction
-      if (accelerations) divide_by_masses(model, f, threads);
+      serial();  // a collapsed spring: compute_forces gives it its rest direction
       return;
     }
   }

@@ -27,16 +27,31 @@ void finish_acceleration(const Model& model, int threads, Real t, VecX& a) {
 }
 }  // namespace
 
-bool Dynamics::springs_only() const {
-  return bands_ != nullptr && anchors_ == nullptr && model_->external_forces.empty() &&
-         contacts_->seed_contacts().empty();
+bool Dynamics::springs_and_seed_contacts_only() const {
+  return bands_ != nullptr && anchors_ == nullptr && model_->external_forces.empty();
 }
 
+namespace {
+// The seed contact forces, added by each thread of the force loop to its own particles.
+class SeedContactTerms final : public SpringBands::RangeTerms {
+ public:
+  SeedContactTerms(const ContactSolver& contacts, const VecX& v) : contacts_(contacts), v_(v) {}
+  void add(int begin, int end, VecX& f) const override { contacts_.add_forces(v_, f, begin, end); }
+
+ private:
+  const ContactSolver& contacts_;
+  const VecX& v_;
+};
+}  // namespace
+
 void Dynamics::acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const {
-  if (springs_only()) {
-    // Gravity and springs only: the force loop divides by the masses as it writes (same bits).
+  if (springs_and_seed_contacts_only()) {
+    // Gravity, springs and seed contact forces: the force loop's threads add the contact terms
+    // and divide by the masses as they write (the same bits as forces() and the division).
     ++evaluations_;
-    bands_->compute_accelerations(*model_, x, v, a, threads_);
+    const SeedContactTerms terms(*contacts_, v);
+    bands_->compute_accelerations(*model_, x, v, a, threads_,
+                                  contacts_->seed_contacts().empty() ? nullptr : &terms);
     if (!model_->pins.empty()) model_->pins.apply_acceleration(t, a);
     return;
   }

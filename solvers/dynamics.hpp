@@ -66,9 +66,9 @@ class Dynamics {
   int threads() const { return threads_; }
 
  private:
-  // True when the forces are the bands' alone (gravity, springs, dampers): no anchors, external
-  // forces or seed contact terms.
-  bool springs_only() const;
+  // True when the forces are the bands' (gravity, springs, dampers) and the seed contact terms:
+  // no anchors or external forces.
+  bool springs_and_seed_contacts_only() const;
 
   const Model* model_;
   const ContactSolver* contacts_;

@@ -25,5 +25,9 @@ void subtract(int n, const Real* tx, const Real* ty, const Real* tz, Real* ax, R
 // where a particle is both (one pass; the same bits for any split of the particles).
 void add_ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx, const Real* ty,
               const Real* tz, Real* ax, Real* ay, Real* az);
+// As add_ends, but a[i] = (a[i] + t_first) - t_second where a particle is both: the same bits
+// as adding at every first end and then subtracting at every second end (two passes).
+void add_then_subtract_ends(int a, int b, int a0, int a1, int b0, int b1, const Real* tx,
+                            const Real* ty, const Real* tz, Real* ax, Real* ay, Real* az);
 
 }  // namespace jelly::band_kernels

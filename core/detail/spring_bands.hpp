@@ -60,15 +60,27 @@ class SpringBands {
   // this thread count. Not for concurrent calls on one object (it keeps its scratch arrays).
   void compute_forces(const Model& model, const VecX& x, const VecX& v, VecX& f,
                       int threads = 1) const;
-  // a = M^-1 f with f as compute_forces (each thread divides the sums it made: one pass less);
-  // the same bits as compute_forces followed by a *= 1 / m.
+  // Terms a caller adds to the forces of a range of particles, each particle's on its own
+  // (the seed contact forces): called by each thread of the force loop for its own particles.
+  class RangeTerms {
+   public:
+    // Adds the terms of the particles [begin, end) to f (size 3N, the springs' sums there).
+    virtual void add(int begin, int end, VecX& f) const = 0;
+
+   protected:
+    ~RangeTerms() = default;
+  };
+
+  // a = M^-1 (f + terms) with f as compute_forces and `terms` (may be null) added to f, each
+  // thread adding and dividing the sums it made (no pass or thread team of their own); the same
+  // bits as compute_forces, then terms->add(0, N, f), then a = f * (1 / m).
   void compute_accelerations(const Model& model, const VecX& x, const VecX& v, VecX& a,
-                             int threads = 1) const;
+                             int threads = 1, const RangeTerms* terms = nullptr) const;
 
  private:
-  // compute_forces, or compute_accelerations when `accelerations`.
+  // compute_forces, or compute_accelerations (with `terms`) when `accelerations`.
   void evaluate(const Model& model, const VecX& x, const VecX& v, VecX& f, int threads,
-                bool accelerations) const;
+                bool accelerations, const RangeTerms* terms) const;
   // Copies rest lengths, ks and kd from the model into the bands.
   void copy_coefficients(const Model& model);
 

@@ -127,7 +127,12 @@ void ContactSolver::resolve(const Model& model, const Terrains& terrains, const 
 }
 
 void ContactSolver::add_forces(const VecX& v, VecX& f) const {
+  add_forces(v, f, 0, std::numeric_limits<int>::max());
+}
+
+void ContactSolver::add_forces(const VecX& v, VecX& f, int begin, int end) const {
   for (const SeedContact& c : seed_contacts_) {
+    if (c.particle < begin || c.particle >= end) continue;
     auto fi = particle(f, c.particle);
     const Real fn = fi.dot(c.normal);
     if (fn >= 0) continue;

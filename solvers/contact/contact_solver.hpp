@@ -44,6 +44,8 @@ class ContactSolver {
   // Seed model: for each particle that collided at the last resolve() and whose force f pushes
   // into the surface, cancels the inward normal force N and adds the friction -mu N v_t.
   void add_forces(const VecX& v, VecX& f) const;
+  // add_forces for the particles in [begin, end) alone (each particle's terms in the same order).
+  void add_forces(const VecX& v, VecX& f, int begin, int end) const;
 
   // seed_framework, the course framework's collision handler inside a force evaluation at time t
   // on that evaluation's own state (x, v) with its forces f (gravity, springs, dampers): for each

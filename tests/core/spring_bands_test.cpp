@@ -1,7 +1,9 @@
 // The vectorised force loop over spring bands computes the same forces as compute_forces.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
@@ -94,6 +96,64 @@ TEST(SpringBands, ThreadsAndAccelerationsGiveTheSameBits) {
     bands.compute_accelerations(m, s.x, s.v, a, threads);
     EXPECT_TRUE(f == f1) << threads << " threads";
     EXPECT_TRUE(a == a1) << threads << " threads";
+  }
+}
+
+// Terms added inside the force loop (the seed contact forces use this): each particle's terms
+// are added once, by the thread that owns it, to its finished sum and before the division by the
+// mass: the same bits as adding them to compute_forces' result and dividing, for any split.
+class EverySeventhParticle final : public SpringBands::RangeTerms {
+ public:
+  explicit EverySeventhParticle(int particles) : calls_(particles, 0) {}
+  void add(int begin, int end, VecX& f) const override {
+    for (int i = begin; i < end; ++i) {
+      ++calls_[i];
+      if (i % 7 != 0) continue;
+      // Depends on the sum it is added to, as the contact force does.
+      for (int d = 0; d < 3; ++d) f[3 * i + d] += -0.5 * f[3 * i + d] + 1e-3 * (i + d);
+    }
+  }
+  std::vector<int>& calls() const { return calls_; }
+
+ private:
+  mutable std::vector<int> calls_;
+};
+
+TEST(SpringBands, TermsAddedByEachThreadGiveTheSameBits) {
+  const Model m = build_cube(testing::small_cube(14));
+  const SpringBands bands(m);
+  ASSERT_TRUE(bands.dense());
+  const State s = moving(m, 5, 0.05);
+  const EverySeventhParticle terms(m.num_particles());
+  VecX expected(m.num_dofs());
+  bands.compute_forces(m, s.x, s.v, expected, 1);
+  terms.add(0, m.num_particles(), expected);
+  for (int i = 0; i < m.num_particles(); ++i) {
+    const Real inv = 1.0 / m.mass[i];
+    for (int d = 0; d < 3; ++d) expected[3 * i + d] *= inv;
+  }
+  for (int threads : {1, 2, 3, 4}) {
+    std::fill(terms.calls().begin(), terms.calls().end(), 0);
+    VecX a(m.num_dofs());
+    bands.compute_accelerations(m, s.x, s.v, a, threads, &terms);
+    EXPECT_TRUE(a == expected) << threads << " threads";
+    EXPECT_EQ(std::count(terms.calls().begin(), terms.calls().end(), 1), m.num_particles())
+        << threads << " threads: every particle's terms added once";
+  }
+  // A collapsed spring: the serial loop's forces, then the terms, then the division.
+  State collapsed = s;
+  const int last = m.num_particles() - 1;
+  particle(collapsed.x, last) = particle(collapsed.x, last - 1);
+  compute_forces(m, collapsed.x, collapsed.v, expected);
+  terms.add(0, m.num_particles(), expected);
+  for (int i = 0; i < m.num_particles(); ++i) {
+    const Real inv = 1.0 / m.mass[i];
+    for (int d = 0; d < 3; ++d) expected[3 * i + d] *= inv;
+  }
+  for (int threads : {1, 3}) {
+    VecX a(m.num_dofs());
+    bands.compute_accelerations(m, collapsed.x, collapsed.v, a, threads, &terms);
+    EXPECT_TRUE(a == expected) << threads << " threads, collapsed";
   }
 }
 

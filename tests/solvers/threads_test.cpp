@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
@@ -71,7 +72,8 @@ Model two_bodies() {
   return model;
 }
 
-Outcome run(const Model& model, const std::string& integrator, int threads) {
+Outcome run(const Model& model, const std::string& integrator, int threads,
+            ContactModel contact = ContactModel::kCoulomb) {
   const Body& jelly = model.bodies.at(0);
   State s = rest_state(model);
   {
@@ -102,9 +104,9 @@ Outcome run(const Model& model, const std::string& integrator, int threads) {
   o.dt = adaptive ? 1e-3 : implicit ? 1.0 / 100 : 5e-4;
   o.threads = threads;
   Simulator sim(model, s, make_integrator(integrator), o);
-  ContactParams coulomb;
-  coulomb.model = ContactModel::kCoulomb;
-  sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), coulomb)));
+  ContactParams params;
+  params.model = contact;
+  sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), params)));
   const RunReport report = sim.run_until(adaptive ? 2e-3 : implicit ? 0.05 : 0.02);
   EXPECT_TRUE(report.ok()) << integrator << " on " << threads << " threads: " << report.reason;
   return {sim.state(), report.statistics, sim.contacts().contact_count()};
@@ -158,6 +160,21 @@ TEST(Threads, SpringsOnlyJellySameTrajectoryOnOneTwoAndThreeThreads) {
   }
 }
 
+// The same on the seed contact model: the force loop's threads add the seed contact forces to
+// their own particles before dividing by the masses.
+TEST(Threads, SeedContactJellySameTrajectoryOnOneTwoAndThreeThreads) {
+  const Model model = lone_jelly();
+  for (const char* integrator : {"explicit_euler", "rk4"}) {
+    const Outcome one = run(model, integrator, 1, ContactModel::kSeed);
+    EXPECT_GT(one.contacts, 0) << integrator;
+    for (int threads : {2, 3}) {
+      const Outcome other = run(model, integrator, threads, ContactModel::kSeed);
+      EXPECT_TRUE(other.state.x == one.state.x) << integrator << ", " << threads << " threads";
+      EXPECT_TRUE(other.state.v == one.state.v) << integrator << ", " << threads << " threads";
+    }
+  }
+}
+
 // Dynamics' springs-only evaluation (accelerations from the force loop, then the pins' paths)
 // gives the bits of forces() divided by the masses, with pinned particles on their paths.
 TEST(Threads, SpringsOnlyAccelerationsAreTheForcesOverTheMasses) {
@@ -184,6 +201,37 @@ TEST(Threads, SpringsOnlyAccelerationsAreTheForcesOverTheMasses) {
     EXPECT_TRUE(a == f) << threads << " threads";
     EXPECT_EQ(Vec3(particle(a, 5)), Vec3::Zero());
     EXPECT_EQ(dynamics.force_evaluations(), 2);
+  }
+}
+
+// With seed contacts (particles in every thread's range, some pushed into the surface by their
+// forces, some not), the force loop's evaluation gives the bits of forces() over the masses.
+TEST(Threads, SeedContactAccelerationsAreTheForcesOverTheMasses) {
+  const Model model = lone_jelly();
+  const SpringBands bands(model);
+  State s = rest_state(model);
+  for (int i = 0; i < s.x.size(); ++i) {
+    s.x[i] += 1e-3 * std::sin(0.37 * i);
+    s.v[i] = 0.1 * std::cos(0.11 * i);
+  }
+  std::vector<ContactSolver::SeedContact> seed;
+  for (int i = 0; i < model.num_particles(); i += 97)
+    seed.push_back({i, Vec3(std::sin(0.1 * i), 1, 0.2).normalized(), 0.5});
+  ContactSolver contacts;
+  contacts.restore(seed, static_cast<int>(seed.size()));
+  ASSERT_GT(seed.size(), 20u);
+  for (int threads : {1, 2, 3}) {
+    const Dynamics dynamics(model, contacts, nullptr, &bands, nullptr, threads);
+    VecX a(model.num_dofs()), f(model.num_dofs()), springs(model.num_dofs());
+    dynamics.acceleration(0.1, s.x, s.v, a);
+    dynamics.forces(0.1, s.x, s.v, f);
+    bands.compute_forces(model, s.x, s.v, springs, threads);
+    EXPECT_FALSE(f == springs) << "the contact forces should change some forces";
+    for (int i = 0; i < model.num_particles(); ++i) {
+      const Real inv = 1.0 / model.mass[i];
+      for (int d = 0; d < 3; ++d) f[3 * i + d] *= inv;
+    }
+    EXPECT_TRUE(a == f) << threads << " threads";
   }
 }
 
