@@ -128,10 +128,7 @@ TEST(SpringBands, TermsAddedByEachThreadGiveTheSameBits) {
   VecX expected(m.num_dofs());
   bands.compute_forces(m, s.x, s.v, expected, 1);
   terms.add(0, m.num_particles(), expected);
-  for (int i = 0; i < m.num_particles(); ++i) {
-    const Real inv = 1.0 / m.mass[i];
-    for (int d = 0; d < 3; ++d) expected[3 * i + d] *= inv;
-  }
+  divide_by_masses(m, expected);
   for (int threads : {1, 2, 3, 4}) {
     std::fill(terms.calls().begin(), terms.calls().end(), 0);
     VecX a(m.num_dofs());
@@ -146,10 +143,7 @@ TEST(SpringBands, TermsAddedByEachThreadGiveTheSameBits) {
   particle(collapsed.x, last) = particle(collapsed.x, last - 1);
   compute_forces(m, collapsed.x, collapsed.v, expected);
   terms.add(0, m.num_particles(), expected);
-  for (int i = 0; i < m.num_particles(); ++i) {
-    const Real inv = 1.0 / m.mass[i];
-    for (int d = 0; d < 3; ++d) expected[3 * i + d] *= inv;
-  }
+  divide_by_masses(m, expected);
   for (int threads : {1, 3}) {
     VecX a(m.num_dofs());
     bands.compute_accelerations(m, collapsed.x, collapsed.v, a, threads, &terms);

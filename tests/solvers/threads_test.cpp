@@ -7,6 +7,7 @@
 
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/core/forces.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
@@ -227,10 +228,7 @@ TEST(Threads, SeedContactAccelerationsAreTheForcesOverTheMasses) {
     dynamics.forces(0.1, s.x, s.v, f);
     bands.compute_forces(model, s.x, s.v, springs, threads);
     EXPECT_FALSE(f == springs) << "the contact forces should change some forces";
-    for (int i = 0; i < model.num_particles(); ++i) {
-      const Real inv = 1.0 / model.mass[i];
-      for (int d = 0; d < 3; ++d) f[3 * i + d] *= inv;
-    }
+    divide_by_masses(model, f);
     EXPECT_TRUE(a == f) << threads << " threads";
   }
 }
