@@ -9,6 +9,7 @@
 // two coefficients per spring became floats at the default cg_tolerance (likewise).
 #include <cstdint>
 #include <cstring>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,13 @@ struct Reference {
   std::uint64_t hash;
   Vec3 first_particle;  // printed to 8 digits, for a readable failure
 };
+
+// The test's name in ctest: the scene and its overrides (gtest would print the bytes of the
+// struct, a pointer among them, and the name would change from build to build).
+void PrintTo(const Reference& r, std::ostream* out) {
+  *out << r.scene;
+  for (const std::string& o : r.overrides) *out << ' ' << o;
+}
 
 class SeedReference : public ::testing::TestWithParam<Reference> {};
 
