@@ -40,7 +40,7 @@ void check_new_file(const std::string& flag, const std::string& path, bool overw
                      "it, or choose another name");
 }
 
-bool is_recording(const std::string& path) {
+[[maybe_unused]] bool is_recording(const std::string& path) {
   const auto dot = path.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
   return ext == ".h5" || ext == ".hdf5";

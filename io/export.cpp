@@ -79,7 +79,7 @@ std::vector<ObjObject> read_obj(const std::string& path) {
 }
 
 Pc2Writer::Pc2Writer(const std::string& path, int num_points, float start_frame, float sample_rate)
-    : path_(path), num_points_(num_points), buffer_(static_cast<size_t>(3 * num_points)) {
+    : path_(path), buffer_(static_cast<size_t>(3 * num_points)) {
   require(num_points >= 0, "num_points", num_points, ">= 0");
   file_ = std::fopen(path.c_str(), "wb");
   if (file_ == nullptr)

@@ -50,7 +50,6 @@ class Pc2Writer {
  private:
   std::string path_;
   std::FILE* file_ = nullptr;
-  int num_points_;
   int samples_ = 0;
   std::vector<float> buffer_;
   bool failed_ = false;
