@@ -2,7 +2,11 @@
 // integrator on the seed slope (contact included).
 #include <benchmark/benchmark.h>
 
+#include <cmath>
+#include <vector>
+
 #include <jelly/core/detail/band_system.hpp>
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/jelly.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
@@ -50,6 +54,64 @@ void BM_ComputeForcesBanded(benchmark::State& bench) {
 BENCHMARK(BM_ComputeForcesBanded)
     ->ArgsProduct({{10, 20, 40}, {1, 2}})
     ->Unit(benchmark::kMicrosecond);
+
+// What two threads can gain on this machine, apart from jelly's code (docs/benchmarks.md, "What
+// the host gives two threads"): two passes over the 3 n^3 entries of the n^3 cube's vectors on
+// range(1) threads, split as the particle loops are (parallel::for_ranges). BM_StreamingPass is
+// rk4's update between two stages (7 vectors: the step's x and v, the stage's acceleration,
+// position and velocity, the two sums of slopes): little arithmetic per byte, so memory and cache
+// traffic decide. BM_ComputePass does a spring's square root and division per entry on values
+// kept in registers: arithmetic decides.
+void BM_StreamingPass(benchmark::State& bench) {
+  const long n = 3 * bench.range(0) * bench.range(0) * bench.range(0);
+  const int threads = static_cast<int>(bench.range(1));
+  std::vector<VecX> w(7, VecX::Constant(n, 1.0));
+  for (auto _ : bench) {
+    parallel::for_ranges(
+        threads, n,
+        [&](long begin, long end) {
+          const Real* __restrict x = w[0].data();
+          const Real* __restrict v = w[1].data();
+          const Real* __restrict a = w[2].data();
+          Real* __restrict xs = w[3].data();
+          Real* __restrict vs = w[4].data();
+          Real* __restrict dx = w[5].data();
+          Real* __restrict dv = w[6].data();
+          for (long i = begin; i < end; ++i) {
+            dx[i] += 2 * vs[i];
+            dv[i] += 2 * a[i];
+            xs[i] = x[i] + 1e-3 * vs[i];
+            vs[i] = v[i] + 1e-3 * a[i];
+          }
+        },
+        parallel::kMinItemsPerThread, 3);
+    benchmark::DoNotOptimize(w[6].data());
+    benchmark::ClobberMemory();
+  }
+  bench.counters["bytes_per_s"] = benchmark::Counter(static_cast<double>(n) * 10 * sizeof(Real),
+                                                     benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_StreamingPass)->ArgsProduct({{20, 40}, {1, 2}})->Unit(benchmark::kMicrosecond);
+
+void BM_ComputePass(benchmark::State& bench) {
+  const long n = 3 * bench.range(0) * bench.range(0) * bench.range(0);
+  const int threads = static_cast<int>(bench.range(1));
+  std::vector<Real> out(static_cast<size_t>(n / 1024 + 1), 0.0);
+  for (auto _ : bench) {
+    parallel::for_ranges(threads, n, [&](long begin, long end) {
+      Real sum = 0;
+      for (long i = begin; i < end; ++i) {
+        const Real d = 1.0 + 1e-9 * static_cast<Real>(i & 255);
+        const Real length = std::sqrt(d * d + 2.0);
+        sum += (length - 1.0) / (length + 1e-300);
+      }
+      out[static_cast<size_t>(begin / 1024)] = sum;
+    });
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_ComputePass)->ArgsProduct({{20, 40}, {1, 2}})->Unit(benchmark::kMicrosecond);
 
 // implicit_euler's matrix-free backward-Euler matrix (core/detail/band_system.hpp) of the n^3
 // seed cube, slightly deformed, at dt = 1/60 s, assembled on `threads` threads. `error` says
