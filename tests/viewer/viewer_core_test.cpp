@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <thread>
 
@@ -166,6 +167,19 @@ TEST(Camera, ParsesAndFrames) {
     EXPECT_GT(q->y(), 0);
     EXPECT_LT(q->y(), 720);
   }
+}
+
+// A negative point count is refused by name before any buffer or file is made.
+TEST(Export, Pc2WriterRefusesANegativePointCount) {
+  TempDir dir;
+  const std::string path = dir.file("bad.pc2");
+  try {
+    Pc2Writer writer(path, -1, 0, 1);
+    FAIL() << "a PC2 writer of -1 points was made";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("num_points"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
 }
 
 // The OBJ sequence and the PC2 cache read back equal the recorded surface positions (to their
