@@ -17,13 +17,6 @@ constexpr char kPc2Signature[12] = {'P', 'O', 'I', 'N', 'T', 'C', 'A', 'C', 'H',
 void put_i32(std::FILE* f, std::int32_t v) { std::fwrite(&v, 4, 1, f); }
 void put_f32(std::FILE* f, float v) { std::fwrite(&v, 4, 1, f); }
 
-// The entries of a sample of num_points points, once num_points is checked (before the buffer
-// of that size is made).
-size_t sample_entries(int num_points) {
-  require(num_points >= 0, "num_points", num_points, ">= 0");
-  return 3 * static_cast<size_t>(num_points);
-}
-
 }  // namespace
 
 void write_obj(const std::string& path, const std::vector<ObjObject>& objects,
@@ -86,7 +79,9 @@ std::vector<ObjObject> read_obj(const std::string& path) {
 }
 
 Pc2Writer::Pc2Writer(const std::string& path, int num_points, float start_frame, float sample_rate)
-    : path_(path), buffer_(sample_entries(num_points)) {
+    : path_(path) {
+  require(num_points >= 0, "num_points", num_points, ">= 0");  // before the buffer's size
+  buffer_.resize(3 * static_cast<size_t>(num_points));
   file_ = std::fopen(path.c_str(), "wb");
   if (file_ == nullptr)
     throw InputError("--pc2", path,
