@@ -312,7 +312,8 @@ void BandSystem::diagonal_block(int i, Real out[9]) const {
   out[5] = out[7] = d[5 * n];
 }
 
-void BandSystem::multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y) const {
+void BandSystem::multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y,
+                               int threads) const {
   const int n = num_particles_;
   const Real* sx = positions_.data();
   const std::vector<SpringBands::Band>& bands = bands_->bands();
@@ -331,7 +332,7 @@ void BandSystem::multiply_rows(const VecX& p, const std::vector<int>& particles,
     t[1] = ud * u1 + c2 * d1;
     t[2] = ud * u2 + c2 * d2;
   };
-  for (const int i : particles) {
+  const auto row = [&](int i) {
     Real acc[3];
     for (int c = 0; c < 3; ++c) acc[c] = mass_[i] * p[3 * i + c];
     // Band by band as multiply adds them (band_kernels::add_ends): t_first - t_second where the
@@ -355,10 +356,18 @@ void BandSystem::multiply_rows(const VecX& p, const std::vector<int>& particles,
       }
     }
     for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c];
-  }
+  };
+  // A row costs a few hundred operations: a thread for fewer rows would not pay its start.
+  constexpr long kMinRowsPerThread = 128;
+  parallel::for_ranges(
+      threads, static_cast<long>(particles.size()),
+      [&](long begin, long end) {
+        for (long r = begin; r < end; ++r) row(particles[r]);
+      },
+      kMinRowsPerThread);
 }
 
-void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) const {
+void BandSystem::multiply(const VecX& p, VecX& y, int threads, ProductFilter filter) const {
   const int n = num_particles_;
   const std::vector<SpringBands::Band>& bands = bands_->bands();
   const int team = this->team(threads);
@@ -376,8 +385,8 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) c
     const int p0 = static_cast<int>(range.begin), p1 = static_cast<int>(range.end);
     for (int i = p0; i < p1; ++i) {
       Real q[3] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
-      if (input.slot != nullptr && input.slot[i] >= 0) {
-        const Real* f = input.map + 9 * static_cast<size_t>(input.slot[i]);
+      if (filter.slot != nullptr && filter.slot[i] >= 0) {
+        const Real* f = filter.map + 9 * static_cast<size_t>(filter.slot[i]);
         const Real q0 = q[0], q1 = q[1], q2 = q[2];
         // Summed as Eigen's 3x3 product does (a0 + (a1 + a2)): the same bits as S_c p_c.
         for (int c = 0; c < 3; ++c) q[c] = f[c] * q0 + (f[3 + c] * q1 + f[6 + c] * q2);
@@ -411,6 +420,21 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, InputMap input) c
     }
     for (int i = p0; i < p1; ++i) {
       for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c * n + i];
+    }
+    if (filter.scale != nullptr) {
+      for (int i = p0; i < p1; ++i) {
+        if (filter.slot[i] < 0) continue;
+        // y_i -> S y_i + c S p_i + (p_i - S p_i), summed as Eigen's expression of the same
+        // (S p_i is the filtered input, kept in sp).
+        const Real* f = filter.map + 9 * static_cast<size_t>(filter.slot[i]);
+        const Real scale = filter.scale[filter.slot[i]];
+        const Real y0 = y[3 * i], y1 = y[3 * i + 1], y2 = y[3 * i + 2];
+        for (int c = 0; c < 3; ++c) {
+          const Real sy = f[c] * y0 + (f[3 + c] * y1 + f[6 + c] * y2);
+          const Real sq = sp[c * n + i];
+          y[3 * i + c] = sy + scale * sq + (p[3 * i + c] - sq);
+        }
+      }
     }
     seconds += std::chrono::duration<double>(Clock::now() - start).count();
     split_.record(part, seconds);  // (without the wait at the barrier)

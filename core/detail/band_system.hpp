@@ -16,12 +16,15 @@
 
 namespace jelly {
 
-// A linear map of the product's input at some particles (implicit_euler's contact filter):
-// p_i -> map[slot[i]] p_i where slot[i] >= 0 (slot: one entry per particle; map: 3x3,
-// column-major). Applied while the input is copied, so the filtered input costs no extra pass.
-struct InputMap {
+// A filter of the product at some particles (implicit_euler's contact filter), with S = map[slot[i]]
+// where slot[i] >= 0 (slot: one entry per particle; map: 3x3, column-major):
+//   input:  p_i -> S p_i, applied while the input is copied (no extra pass);
+//   output (when `scale` is set, one number c per slot): y_i -> S y_i + c S p_i + (p_i - S p_i)
+//           with p_i the unfiltered input, applied as the product writes its rows (no extra pass).
+struct ProductFilter {
   const int* slot = nullptr;
-  const Real* map = nullptr;  // 9 numbers per slot
+  const Real* map = nullptr;    // 9 numbers per slot
+  const Real* scale = nullptr;  // 1 number per slot, or null: the input filter only
 };
 
 class BandSystem {
@@ -48,13 +51,15 @@ class BandSystem {
                 Real beta, const VecX& w, VecX& kw, int threads);
   // A_pp += value I (anchors, wind drag). Call after assemble.
   void add_diagonal(int particle, Real value);
-  // y = A p, or y = A (F p) with F the map `input` (when its slot is not null). No allocation
-  // after the first call with this thread count.
-  void multiply(const VecX& p, VecX& y, int threads, InputMap input = {}) const;
+  // y = A p, or y = A p filtered by `filter` (when its slot is not null). No allocation after
+  // the first call with this thread count.
+  void multiply(const VecX& p, VecX& y, int threads, ProductFilter filter = {}) const;
   // The rows of y = A p at the given particles only (the other rows of y are left as they
-  // are): the same bits as multiply's without an input map. Serial; for a few particles (the
-  // contacts' impulses) instead of a whole product.
-  void multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y) const;
+  // are): the same bits as multiply's without a filter, for a few particles (the contacts'
+  // impulses) instead of a whole product; split between up to `threads` threads when there
+  // are enough of them.
+  void multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y,
+                     int threads = 1) const;
   // The diagonal 3x3 block of particle i, row-major.
   void diagonal_block(int i, Real out[9]) const;
 

@@ -147,13 +147,18 @@ template <class Position>
 void ImplicitContact::find_penetrating(const Terrains& terrains, Position&& position,
                                        Real tolerance) {
   penetrating_.resize(slot_.size());
-  parallel::for_ranges(threads_, static_cast<long>(slot_.size()), [&](long begin, long end) {
-    for (long i = begin; i < end; ++i) {
-      penetrating_[i] =
-          slot_[i] >= 0 ? -1
-                        : penetrated_terrain(terrains, position(static_cast<int>(i)), tolerance);
-    }
-  });
+  // (Each particle costs a few virtual calls per terrain: worth a thread from about a thousand.)
+  parallel::for_ranges(
+      threads_, static_cast<long>(slot_.size()),
+      [&](long begin, long end) {
+        for (long i = begin; i < end; ++i) {
+          penetrating_[i] =
+              slot_[i] >= 0
+                  ? -1
+                  : penetrated_terrain(terrains, position(static_cast<int>(i)), tolerance);
+        }
+      },
+      parallel::kMinParticlesPerThread);
 }
 
 bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, const State& s0,
@@ -321,22 +326,16 @@ bool ImplicitContact::constrain_rhs(const VecX& b, bool prescribe, const VecX* a
   return true;
 }
 
-InputMap ImplicitContact::input_map() {
+ProductFilter ImplicitContact::product_filter() {
   projectors_.resize(9 * contacts_.size());
+  viscosities_.resize(contacts_.size());
   for (size_t k = 0; k < contacts_.size(); ++k) {
-    const Mat3 s = free_projector(contacts_[k]);
+    const Contact& c = contacts_[k];
+    const Mat3 s = free_projector(c);
     std::copy(s.data(), s.data() + 9, projectors_.data() + 9 * k);
+    viscosities_[k] = c.mode == Mode::kSlide && !c.pinned ? c.viscosity : 0.0;
   }
-  return InputMap{slot_.data(), projectors_.data()};
-}
-
-void ImplicitContact::filter_output(const VecX& p, VecX& y) const {
-  for (const Contact& c : contacts_) {
-    const Mat3 sc = free_projector(c);
-    const Real viscosity = c.mode == Mode::kSlide && !c.pinned ? c.viscosity : 0.0;
-    const Vec3 pc = particle(p, c.particle);
-    particle(y, c.particle) = sc * particle(y, c.particle) + viscosity * (sc * pc) + (pc - sc * pc);
-  }
+  return ProductFilter{slot_.data(), projectors_.data(), viscosities_.data()};
 }
 
 bool ImplicitContact::filter_diagonal_block(int i, Real block[9]) const {
@@ -522,11 +521,13 @@ void ImplicitContact::finish(const Model& model, const Terrains& terrains, State
   // Particles left below a surface (the active set was still changing when the solves ran out):
   // onto the surface, without inward velocity.
   projected_ = 0;
+  threads_ = threads;
+  find_penetrating(
+      terrains, [&](int i) { return Vec3(particle(s1.x, i)); }, kPenetrationTolerance);
   for (int i = 0; i < model.num_particles(); ++i) {
-    if (slot_[i] >= 0) continue;
-    auto x = particle(s1.x, i);
-    const int k = penetrated_terrain(terrains, x, kPenetrationTolerance);
+    const int k = penetrating_[i];
     if (k < 0) continue;
+    auto x = particle(s1.x, i);
     const Terrain& terrain = *terrains[k];
     const Vec3 n = terrain.normal(x, t1_);
     const Vec3 u = terrain.surface_velocity(x, t1_);

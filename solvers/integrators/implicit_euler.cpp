@@ -7,6 +7,7 @@
 #include <jelly/core/detail/anchor_jacobian.hpp>
 #include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/contact/detail/implicit_body_contact.hpp>
@@ -44,6 +45,15 @@ void restore_momentum(const VecX& mass, const VecX& b, VecX& y) {
     missing += b.segment<3>(3 * i) - mass[i] * y.segment<3>(3 * i);
   const Vec3 shift = missing / mass.sum();
   for (Eigen::Index i = 0; i < np; ++i) y.segment<3>(3 * i) += shift;
+}
+
+// body(k) for every entry k of a vector of n entries, split between up to `threads` threads
+// (each entry's arithmetic is its own: the same bits for any split).
+template <class Body>
+void for_each_entry(int threads, Eigen::Index n, Body&& body) {
+  parallel::for_ranges(threads, static_cast<long>(n), [&](long begin, long end) {
+    for (long k = begin; k < end; ++k) body(k);
+  });
 }
 
 // Whether a matrix of dense 3x3 blocks (full storage, sorted rows) holds block (i, j).
@@ -399,7 +409,7 @@ bool ImplicitEuler::Impl::update_contacts(const Terrains& terrains, const VecX& 
   // The contacts' impulses need A dv at their particles only.
   contact_rows_.clear();
   for (const auto& c : contact_.contacts()) contact_rows_.push_back(c.particle);
-  band_->multiply_rows(dv_, contact_rows_, az_);
+  band_->multiply_rows(dv_, contact_rows_, az_, threads_);
   return contact_.update_from_product(terrains, b, dv_, commit, az_, screening);
 }
 
@@ -421,10 +431,9 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
   factorization_seconds_ += seconds_since(start);
   if (r.ok()) {
     start = Clock::now();
-    const InputMap input = constrained ? contact_.input_map() : InputMap{};
+    const ProductFilter filter = constrained ? contact_.product_filter() : ProductFilter{};
     const auto apply = [&](const VecX& in, VecX& out) {
-      band_->multiply(in, out, threads_, input);
-      if (constrained) contact_.filter_output(in, out);
+      band_->multiply(in, out, threads_, filter);
     };
     // Resuming: from the iterate as CG left it (before finish_solve's correction), with the
     // iterations the loose solve left, so that it is one solve in every respect.
@@ -526,7 +535,8 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   }
   anchored_ = dynamics.anchors() != nullptr;
   if (StepResult r = assemble(dynamics, s.x, s.v, s.t + h, h); !r.ok) return r;
-  b_ = h * (f_ + h * kw_);
+  b_.resize(f_.size());
+  for_each_entry(threads_, b_.size(), [&](long k) { b_[k] = h * (f_[k] + h * kw_[k]); });
   if (bodies_active_ && bodies_.any_active()) refresh_pair_terms();
   assembly_seconds_ += seconds_since(start);
   terrains_seen_ = dynamics.terrains() != nullptr;
@@ -549,7 +559,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
       have_dv_ = false;
       return r;
     }
-    if (constrained) dv_ += z_;
+    if (constrained) for_each_entry(threads_, dv_.size(), [&](long k) { dv_[k] += z_[k]; });
     return r;
   };
   // Solve; with contacts, again while their active set changes.
@@ -638,14 +648,17 @@ StepResult ImplicitEuler::Impl::step(const Dynamics& dynamics, State& s, Real h)
   if (StepResult r = prepare(dynamics, h); !r.ok) return r;
   if (solver_) solver_->set_threads(threads_);
   if (StepResult r = linearized_solve(dynamics, s, h); !r.ok) return r;
-  v1_ = s.v + dv_;
+  v1_.resize(s.v.size());
+  for_each_entry(threads_, v1_.size(), [&](long k) { v1_[k] = s.v[k] + dv_[k]; });
   residuals_.clear();
   converged_ = true;
   if (options_.newton_iterations > 1) {
     if (StepResult r = newton(dynamics, s, h); !r.ok) return r;
   }
-  s.v = v1_;
-  s.x += h * s.v;
+  for_each_entry(threads_, v1_.size(), [&](long k) {
+    s.v[k] = v1_[k];
+    s.x[k] += h * s.v[k];
+  });
   s.t += h;
   if (contact_active_) contact_.finish(dynamics.model(), *contact_terrains_, s, threads_);
   if (bodies_active_) {

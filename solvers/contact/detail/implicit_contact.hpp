@@ -100,11 +100,10 @@ class ImplicitContact {
   //     whether z is non-zero), then with A z (forms rhs and projects guess).
   bool constrain_rhs(const VecX& b, bool prescribe, const VecX* a_z, VecX& rhs, VecX& z,
                      VecX& guess);
-  //   input_map: q = p with q_c = S_c p_c at the contacts (q = p elsewhere), as a map for
-  //     BandSystem::multiply (valid until the contacts change);
-  //   filter_output: y_c = S_c y_c + C_c p_c + (I - S_c) p_c at the contacts, for y = A q.
-  InputMap input_map();
-  void filter_output(const VecX& p, VecX& y) const;
+  //   product_filter: the filter for BandSystem::multiply (valid until the contacts change):
+  //     the product's input q = p with q_c = S_c p_c at the contacts (q = p elsewhere), and its
+  //     output y_c = S_c y_c + C_c p_c + (I - S_c) p_c at the contacts, for y = A q.
+  ProductFilter product_filter();
   //   the filtered diagonal block S D S + C + I - S of a contact particle (D row-major, in
   //     place), for block Jacobi; returns false for a particle without contact.
   bool filter_diagonal_block(int particle, Real block[9]) const;
@@ -170,7 +169,8 @@ class ImplicitContact {
   std::vector<Contact> contacts_, next_;
   std::vector<Bounce> bounces_;    // finish(): the contacts that bounce
   std::vector<int> slot_;          // [N]: index into contacts_ or -1
-  std::vector<Real> projectors_;   // [9 * contacts]: S_c column-major (input_map)
+  std::vector<Real> projectors_;   // [9 * contacts]: S_c column-major (product_filter)
+  std::vector<Real> viscosities_;  // [contacts]: C_c's viscosity, 0 unless sliding (product_filter)
   std::vector<char> pinned_mask_;  // [N]: pinned this step
   std::vector<Real> saved_;        // original values of the constrained columns
   std::vector<int> saved_at_;      // [contacts]: offset into saved_
