@@ -16,8 +16,8 @@
 
 namespace jelly {
 
-// A filter of the product at some particles (implicit_euler's contact filter), with S = map[slot[i]]
-// where slot[i] >= 0 (slot: one entry per particle; map: 3x3, column-major):
+// A filter of the product at some particles (implicit_euler's contact filter), with S =
+// map[slot[i]] where slot[i] >= 0 (slot: one entry per particle; map: 3x3, column-major):
 //   input:  p_i -> S p_i, applied while the input is copied (no extra pass);
 //   output (when `scale` is set, one number c per slot): y_i -> S y_i + c S p_i + (p_i - S p_i)
 //           with p_i the unfiltered input, applied as the product writes its rows (no extra pass).

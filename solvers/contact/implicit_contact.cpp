@@ -152,10 +152,9 @@ void ImplicitContact::find_penetrating(const Terrains& terrains, Position&& posi
       threads_, static_cast<long>(slot_.size()),
       [&](long begin, long end) {
         for (long i = begin; i < end; ++i) {
-          penetrating_[i] =
-              slot_[i] >= 0
-                  ? -1
-                  : penetrated_terrain(terrains, position(static_cast<int>(i)), tolerance);
+          penetrating_[i] = slot_[i] >= 0 ? -1
+                                          : penetrated_terrain(
+                                                terrains, position(static_cast<int>(i)), tolerance);
         }
       },
       parallel::kMinParticlesPerThread);

@@ -1,8 +1,14 @@
 #include <gtest/gtest.h>
 
-#include <jelly/geometry/cube.hpp>
+#include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 
 #include "support/systems.hpp"
 
@@ -38,6 +44,31 @@ TEST(Model, ValidateNamesTheSpring) {
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "springs[0].ks = -3 is invalid: a finite stiffness >= 0");
   }
+  // Every field of a spring, and a particle's mass, is checked (the valid ones skip building
+  // the names).
+  const Real nan = std::numeric_limits<Real>::quiet_NaN();
+  const std::vector<std::pair<std::function<void(Model&)>, std::string>> bad = {
+      {[](Model& b) { b.springs.a[0] = -1; }, "springs[0].a = -1"},
+      {[](Model& b) { b.springs.a[0] = 2; }, "springs[0].a = 2"},
+      {[](Model& b) { b.springs.b[0] = b.springs.a[0]; }, "springs[0].b = "},
+      {[](Model& b) { b.springs.b[0] = 7; }, "springs[0].b = 7"},
+      {[&](Model& b) { b.springs.rest_length[0] = nan; }, "springs[0].rest_length = nan"},
+      {[](Model& b) { b.springs.rest_length[0] = 0; }, "springs[0].rest_length = 0"},
+      {[&](Model& b) { b.springs.ks[0] = nan; }, "springs[0].ks = nan"},
+      {[](Model& b) { b.springs.kd[0] = -1; }, "springs[0].kd = -1"},
+      {[](Model& b) { b.mass[1] = 0; }, "mass[1] = 0"},
+  };
+  for (const auto& [mutate, message] : bad) {
+    Model broken = sys.model();
+    mutate(broken);
+    try {
+      broken.validate();
+      ADD_FAILURE() << "no error for " << message;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(message, 0), 0U) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(sys.model().validate());
 }
 
 }  // namespace
