@@ -424,8 +424,9 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, ProductFilter fil
     if (filter.scale != nullptr) {
       for (int i = p0; i < p1; ++i) {
         if (filter.slot[i] < 0) continue;
-        // y_i -> S y_i + c S p_i + (p_i - S p_i), summed as Eigen's expression of the same
-        // (S p_i is the filtered input, kept in sp).
+        // y_i -> S y_i + c (S p_i) + (p_i - S p_i), with S p_i the filtered input kept in sp
+        // (c times it: Eigen's (c S) p_i in the former ImplicitContact::filter_output differed
+        // in the last bits for sliding contacts).
         const Real* f = filter.map + 9 * static_cast<size_t>(filter.slot[i]);
         const Real scale = filter.scale[filter.slot[i]];
         const Real y0 = y[3 * i], y1 = y[3 * i + 1], y2 = y[3 * i + 2];

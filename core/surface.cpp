@@ -42,22 +42,29 @@ void Surface::validate(int num_particles, const std::string& field) const {
               offsets.back() == static_cast<int>(particles.size()) &&
               particles.size() == weights.size(),
           field + ".offsets", offsets.size(), "offsets from 0 to the number of weights");
+  // (A field's name is built only for a message, as in Model::validate.)
   for (int v = 0; v < num_vertices(); ++v) {
-    require(offsets[v + 1] > offsets[v], field + ".vertex[" + std::to_string(v) + "]", v,
-            "a vertex with at least one particle");
+    const bool ok = offsets[v + 1] > offsets[v];
+    if (!ok)
+      require(ok, field + ".vertex[" + std::to_string(v) + "]", v,
+              "a vertex with at least one particle");
   }
   for (std::size_t k = 0; k < particles.size(); ++k) {
-    require(particles[k] >= 0 && particles[k] < num_particles,
-            field + ".particles[" + std::to_string(k) + "]", particles[k],
+    const bool particle_ok = particles[k] >= 0 && particles[k] < num_particles;
+    const bool weight_ok = std::isfinite(weights[k]);
+    if (particle_ok && weight_ok) continue;
+    require(particle_ok, field + ".particles[" + std::to_string(k) + "]", particles[k],
             "a particle index of the model");
-    require(std::isfinite(weights[k]), field + ".weights[" + std::to_string(k) + "]", weights[k],
+    require(weight_ok, field + ".weights[" + std::to_string(k) + "]", weights[k],
             "a finite weight");
   }
   const int nv = num_vertices();
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     for (int c : triangles[t]) {
-      require(c >= 0 && c < nv, field + ".triangles[" + std::to_string(t) + "]", c,
-              "a vertex index of the surface");
+      const bool ok = c >= 0 && c < nv;
+      if (!ok)
+        require(ok, field + ".triangles[" + std::to_string(t) + "]", c,
+                "a vertex index of the surface");
     }
   }
 }

@@ -21,6 +21,8 @@ namespace jelly {
 //   input:  p_i -> S p_i, applied while the input is copied (no extra pass);
 //   output (when `scale` is set, one number c per slot): y_i -> S y_i + c S p_i + (p_i - S p_i)
 //           with p_i the unfiltered input, applied as the product writes its rows (no extra pass).
+// `map` and `scale` are read only where `slot` is set; the output filter needs the input filter
+// (S p_i is the filtered input), and the product's input and output must be distinct vectors.
 struct ProductFilter {
   const int* slot = nullptr;
   const Real* map = nullptr;    // 9 numbers per slot
@@ -54,10 +56,10 @@ class BandSystem {
   // y = A p, or y = A p filtered by `filter` (when its slot is not null). No allocation after
   // the first call with this thread count.
   void multiply(const VecX& p, VecX& y, int threads, ProductFilter filter = {}) const;
-  // The rows of y = A p at the given particles only (the other rows of y are left as they
-  // are): the same bits as multiply's without a filter, for a few particles (the contacts'
-  // impulses) instead of a whole product; split between up to `threads` threads when there
-  // are enough of them.
+  // The rows of y = A p at the given particles only (distinct; the other rows of y are left as
+  // they are): the same bits as multiply's without a filter, for a few particles (the
+  // contacts' impulses) instead of a whole product; split between up to `threads` threads when
+  // there are enough of them.
   void multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y,
                      int threads = 1) const;
   // The diagonal 3x3 block of particle i, row-major.

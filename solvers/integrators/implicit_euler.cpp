@@ -47,13 +47,17 @@ void restore_momentum(const VecX& mass, const VecX& b, VecX& y) {
   for (Eigen::Index i = 0; i < np; ++i) y.segment<3>(3 * i) += shift;
 }
 
-// body(k) for every entry k of a vector of n entries, split between up to `threads` threads
-// (each entry's arithmetic is its own: the same bits for any split).
+// body(k) for every entry k of a vector of 3 entries per particle, split between up to `threads`
+// threads at particles, as the particle loops are (each entry's arithmetic is its own: the same
+// bits for any split).
 template <class Body>
 void for_each_entry(int threads, Eigen::Index n, Body&& body) {
-  parallel::for_ranges(threads, static_cast<long>(n), [&](long begin, long end) {
-    for (long k = begin; k < end; ++k) body(k);
-  });
+  parallel::for_ranges(
+      threads, static_cast<long>(n),
+      [&](long begin, long end) {
+        for (long k = begin; k < end; ++k) body(k);
+      },
+      parallel::kMinItemsPerThread, 3);
 }
 
 // Whether a matrix of dense 3x3 blocks (full storage, sorted rows) holds block (i, j).
@@ -406,9 +410,10 @@ void ImplicitEuler::Impl::constrain(const VecX& b, bool prescribe, VecX& guess) 
 bool ImplicitEuler::Impl::update_contacts(const Terrains& terrains, const VecX& b, bool commit,
                                           bool screening) {
   if (!matrix_free_) return contact_.update(terrains, b, dv_, commit, a_);
-  // The contacts' impulses need A dv at their particles only.
+  // The contacts' impulses need A dv at their particles only (a pin's impulse is not used).
   contact_rows_.clear();
-  for (const auto& c : contact_.contacts()) contact_rows_.push_back(c.particle);
+  for (const auto& c : contact_.contacts())
+    if (!c.pinned) contact_rows_.push_back(c.particle);
   band_->multiply_rows(dv_, contact_rows_, az_, threads_);
   return contact_.update_from_product(terrains, b, dv_, commit, az_, screening);
 }

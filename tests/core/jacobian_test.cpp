@@ -320,6 +320,85 @@ TEST(BandSystem, ProductsEqualTheAssembledMatrix) {
                                beta, w, kw, 1));
 }
 
+// The contact filter of implicit_euler as the product applies it (ProductFilter): the input
+// q = p with q_i = S_i p_i and the output y_i = S_i (A q)_i + c_i S_i p_i + (p_i - S_i p_i) at
+// the filtered particles, against that formula on the assembled matrix; and with a few hundred
+// particles filtered (more than one thread's worth of rows for multiply_rows), the same bits on
+// 1, 2 and 3 threads and over repeated calls (the balanced split moves between them).
+TEST(BandSystem, FilteredProductsAndRowsAreTheSameOnAnyThreadCount) {
+  CubeSpec spec;
+  spec.n = 12;  // 1,728 particles
+  for (auto& c : spec.springs) c = SpringCoefficients{2400, 120};
+  const Model model = build_cube(spec);
+  const SpringBands bands(model);
+  const State s = random_state(model, 9, 0.1);
+  const VecX p = VecX::Random(model.num_dofs());
+  const Real alpha = 0.01, beta = 1e-4;
+  const int np = model.num_particles();
+  // Every third particle filtered (576, across every thread boundary): sliding (a tangent
+  // plane and a viscosity), sticking or pinned (S = 0) in turn.
+  std::vector<int> slot(np, -1), rows;
+  std::vector<Real> map, scale;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  for (int i = 0; i < np; i += 3) {
+    slot[i] = static_cast<int>(rows.size());
+    rows.push_back(i);
+    Eigen::Matrix3d projector = Eigen::Matrix3d::Zero();
+    Real c = 0;
+    if (rows.size() % 2 == 1) {
+      const Vec3 normal = Vec3(u(rng), u(rng), u(rng)).normalized();
+      projector = Eigen::Matrix3d::Identity() - normal * normal.transpose();
+      c = 5 * (1 + u(rng));
+    }
+    map.insert(map.end(), projector.data(), projector.data() + 9);
+    scale.push_back(c);
+  }
+  ASSERT_GT(rows.size(), 256U);  // multiply_rows splits from 128 rows per thread
+  const ProductFilter filter{slot.data(), map.data(), scale.data()};
+
+  SpringJacobian jacobian(model);
+  JacobianOptions o;
+  SparseMatrix a = jacobian.make_matrix();
+  VecX kw_expected(model.num_dofs());
+  jacobian.assemble_system(model, s.x, s.v, o, alpha, beta, a, p, kw_expected);
+  VecX q = p;
+  for (int i : rows) {
+    const Eigen::Map<const Eigen::Matrix3d> projector(map.data() + 9 * slot[i]);
+    q.segment<3>(3 * i) = projector * p.segment<3>(3 * i);
+  }
+  VecX expected = a * q;
+  for (int i : rows) {
+    const Eigen::Map<const Eigen::Matrix3d> projector(map.data() + 9 * slot[i]);
+    const Vec3 pi = p.segment<3>(3 * i), si = projector * pi;
+    expected.segment<3>(3 * i) =
+        projector * expected.segment<3>(3 * i) + scale[slot[i]] * si + (pi - si);
+  }
+
+  VecX first_y, first_rows;
+  for (int threads : {1, 2, 3}) {
+    BandSystem system(bands, np);
+    VecX kw(model.num_dofs());
+    ASSERT_TRUE(system.assemble(model, s.x, s.v, o.definiteness, alpha, beta, p, kw, threads));
+    for (int call = 0; call < 3; ++call) {
+      VecX y(model.num_dofs());
+      system.multiply(p, y, threads, filter);
+      EXPECT_LT((y - expected).norm(), 1e-13 * expected.norm()) << threads;
+      if (first_y.size() == 0) first_y = y;
+      EXPECT_TRUE(y == first_y) << threads << " threads, call " << call;
+    }
+    // The rows alone, on up to `threads` threads: the unfiltered product's rows, bit for bit.
+    VecX whole(model.num_dofs());
+    system.multiply(p, whole, threads);
+    VecX rows_only = VecX::Constant(model.num_dofs(), -1.0);
+    system.multiply_rows(p, rows, rows_only, threads);
+    for (int i : rows) EXPECT_TRUE(rows_only.segment<3>(3 * i) == whole.segment<3>(3 * i)) << i;
+    EXPECT_EQ(rows_only[3], -1.0);  // particle 1 is not a row
+    if (first_rows.size() == 0) first_rows = rows_only;
+    EXPECT_TRUE(rows_only == first_rows) << threads;
+  }
+}
+
 // Extra blocks (pairs without a spring) are in the pattern and zero after every assembly.
 TEST(SpringJacobian, ExtraBlocksAreZero) {
   const Model model = cube_model(2400, 120);

@@ -8,6 +8,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/core/surface.hpp>
 #include <jelly/geometry/cube.hpp>
 
 #include "support/systems.hpp"
@@ -69,6 +70,33 @@ TEST(Model, ValidateNamesTheSpring) {
     }
   }
   EXPECT_NO_THROW(sys.model().validate());
+}
+
+TEST(Surface, ValidateNamesTheEntry) {
+  Surface good;
+  for (int p = 0; p < 3; ++p) good.add_particle_vertex(p);
+  good.triangles.push_back({0, 1, 2});
+  EXPECT_NO_THROW(good.validate(3, "bodies.a.surface"));
+  const std::vector<std::pair<std::function<void(Surface&)>, std::string>> bad = {
+      {[](Surface& b) { b.particles[1] = 3; }, "bodies.a.surface.particles[1] = 3"},
+      {[](Surface& b) { b.weights[2] = std::numeric_limits<Real>::infinity(); },
+       "bodies.a.surface.weights[2] = inf"},
+      {[](Surface& b) { b.triangles[0][2] = 3; }, "bodies.a.surface.triangles[0] = 3"},
+      {[](Surface& b) {
+         b.offsets = {0, 1, 1, 3};  // vertex 1 without particles
+       },
+       "bodies.a.surface.vertex[1] = 1"},
+  };
+  for (const auto& [mutate, message] : bad) {
+    Surface broken = good;
+    mutate(broken);
+    try {
+      broken.validate(3, "bodies.a.surface");
+      ADD_FAILURE() << "no error for " << message;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(message, 0), 0U) << e.what();
+    }
+  }
 }
 
 }  // namespace
