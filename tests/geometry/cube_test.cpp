@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <ostream>
+#include <string>
+
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
@@ -10,6 +13,9 @@ namespace {
 struct Counts {
   int n, structural, shear, bending;
 };
+
+// (For ctest's test names: gtest prints a struct without PrintTo as its bytes.)
+void PrintTo(const Counts& c, std::ostream* os) { *os << "n = " << c.n; }
 
 class CubeCounts : public ::testing::TestWithParam<Counts> {};
 
@@ -28,7 +34,10 @@ TEST_P(CubeCounts, SpringsPerType) {
 // structural 3 n^2 (n-1); shear 6 n (n-1)^2 + 4 (n-1)^3; bending 3 n^2 (n-2).
 INSTANTIATE_TEST_SUITE_P(Seed, CubeCounts,
                          ::testing::Values(Counts{2, 12, 6 * 2 + 4, 0}, Counts{3, 54, 72 + 32, 27},
-                                           Counts{10, 2700, 7776, 2400}));
+                                           Counts{10, 2700, 7776, 2400}),
+                         [](const ::testing::TestParamInfo<Counts>& p) {
+                           return "n" + std::to_string(p.param.n);
+                         });
 
 TEST(Cube, SeedPoseAndRestLengths) {
   const Model m = build_cube(CubeSpec{});

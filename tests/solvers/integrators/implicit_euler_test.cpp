@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ostream>
 #include <random>
 
 #include <jelly/core/errors.hpp>
@@ -299,6 +300,9 @@ TEST(ImplicitEuler, InvalidOptionsNameTheField) {
 struct Material {
   Real ks, kd;
 };
+
+// (For ctest's test names: gtest prints a struct without PrintTo as its bytes.)
+void PrintTo(const Material& m, std::ostream* os) { *os << "ks " << m.ks << ", kd " << m.kd; }
 
 struct SceneOutcome {
   RunReport report;
