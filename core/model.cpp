@@ -68,20 +68,16 @@ void Model::validate() const {
   for (int s = 0; s < springs.size(); ++s) {
     const int a = springs.a[s], b = springs.b[s];
     const Real l0 = springs.rest_length[s], ks = springs.ks[s], kd = springs.kd[s];
-    if (a >= 0 && a < n && b >= 0 && b < n && b != a && std::isfinite(l0) && l0 > 0 &&
-        std::isfinite(ks) && ks >= 0 && std::isfinite(kd) && kd >= 0)
-      continue;
+    const bool a_ok = a >= 0 && a < n, b_ok = b >= 0 && b < n && b != a;
+    const bool l0_ok = std::isfinite(l0) && l0 > 0;
+    const bool ks_ok = std::isfinite(ks) && ks >= 0, kd_ok = std::isfinite(kd) && kd >= 0;
+    if (a_ok && b_ok && l0_ok && ks_ok && kd_ok) continue;
     const std::string at = "springs[" + std::to_string(s) + "]";
-    require(springs.a[s] >= 0 && springs.a[s] < n, at + ".a", springs.a[s],
-            "a particle index in [0, " + std::to_string(n) + ")");
-    require(springs.b[s] >= 0 && springs.b[s] < n && springs.b[s] != springs.a[s], at + ".b",
-            springs.b[s], "a particle index in [0, N) other than a");
-    require(std::isfinite(springs.rest_length[s]) && springs.rest_length[s] > 0,
-            at + ".rest_length", springs.rest_length[s], "a finite length > 0");
-    require(std::isfinite(springs.ks[s]) && springs.ks[s] >= 0, at + ".ks", springs.ks[s],
-            "a finite stiffness >= 0");
-    require(std::isfinite(springs.kd[s]) && springs.kd[s] >= 0, at + ".kd", springs.kd[s],
-            "a finite damping >= 0");
+    require(a_ok, at + ".a", a, "a particle index in [0, " + std::to_string(n) + ")");
+    require(b_ok, at + ".b", b, "a particle index in [0, N) other than a");
+    require(l0_ok, at + ".rest_length", l0, "a finite length > 0");
+    require(ks_ok, at + ".ks", ks, "a finite stiffness >= 0");
+    require(kd_ok, at + ".kd", kd, "a finite damping >= 0");
   }
   // Bodies, when there are any, cover the particles and springs in order.
   int next_particle = 0, next_spring = 0;
