@@ -10,6 +10,8 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas-dev libsundials-dev libhdf5-dev hdf5-tools
   libceres-dev libgtest-dev libgmock-dev googletest libbenchmark-dev nlohmann-json3-dev libcli11-dev
   python3-h5py python3-matplotlib python3-numpy ffmpeg clang-format ccache
+  # scripts/scale_goals.sh: a run's peak memory (/usr/bin/time)
+  time
   # meshes: reading OBJ/STL/PLY (assimp), tetrahedral meshes and `jelly mesh` (Gmsh)
   libassimp-dev libgmsh-dev
   # scripts/make_assets.py (the meshes under assets/) and its test: Gmsh's Python API
