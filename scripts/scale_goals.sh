@@ -5,7 +5,7 @@
 # shared 2-core virtual machines whose speed changes from minute to minute; this script is how to
 # measure the same goals on another machine.
 #
-#   scripts/scale_goals.sh [--rounds N] [--out DIR] [--quick]
+#   scripts/scale_goals.sh [--rounds N] [--out DIR] [--quick] [--overwrite]
 #
 # Each round runs, one after the other:
 #   * jelly-bench speed with 1 and 2 threads interleaved: rk4 at n = 20 (1,000 steps of 1 ms) and
@@ -18,23 +18,29 @@
 #   * xpbd (1 substep) on the seed slope at n = 20 and n = 40, 2 s of 1/60 s frames, 2 threads,
 #     the frames alone as above. Goals: at most 16.7 ms (n = 20) and 100 ms (n = 40) per frame.
 # --quick: small cubes and few steps, to check that the script runs (its figures are not the
-# goals'). Default: 3 rounds, output under out/scale_goals (each run's CSV or log, rounds.csv
-# with every figure, summary.txt). Takes about 40 s per round on the 2-core machine of docs/.
+# goals'). Default: 3 rounds, output under out/scale_goals of the current directory (each run's
+# CSV or log, rounds.csv with every figure, summary.txt); a DIR that is not empty is refused
+# unless --overwrite (which removes the round folders, rounds.csv and summary.txt in it). Takes
+# about 50 s per round on the 2-core machine of docs/.
 #
 # Environment: JELLY_BENCH and JELLY, the programs (default: build/bench/jelly-bench and
 # build/cli/jelly of this checkout). Run it with nothing else running. Exit codes: 0 (whether
 # or not the goals are met), 1 a run failed, 2 a wrong use of this script.
 set -euo pipefail
+# Decimal points whatever the locale: $EPOCHREALTIME uses the locale's (a comma under de_DE, which
+# awk would cut the time at) and sort -g reads the figures by it.
+export LC_ALL=C
 
 usage() {
   echo "error: $1" >&2
-  echo "usage: $0 [--rounds N] [--out DIR] [--quick]" >&2
+  echo "usage: $0 [--rounds N] [--out DIR] [--quick] [--overwrite]" >&2
   exit 2
 }
 
 rounds=3
 out=out/scale_goals
 quick=0
+overwrite=0
 while [[ $# -gt 0 ]]; do
   case $1 in
     --rounds)
@@ -43,7 +49,7 @@ while [[ $# -gt 0 ]]; do
       shift 2
       ;;
     --out)
-      [[ $# -ge 2 && -n $2 ]] || usage "--out takes a directory"
+      [[ $# -ge 2 && -n $2 && $2 != -* ]] || usage "--out takes a directory"
       out=$2
       shift 2
       ;;
@@ -51,11 +57,15 @@ while [[ $# -gt 0 ]]; do
       quick=1
       shift
       ;;
+    --overwrite)
+      overwrite=1
+      shift
+      ;;
     *) usage "unknown argument '$1'" ;;
   esac
 done
 
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd -- "$(dirname -- "$0")/.." >/dev/null && pwd)
 bench=${JELLY_BENCH:-$root/build/bench/jelly-bench}
 jelly=${JELLY:-$root/build/cli/jelly}
 [[ -x $bench ]] || usage "jelly-bench not found at $bench (build first, or set JELLY_BENCH)"
@@ -69,7 +79,13 @@ if [[ $quick == 1 ]]; then
 else
   small=20 large=40 rk4_small=1000 rk4_large=100 ie_small=60 ie_large=10 frames=120
 fi
-mkdir -p "$out"
+# Nothing of an earlier run into the same DIR is read as this one's or left to look like it, and
+# nothing is removed without --overwrite.
+if [[ -n $(ls -A -- "$out" 2>/dev/null) ]]; then
+  [[ $overwrite == 1 ]] || usage "$out is not empty (an earlier run?): choose another --out, or --overwrite"
+  rm -rf -- "$out"/round[0-9]* "$out/summary.txt" "$out/rounds.csv"
+fi
+mkdir -p -- "$out"
 figures=$out/rounds.csv
 echo "round,goal,value" >"$figures"
 
@@ -111,7 +127,11 @@ peak_mb() { [[ -f $1.time ]] && awk '/^peak_kb/ { printf "%.0f", $2 / 1024 }' "$
 # in ms.
 per_step_ms() { awk -v l="$1" -v s="$2" -v n="$3" 'BEGIN { printf "%.1f", 1000 * (l - s) / (n - 1) }'; }
 
-record() { echo "$1,$2,$3" >>"$figures"; }
+# A figure that could not be read stops the script (a $(...) in an argument would not).
+record() {
+  [[ -n $3 ]] || { echo "round $1: no figure for $2" >&2; exit 1; }
+  echo "$1,$2,$3" >>"$figures"
+}
 
 for r in $(seq "$rounds"); do
   dir=$out/round$r

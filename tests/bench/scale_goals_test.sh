@@ -46,5 +46,11 @@ refuse() {
 refuse "--rounds takes a whole number" --rounds 0
 refuse "--rounds takes a whole number" --rounds
 refuse "unknown argument '--fast'" --fast
+refuse "--out takes a directory" --out
+refuse "is not empty" --quick --out "$work/out"
+# --overwrite: a second run into the same directory, with one round, leaves no second round.
+bash "$script" --quick --rounds 1 --out "$work/out" --overwrite >/dev/null 2>&1 ||
+  fail "the run with --overwrite failed"
+[[ ! -e $work/out/round2 ]] || fail "--overwrite left the earlier run's round2"
 JELLY_BENCH=$work/none refuse "jelly-bench not found at $work/none" --quick
 echo "scale_goals.sh: ok"
