@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/temp_dir.hpp"
+
 namespace jelly::cli_testing {
 
 struct Result {
@@ -25,9 +27,18 @@ inline std::string read_file(const std::string& path) {
   return text.str();
 }
 
-// A fresh path in the test's temporary directory.
+// The directory of this test program's files: new for each run, so that no file of an earlier
+// run can be taken for one of this run's (a path below is unique, but the names derived from it,
+// an .h5's .xdmf sidecar, were not: an earlier run's leftover once failed a test), and removed
+// at exit with whatever the tests left in it.
+inline const jelly::testing::TempDir& test_dir() {
+  static const jelly::testing::TempDir dir("jelly_cli");
+  return dir;
+}
+
+// A fresh path in this run's directory.
 inline std::string temp_path(const std::string& suffix) {
-  std::string pattern = ::testing::TempDir() + "jelly_cli_XXXXXX";
+  std::string pattern = test_dir().file("XXXXXX");
   const int fd = mkstemp(pattern.data());
   if (fd >= 0) close(fd);
   std::remove(pattern.c_str());
