@@ -34,10 +34,14 @@ struct Body {
   std::string kind;
   int first_particle = 0, num_particles = 0;
   int first_spring = 0, num_springs = 0;
-  Real spacing = 0;                   // typical distance between neighbouring particles (m)
-  Real radius = 0;                    // contact radius of its particles (m)
-  Surface surface;                    // global particle indices
-  std::vector<ParticleGroup> groups;  // global particle indices
+  Real spacing = 0;  // typical distance between neighbouring particles (m)
+  Real radius = 0;   // contact radius of its particles (m)
+  // The body's motion at the start (initial_state): every particle moves with
+  // velocity + angular_velocity x (x - c), c the body's centre of mass at rest.
+  Vec3 velocity = Vec3::Zero();          // m/s
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s
+  Surface surface;                       // global particle indices
+  std::vector<ParticleGroup> groups;     // global particle indices
 
   int end_particle() const { return first_particle + num_particles; }
   int end_spring() const { return first_spring + num_springs; }

@@ -65,6 +65,13 @@ void Model::validate() const {
   require(rest_position.size() == 3 * n, "rest_position.size", rest_position.size(),
           "3 x the number of particles");
   require(gravity.allFinite(), "gravity", gravity.transpose(), "finite components");
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    const std::string at = "bodies[" + std::to_string(k) + "].";
+    require(bodies[k].velocity.allFinite(), at + "velocity", bodies[k].velocity.transpose(),
+            "finite components (m/s)");
+    require(bodies[k].angular_velocity.allFinite(), at + "angular_velocity",
+            bodies[k].angular_velocity.transpose(), "finite components (rad/s)");
+  }
   for (int s = 0; s < springs.size(); ++s) {
     const int a = springs.a[s], b = springs.b[s];
     const Real l0 = springs.rest_length[s], ks = springs.ks[s], kd = springs.kd[s];
@@ -99,6 +106,24 @@ void Model::validate() const {
   for (std::size_t k = 0; k < external_forces.size(); ++k) {
     external_forces[k].validate(n, "external_forces[" + std::to_string(k) + "].");
   }
+}
+
+State initial_state(const Model& model) {
+  State state = rest_state(model);
+  for (const Body& b : model.bodies) {
+    if (b.velocity.isZero() && b.angular_velocity.isZero()) continue;
+    Vec3 center = Vec3::Zero();
+    Real mass = 0;
+    for (int i = b.first_particle; i < b.end_particle(); ++i) {
+      center += model.mass[i] * particle(model.rest_position, i);
+      mass += model.mass[i];
+    }
+    center /= mass;
+    for (int i = b.first_particle; i < b.end_particle(); ++i)
+      particle(state.v, i) =
+          b.velocity + b.angular_velocity.cross(particle(model.rest_position, i) - center);
+  }
+  return state;
 }
 
 State rest_state(const Model& model) {

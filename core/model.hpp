@@ -43,5 +43,8 @@ struct Model {
 
 // The model at rest in its construction pose, at time 0.
 State rest_state(const Model& model);
+// The model in its construction pose at time 0, each body moving as its velocity and
+// angular_velocity say (at rest when they are zero).
+State initial_state(const Model& model);
 
 }  // namespace jelly

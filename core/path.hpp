@@ -1,7 +1,8 @@
 #pragma once
 // A prescribed translation as a function of time, offset(0) = 0: what drives pinned particles
 // and moving obstacles. Fixed; the elevator's cycle of constant-acceleration phases along an
-// axis; keyframes joined by straight segments; or a sinusoidal oscillation.
+// axis; keyframes joined by straight segments or by cubic segments with continuous velocity; a
+// sinusoidal oscillation; a circle; or a constant velocity (a controller's target).
 #include <string_view>
 #include <vector>
 
@@ -11,7 +12,7 @@
 
 namespace jelly {
 
-enum class PathKind { kFixed, kPhases, kKeyframes, kOscillation };
+enum class PathKind { kFixed, kPhases, kKeyframes, kOscillation, kCircle, kLinear };
 
 struct PathSample {
   Vec3 offset = Vec3::Zero();
@@ -28,14 +29,29 @@ class Path {
   // held after the last. Throws InputError naming `field` for unsorted times or sizes that differ.
   static Path keyframes(std::vector<Real> times, std::vector<Vec3> offsets,
                         std::string_view field = "keyframes");
+  // The same keyframes joined by cubic Hermite segments: the velocity at a keyframe is the
+  // slope between its neighbours (Catmull-Rom), 0 at the first and last keyframes and at t = 0
+  // (offset 0), so the velocity is continuous and the path starts and ends at rest.
+  static Path cubic_keyframes(std::vector<Real> times, std::vector<Vec3> offsets,
+                              std::string_view field = "keyframes");
+  // A circle about the point `center` (relative to where the path starts) and `axis`, one turn
+  // per `period` seconds, counter-clockwise about axis (right-hand rule); the radius is the
+  // distance from the start to the axis through center. Throws InputError naming `field` for a
+  // zero axis, a radius of 0, or a period that is not finite and > 0.
+  static Path circle(const Vec3& center, const Vec3& axis, Real period,
+                     std::string_view field = "circle");
+  // offset = velocity t (a target moving at a constant velocity; Simulator::set_pin_target).
+  static Path linear(const Vec3& velocity, std::string_view field = "linear");
   // amplitude * (sin(2 pi f t + phase) - sin(phase)).
   static Path oscillation(const Vec3& amplitude, Real frequency, Real phase = 0,
                           std::string_view field = "oscillation");
 
   // Scene JSON: "fixed"; {"kind": "phases", "axis": [0, 1, 0], "phases": [{"duration": 2,
   // "acceleration": 3, "stop_at_end": true}, ...] or "seed"}; {"kind": "keyframes", "times":
-  // [...], "offsets": [[x, y, z], ...]}; {"kind": "oscillation", "amplitude": [x, y, z],
-  // "frequency": 1, "phase": 0}. Throws InputError naming `path`.
+  // [...], "offsets": [[x, y, z], ...], "interpolation": "linear" or "cubic"}; {"kind":
+  // "oscillation", "amplitude": [x, y, z], "frequency": 1, "phase": 0}; {"kind": "circle",
+  // "center": [x, y, z], "axis": [x, y, z], "period": 2}; {"kind": "linear", "velocity": [x, y,
+  // z]}. Throws InputError naming `path`.
   static Path read(const Json& j, const std::string& path);
   Json to_json() const;
 
@@ -49,9 +65,15 @@ class Path {
   const std::vector<Vec3>& offsets() const { return offsets_; }
   const Vec3& amplitude() const { return amplitude_; }
   Real frequency() const { return frequency_; }
+  bool cubic() const { return cubic_; }
+  const Vec3& center() const { return center_; }
+  Real period() const { return period_; }
+  const Vec3& velocity() const { return velocity_; }
   Real phase() const { return phase_; }
 
  private:
+  PathSample sample_cubic(Real t) const;
+
   PathKind kind_ = PathKind::kFixed;
   Vec3 axis_ = Vec3::UnitY();
   ElevatorMotion cycle_;
@@ -59,6 +81,13 @@ class Path {
   std::vector<Vec3> offsets_;
   Vec3 amplitude_ = Vec3::Zero();
   Real frequency_ = 0, phase_ = 0;
+  bool cubic_ = false;                          // keyframes: cubic Hermite segments
+  bool added_start_ = false;                    // cubic: (0, 0) was put before the first keyframe
+  std::vector<Vec3> tangents_;                  // cubic keyframes: velocity at each keyframe
+  Vec3 center_ = Vec3::Zero();                  // circle: centre relative to the start
+  Vec3 e1_ = Vec3::Zero(), e2_ = Vec3::Zero();  // circle: -center and axis x (-center)
+  Real period_ = 0;
+  Vec3 velocity_ = Vec3::Zero();  // linear
 };
 
 std::string_view path_kind_name(PathKind kind);

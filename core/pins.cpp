@@ -28,6 +28,36 @@ void Pins::add_fixed(int particle, const Vec3& anchor) {
   add(particle, anchor, fixed);
 }
 
+int Pins::find(int particle) const {
+  const auto at = std::find(particles.begin(), particles.end(), particle);
+  return at == particles.end() ? -1 : static_cast<int>(at - particles.begin());
+}
+
+void Pins::set(int particle, const Vec3& anchor, Path p) {
+  const int k = find(particle);
+  if (k < 0) {
+    particles.push_back(particle);
+    anchors.push_back(anchor);
+    path.push_back(add_path(std::move(p)));
+    return;
+  }
+  anchors[k] = anchor;
+  const int shared = static_cast<int>(std::count(path.begin(), path.end(), path[k]));
+  if (shared == 1)
+    paths[path[k]] = std::move(p);
+  else
+    path[k] = add_path(std::move(p));
+}
+
+bool Pins::remove(int particle) {
+  const int k = find(particle);
+  if (k < 0) return false;
+  particles.erase(particles.begin() + k);
+  anchors.erase(anchors.begin() + k);
+  path.erase(path.begin() + k);
+  return true;
+}
+
 bool Pins::all_fixed() const {
   return std::all_of(path.begin(), path.end(), [&](int p) { return paths[p].is_fixed(); });
 }

@@ -24,6 +24,14 @@ struct Pins {
   // twice keeps its first pin.
   void add(int particle, const Vec3& anchor, int path_index);
   void add_fixed(int particle, const Vec3& anchor);
+  // The pin of `particle` (its index k), or -1 when it is not pinned.
+  int find(int particle) const;
+  // Pins `particle` at `anchor` moving along `p`, or gives its pin that anchor and path when it
+  // is pinned already (a path no other pin uses is replaced in place: driving a pin every step
+  // does not grow `paths`).
+  void set(int particle, const Vec3& anchor, Path p);
+  // Frees `particle`; false when it was not pinned.
+  bool remove(int particle);
   bool all_fixed() const;
 
   Vec3 position(int k, Real t) const;

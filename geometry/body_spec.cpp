@@ -116,6 +116,10 @@ void BodySpec::validate(const std::string& prefix) const {
   material.validate(prefix);
   require(std::isfinite(radius) && radius >= 0, prefix + "radius", radius,
           "a finite radius >= 0 m (0 = half the lattice spacing)");
+  require(velocity.allFinite(), prefix + "velocity", velocity.transpose(),
+          "finite components (m/s)");
+  require(angular_velocity.allFinite(), prefix + "angular_velocity", angular_velocity.transpose(),
+          "finite components (rad/s)");
 }
 
 BodySpec BodySpec::read(JsonFields& f) {
@@ -130,6 +134,8 @@ BodySpec BodySpec::read(JsonFields& f) {
   b.material.particle_mass = f.number_or("particle_mass", b.material.particle_mass);
   b.material.density = f.number_or("density", b.material.density);
   b.radius = f.number_or("radius", b.radius);
+  b.velocity = f.vec3_or("velocity", b.velocity);
+  b.angular_velocity = f.vec3_or("angular_velocity", b.angular_velocity);
   if (const Json* pins = f.value("pins")) {
     if (!pins->is_array()) throw InputError(f.path("pins"), json_text(*pins), "a list of pins");
     for (std::size_t i = 0; i < pins->size(); ++i) {
@@ -182,6 +188,8 @@ Json BodySpec::to_json() const {
   j["particle_mass"] = material.particle_mass;
   j["density"] = material.density;
   j["radius"] = radius;
+  if (!velocity.isZero()) j["velocity"] = json_of(velocity);
+  if (!angular_velocity.isZero()) j["angular_velocity"] = json_of(angular_velocity);
   if (!pins.empty()) {
     Json list = Json::array();
     for (const PinSpec& p : pins) {
@@ -221,6 +229,8 @@ void add_body(Model& model, const BodySpec& spec, const std::string& prefix) {
           "a name no other body has");
   const int index =
       model.add_body(spec.name, spec.shape->build(spec.material, prefix), spec.radius);
+  model.bodies[index].velocity = spec.velocity;
+  model.bodies[index].angular_velocity = spec.angular_velocity;
   const Body& body = model.bodies[index];
   for (std::size_t k = 0; k < spec.pins.size(); ++k) {
     const std::string at = prefix + "pins[" + std::to_string(k) + "].";

@@ -50,6 +50,8 @@ struct BodySpec {
   PolymorphicValue<BodyShape> shape;  // the kind's own parameters
   Material material;
   Real radius = 0;  // contact radius of its particles (m); 0 = half the lattice spacing
+  Vec3 velocity = Vec3::Zero();          // m/s at the start, every particle
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s at the start, about the centre of mass
   std::vector<PinSpec> pins;
   std::vector<ExternalForceSpec> forces;
 

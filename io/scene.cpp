@@ -120,7 +120,7 @@ Model make_model(const Scene& scene) {
 
 Simulator make_simulator(const Scene& scene) {
   Model model = make_model(scene);
-  State state = rest_state(model);
+  State state = initial_state(model);
   Simulator sim(std::move(model), std::move(state),
                 make_integrator(scene.integrator.name, scene.integrator.options),
                 simulator_options(scene));

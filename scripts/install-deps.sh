@@ -23,6 +23,8 @@ packages=(
   libgl1-mesa-dri xvfb xauth
   # the Python module jelly (python/): bindings, its tests, sweeps on Dask
   pybind11-dev python3-pybind11 python3-dev python3-pytest python3-distributed python3-pandas
+  # sparse Jacobians of forces written in Python (jelly.Force.jacobians)
+  python3-scipy
 )
 if [ "${1:-}" = "--tests" ]; then
   # The test jelly_paraview (tests/io/paraview_test.py; it skips without them): ParaView and its

@@ -2,6 +2,7 @@
 
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
+#include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
 
 namespace jelly {
@@ -13,10 +14,15 @@ void Dynamics::forces(Real t, const VecX& x, const VecX& v, VecX& f) const {
   else
     compute_forces(*model_, x, v, f);
   if (anchors_) add_anchor_forces(*anchors_, x, v, f);
-  if (!model_->external_forces.empty()) {
-    add_external_forces(model_->external_forces, model_->mass, t, v, f);
-  }
+  add_applied_forces(t, x, v, f);
   contacts_->add_forces(v, f);
+}
+
+void Dynamics::add_applied_forces(Real t, const VecX& x, const VecX& v, VecX& f) const {
+  if (!model_->external_forces.empty())
+    add_external_forces(model_->external_forces, model_->mass, t, v, f);
+  if (forces_)
+    for (const std::shared_ptr<Force>& force : *forces_) force->add_forces(t, x, v, f);
 }
 
 namespace {
@@ -28,7 +34,8 @@ void finish_acceleration(const Model& model, int threads, Real t, VecX& a) {
 }  // namespace
 
 bool Dynamics::springs_and_seed_contacts_only() const {
-  return bands_ != nullptr && anchors_ == nullptr && model_->external_forces.empty();
+  return bands_ != nullptr && anchors_ == nullptr && forces_ == nullptr &&
+         model_->external_forces.empty();
 }
 
 namespace {

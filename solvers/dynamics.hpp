@@ -5,6 +5,7 @@
 // their paths. With a seed_framework terrain, an evaluation also runs the course framework's
 // collision handler on its own state (stage_acceleration()).
 #include <jelly/core/anchor_springs.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
 
@@ -20,10 +21,12 @@ class Dynamics {
   // (may be null) are added to the forces, and implicit integrators add their Jacobian;
   // `threads` (>= 1) is how many threads the force loop and the integrators' own loops may use;
   // `body_contact` (may be null: no contact between bodies) is for integrators that resolve it
-  // inside their step (Integrator::resolves_body_contact()).
+  // inside their step (Integrator::resolves_body_contact()); `extra_forces` (may be null):
+  // forces added to the model's at every evaluation (Force plugins, core/force.hpp).
   Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains = nullptr,
            const SpringBands* bands = nullptr, const AnchorSprings* anchors = nullptr,
-           int threads = 1, BodyContact* body_contact = nullptr)
+           int threads = 1, BodyContact* body_contact = nullptr,
+           const ForceList* extra_forces = nullptr)
       : model_(&model),
         contacts_(&contacts),
         terrains_(terrains),
@@ -31,12 +34,17 @@ class Dynamics {
         anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr),
         threads_(threads > 1 ? threads : 1),
         body_contact_(body_contact),
+        forces_(extra_forces != nullptr && !extra_forces->empty() ? extra_forces : nullptr),
         in_evaluation_contact_(terrains != nullptr &&
                                ContactSolver::has_in_evaluation_contact(*terrains)) {}
 
   // f(t, x, v): size 3N, no allocation. Pinned particles get the forces as if free (an
   // implicit method constrains them itself).
   void forces(Real t, const VecX& x, const VecX& v, VecX& f) const;
+  // f += the forces applied from outside the springs: the model's external forces and the
+  // added Force plugins (not gravity, the springs or contact). For methods that treat these
+  // explicitly while they handle the springs themselves (xpbd).
+  void add_applied_forces(Real t, const VecX& x, const VecX& v, VecX& f) const;
   // a = M^-1 f(t, x, v), except that pinned particles get their path's acceleration.
   void acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const;
   // The evaluation of an explicit method's stage at time t (docs/contact.md, seed_framework):
@@ -61,13 +69,15 @@ class Dynamics {
   BodyContact* body_contact() const { return body_contact_; }
   // The anchor springs, or null when there are none.
   const AnchorSprings* anchors() const { return anchors_; }
+  // The added Force plugins, or null when there are none.
+  const ForceList* added_forces() const { return forces_; }
   long force_evaluations() const { return evaluations_; }
   // Threads the integrator may use for its own loops (results do not depend on it).
   int threads() const { return threads_; }
 
  private:
   // True when the forces are the bands' (gravity, springs, dampers) and the seed contact terms:
-  // no anchors or external forces.
+  // no anchors, external or added forces.
   bool springs_and_seed_contacts_only() const;
 
   const Model* model_;
@@ -77,6 +87,7 @@ class Dynamics {
   const AnchorSprings* anchors_;
   int threads_;
   BodyContact* body_contact_;
+  const ForceList* forces_;
   bool in_evaluation_contact_;
   mutable long evaluations_ = 0;
 };

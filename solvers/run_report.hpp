@@ -2,6 +2,7 @@
 // What a run returns: how it ended, where, and what it cost.
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <jelly/solvers/integrators/integrator.hpp>
 
@@ -26,6 +27,9 @@ struct RunReport {
   double wall_seconds = 0;
   long force_evaluations = 0;
   Statistics statistics;  // the integrator's counters
+  // What the caller should know that is not a warning: an added force without Jacobians that
+  // an implicit integrator treats explicitly within its step, said once per simulator.
+  std::vector<std::string> notes;
 
   // Reached the requested time (with or without warnings).
   bool ok() const {

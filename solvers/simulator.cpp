@@ -48,6 +48,126 @@ void Simulator::add_terrain(std::unique_ptr<Terrain> terrain) {
   terrains_.push_back(std::move(terrain));
 }
 
+void Simulator::remove_terrain(int index) {
+  require(index >= 0 && index < static_cast<int>(terrains_.size()), "terrain index", index,
+          "an index in [0, " + std::to_string(terrains_.size()) + ")");
+  terrains_.erase(terrains_.begin() + index);
+  // Seed contacts name no terrain; the implicit solve's active set is rebuilt each step.
+}
+
+ForceHandle Simulator::add_force(std::shared_ptr<Force> force) {
+  require(force != nullptr, "force", "null", "a force");
+  force->validate(model_.num_particles());
+  forces_.push_back(std::move(force));
+  force_handles_.push_back(next_force_handle_);
+  return next_force_handle_++;
+}
+
+bool Simulator::remove_force(ForceHandle handle) {
+  const auto at = std::find(force_handles_.begin(), force_handles_.end(), handle);
+  if (at == force_handles_.end()) return false;
+  const auto k = at - force_handles_.begin();
+  forces_.erase(forces_.begin() + k);
+  force_handles_.erase(at);
+  return true;
+}
+
+namespace {
+std::string body_field(const Model& model, int body) {
+  require(body >= 0 && body < model.num_bodies(), "body", body,
+          "a body index in [0, " + std::to_string(model.num_bodies()) + ")");
+  return "bodies[" + std::to_string(body) + "].";
+}
+}  // namespace
+
+void Simulator::set_spring_coefficients(int body, SpringType type, SpringCoefficients c) {
+  const std::string at =
+      body_field(model_, body) + "springs." + std::string(spring_type_name(type)) + ".";
+  require(std::isfinite(c.ks) && c.ks >= 0, at + "ks", c.ks, "a finite stiffness >= 0 N/m");
+  require(std::isfinite(c.kd) && c.kd >= 0, at + "kd", c.kd, "a finite damping >= 0 N s/m");
+  const Body& b = model_.bodies[body];
+  Springs& springs = model_.springs;
+  for (int s = b.first_spring; s < b.end_spring(); ++s) {
+    if (springs.type[s] != type) continue;
+    springs.ks[s] = c.ks;
+    springs.kd[s] = c.kd;
+  }
+  model_changed();
+}
+
+void Simulator::set_gravity(const Vec3& gravity) {
+  require(gravity.allFinite(), "gravity", gravity.transpose(), "finite components (m/s^2)");
+  model_.gravity = gravity;
+  model_changed();
+}
+
+void Simulator::set_particle_mass(int body, Real particle_mass) {
+  const std::string at = body_field(model_, body) + "particle_mass";
+  require(std::isfinite(particle_mass) && particle_mass > 0, at, particle_mass,
+          "a finite mass > 0 kg");
+  const Body& b = model_.bodies[body];
+  model_.mass.segment(b.first_particle, b.num_particles).setConstant(particle_mass);
+  model_changed();
+}
+
+void Simulator::set_integrator(std::unique_ptr<Integrator> integrator) {
+  require(integrator != nullptr, "integrator", "null", "an integrator");
+  for (std::size_t k = 0; k < terrains_.size(); ++k) {
+    if (terrains_[k]->contact().model == ContactModel::kSeedFramework &&
+        !integrator->supports_in_evaluation_contact()) {
+      throw InputError("terrains[" + std::to_string(k) + "].contact.model", "\"seed_framework\"",
+                       in_evaluation_contact_requirement(integrator->name()));
+    }
+  }
+  integrator_ = std::move(integrator);
+}
+
+void Simulator::set_dt(Real dt) {
+  SimulatorOptions o = options_;
+  o.dt = dt;
+  o.validate();
+  options_ = o;
+}
+
+void Simulator::set_output_interval(Real interval) {
+  SimulatorOptions o = options_;
+  o.output_interval = interval;
+  o.validate();
+  options_ = o;
+  next_output_ = state_.t;  // the next frame now, then every interval
+}
+
+namespace {
+void require_particle(const Model& model, int particle) {
+  require(particle >= 0 && particle < model.num_particles(), "pin particle", particle,
+          "a particle index in [0, " + std::to_string(model.num_particles()) + ")");
+}
+}  // namespace
+
+void Simulator::set_pin(int particle, const Vec3& anchor, Path path) {
+  require_particle(model_, particle);
+  require(anchor.allFinite(), "pin anchor", anchor.transpose(), "finite components (m)");
+  model_.pins.set(particle, anchor, std::move(path));
+}
+
+void Simulator::set_pin_target(int particle, const Vec3& position, const Vec3& velocity) {
+  require_particle(model_, particle);
+  require(model_.pins.find(particle) >= 0, "pin particle", particle,
+          "a pinned particle (set_pin pins one)");
+  require(position.allFinite(), "pin target", position.transpose(), "finite components (m)");
+  require(velocity.allFinite(), "pin target velocity", velocity.transpose(),
+          "finite components (m/s)");
+  // position + velocity (t - now) = anchor + velocity t with anchor = position - velocity now.
+  model_.pins.set(particle, position - velocity * state_.t, Path::linear(velocity));
+}
+
+bool Simulator::remove_pin(int particle) { return model_.pins.remove(particle); }
+
+void Simulator::model_changed() {
+  bands_ = std::make_unique<const SpringBands>(model_);
+  for (const std::shared_ptr<Force>& force : forces_) force->validate(model_.num_particles());
+}
+
 void Simulator::set_body_contact(const BodyContactParams& params) {
   body_contact_ = BodyContact(params);
 }
@@ -226,10 +346,21 @@ StepResult Simulator::step() {
   const int threads = parallel::resolve_threads(options_.threads);
   const bool bodies = body_contact_.active(model_);
   const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_, threads,
-                          bodies ? &body_contact_ : nullptr);
+                          bodies ? &body_contact_ : nullptr, &forces_);
   parallel::copy(threads, state_.x, before_.x);
   parallel::copy(threads, state_.v, before_.v);
-  StepResult result = integrator_->step(dynamics, state_, options_.dt);
+  before_.t = state_.t;
+  StepResult result;
+  try {
+    result = integrator_->step(dynamics, state_, options_.dt);
+  } catch (...) {
+    // A force of the user's failed: back to the last completed step.
+    parallel::copy(threads, before_.x, state_.x);
+    parallel::copy(threads, before_.v, state_.v);
+    state_.t = before_.t;
+    force_evaluations_ += dynamics.force_evaluations();
+    throw;
+  }
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
   // Bodies first, then the terrains: a terrain has the last word on where a particle may be.
@@ -247,6 +378,26 @@ void Simulator::emit_frame() {
   ++frames_;
   if (options_.output_interval > 0) {
     while (next_output_ <= state_.t + 1e-9 * options_.dt) next_output_ += options_.output_interval;
+  }
+}
+
+void Simulator::note_forces(RunReport& report) {
+  for (const std::shared_ptr<Force>& force : forces_) {
+    std::string note;
+    if (integrator_->uses_force_jacobians()) {
+      if (force->has_jacobian()) continue;
+      note = "force '" + force->name() +
+             "' gives no Jacobian: " + std::string(integrator_->name()) +
+             " treats it explicitly within each step";
+    } else if (integrator_->is_implicit()) {
+      note = "force '" + force->name() + "': " + std::string(integrator_->name()) +
+             " treats added forces explicitly within each step";
+    } else {
+      continue;
+    }
+    if (std::find(noted_.begin(), noted_.end(), note) != noted_.end()) continue;
+    noted_.push_back(note);
+    report.notes.push_back(std::move(note));
   }
 }
 
@@ -286,6 +437,7 @@ RunReport Simulator::run_until(Real t_end) {
   if (report.status == RunStatus::kCompleted)
     warn_of_tolerance_misses(misses_before, integrator_->tolerance_misses(), report);
   report.force_evaluations = force_evaluations_ - evaluations_before;
+  note_forces(report);
   report.statistics = integrator_->statistics();
   if (body_contact_.active(model_)) {
     const BodyContact::Stats& b = body_contact_.stats();

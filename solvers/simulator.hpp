@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
@@ -118,6 +120,9 @@ struct SimulatorSnapshot {
   std::vector<Real> integrator_state;
 };
 
+// Names a force added to a simulator (Simulator::add_force), for removing it.
+using ForceHandle = long;
+
 class Simulator {
  public:
   // Throws InputError for an invalid model, state size or option.
@@ -129,6 +134,43 @@ class Simulator {
 
   // Throws InputError for a seed_framework terrain when the integrator does not support it.
   void add_terrain(std::unique_ptr<Terrain> terrain);
+  // Removes terrains()[index] (the active contacts are kept for the others). Throws InputError
+  // for an index out of range.
+  void remove_terrain(int index);
+
+  // Forces of your own (core/force.hpp): evaluated at every force evaluation of every
+  // integrator, after the model's own, until removed. Returns the handle remove_force() takes.
+  // Throws InputError for null or a force whose validate() refuses this model.
+  ForceHandle add_force(std::shared_ptr<Force> force);
+  // False when no force has this handle.
+  bool remove_force(ForceHandle handle);
+  const ForceList& forces() const { return forces_; }
+
+  // Live edits of the model between steps, validated like a scene (an invalid value throws
+  // InputError naming the scene's field and changes nothing). The next step uses them; a
+  // checkpoint taken after them holds the edited model (model()).
+  // ks and kd of every spring of `type` in body `body` (N/m, N s/m; finite, >= 0).
+  void set_spring_coefficients(int body, SpringType type, SpringCoefficients coefficients);
+  void set_gravity(const Vec3& gravity);
+  // Every particle of body `body` gets `particle_mass` (kg, finite, > 0).
+  void set_particle_mass(int body, Real particle_mass);
+  // Replaces the integrator, keeping the model, terrains, forces, pins, observers, options and
+  // state; its internal state starts afresh. Throws InputError for null or for an integrator
+  // that cannot handle a terrain of this simulator (seed_framework).
+  void set_integrator(std::unique_ptr<Integrator> integrator);
+  // Sets options().dt, options().output_interval (validated like SimulatorOptions).
+  void set_dt(Real dt);
+  void set_output_interval(Real interval);
+  // Pins particle `particle` (global index) to move along `path` from `anchor` (its position
+  // at t = 0 of the path), or re-pins it when it is pinned already. Throws InputError for an
+  // index out of range or a non-finite anchor.
+  void set_pin(int particle, const Vec3& anchor, Path path);
+  // Drives pinned particle `particle` from now on: at time t >= now it is at
+  // position + velocity (t - now) (the controller's target for the next steps). Throws
+  // InputError when the particle is not pinned or a value is not finite.
+  void set_pin_target(int particle, const Vec3& position, const Vec3& velocity = Vec3::Zero());
+  // Frees a pinned particle; false when it was not pinned.
+  bool remove_pin(int particle);
   // Contact between bodies and within a body (default: between bodies, when there are two or
   // more). Throws InputError for invalid parameters.
   void set_body_contact(const BodyContactParams& params);
@@ -150,7 +192,8 @@ class Simulator {
   // check divergence (run_until does).
   StepResult step();
   // Steps until t_end (the last step lands within dt / 2 of it), calling observers, and stops
-  // early on divergence or integrator failure.
+  // early on divergence or integrator failure. An exception from a force of the user's leaves
+  // the simulator at the last completed step and propagates.
   RunReport run_until(Real t_end);
 
   const Model& model() const { return model_; }
@@ -185,6 +228,11 @@ class Simulator {
 
  private:
   void emit_frame();
+  // After an edit of model_: the force loop's bands again, and the model validated.
+  void model_changed();
+  // The notes of this run (forces an implicit integrator takes explicitly), once per force and
+  // integrator.
+  void note_forces(RunReport& report);
 
   Model model_;
   std::unique_ptr<const SpringBands> bands_;  // the vectorised force loop over model_'s springs
@@ -197,6 +245,10 @@ class Simulator {
   State before_;  // the state at the start of the current step
   ObserverList observers_;
   AnchorSprings anchors_;
+  ForceList forces_;
+  std::vector<ForceHandle> force_handles_;  // parallel to forces_
+  ForceHandle next_force_handle_ = 1;
+  std::vector<std::string> noted_;  // the notes given so far
   long total_steps_ = 0;
   long force_evaluations_ = 0;
   long frames_ = 0;

@@ -11,7 +11,7 @@ from typing import Any as _Any, Optional as _Optional, Union as _Union
 from . import _jelly
 from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module folder)
     AnchorSpring, ArkodeOptions, Body, Checkpoint, ContactParams, CubeSpec, DivergenceGuard,
-    Elevator, ElevatorSpec, ExternalForce, FitOptions, FitResult, FittedParameter, H5Recorder,
+    Elevator, ElevatorSpec, ExternalForce, FitOptions, Force, FitResult, FittedParameter, H5Recorder,
     ImplicitEulerOptions, InputError, Integrator, IntegratorOptions, Model, Observer, Pins, Plane,
     RecorderOptions, Recording, RunReport, SimulatorOptions, SimulatorSnapshot, Simulator,
     SpringCoefficients, Springs, SpringType, State, StepResult, Surface, Terrain, __version__,
@@ -19,7 +19,7 @@ from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module f
     contact_models, cube_index, cube_particle_count, cube_spring_count, describe_recording,
     elastic_energy, gravitational_energy, integrator_infos, integrator_names, kinetic_energy,
     linear_momentum, make_model, make_terrain, parse_free_parameters, read_checkpoint, read_recording,
-    rest_state, restore, scene_to_json, spring_type_names, terrain_kinds, total_energy,
+    initial_state, rest_state, restore, scene_to_json, spring_type_names, terrain_kinds, total_energy,
     write_xdmf_for_recording)
 from ._scene import Scene, load_scene
 from ._sweep import sweep, sweep_points

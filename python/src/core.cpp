@@ -1,8 +1,11 @@
 // core/: the model (masses, springs as NumPy arrays, its bodies with their render surfaces,
 // pins and external forces), the state, energies and momenta.
+#include <map>
+
 #include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/body.hpp>
 #include <jelly/core/external_force.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/pins.hpp>
@@ -43,6 +46,97 @@ py::array vertices_of(const Surface& surface, const py::object& x) {
   surface.vertices(flat, out);
   return py::array(py::cast(std::move(out)));
 }
+
+// A Force subclassed in Python: forces(self, t, x, v, f) adds into f ((N, 3), float64); the
+// optional jacobians(self, t, x, v) returns (dfdx, dfdv), each a SciPy sparse matrix (anything
+// with tocoo()), a dense (3N, 3N) array or None. Called from the stepping thread with the GIL
+// released: each call takes it back. x and v are read-only copies; f starts at zero and is
+// added to the simulator's forces.
+class PyForce : public Force {
+ public:
+  std::string name() const override {
+    py::gil_scoped_acquire gil;
+    const py::object self = py::cast(static_cast<const Force*>(this));
+    if (py::hasattr(self, "name") && py::isinstance<py::str>(self.attr("name")))
+      return self.attr("name").cast<std::string>();
+    return py::str(self.get_type().attr("__name__")).cast<std::string>();
+  }
+  void add_forces(Real t, const VecX& x, const VecX& v, VecX& f) const override {
+    py::gil_scoped_acquire gil;
+    const py::function forces = py::get_override(static_cast<const Force*>(this), "forces");
+    if (!forces) throw InputError("jelly.Force subclasses must override forces(self, t, x, v, f)");
+    const py::ssize_t n = x.size() / 3;
+    py::array_t<Real> xa({n, py::ssize_t{3}}), va({n, py::ssize_t{3}}), fa({n, py::ssize_t{3}});
+    std::copy(x.data(), x.data() + x.size(), xa.mutable_data());
+    std::copy(v.data(), v.data() + v.size(), va.mutable_data());
+    std::fill(fa.mutable_data(), fa.mutable_data() + f.size(), 0.0);
+    for (py::array_t<Real>* a : {&xa, &va})
+      py::detail::array_proxy(a->ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+    forces(t, xa, va, fa);
+    const Real* added = fa.data();
+    for (Eigen::Index k = 0; k < f.size(); ++k) f[k] += added[k];
+  }
+  bool has_jacobian() const override {
+    py::gil_scoped_acquire gil;
+    return static_cast<bool>(py::get_override(static_cast<const Force*>(this), "jacobians"));
+  }
+  void add_jacobian(Real t, const VecX& x, const VecX& v, ForceJacobian& jacobian) const override {
+    py::gil_scoped_acquire gil;
+    const py::function jacobians = py::get_override(static_cast<const Force*>(this), "jacobians");
+    if (!jacobians) return;
+    const py::ssize_t n = x.size() / 3;
+    py::array_t<Real> xa({n, py::ssize_t{3}}), va({n, py::ssize_t{3}});
+    std::copy(x.data(), x.data() + x.size(), xa.mutable_data());
+    std::copy(v.data(), v.data() + v.size(), va.mutable_data());
+    const py::object result = jacobians(t, xa, va);
+    if (result.is_none()) return;
+    if (!py::isinstance<py::tuple>(result) || py::len(result) != 2)
+      throw InputError("force '" + name() + "' jacobians()", py::repr(result).cast<std::string>(),
+                       "a tuple (dfdx, dfdv) of sparse matrices, arrays or None");
+    // Entries grouped into 3x3 blocks of particles, in a sorted map (deterministic order).
+    std::map<std::pair<int, int>, ForceJacobian::Block> blocks;
+    for (int which = 0; which < 2; ++which) {
+      const py::object m = py::tuple(result)[which];
+      if (m.is_none()) continue;
+      const std::string field = "force '" + name() + "' jacobians()[" + std::to_string(which) + "]";
+      const py::object coo = py::hasattr(m, "tocoo") ? m.attr("tocoo")() : py::object();
+      std::vector<long> rows, cols;
+      std::vector<Real> values;
+      if (coo) {
+        rows = py::cast<std::vector<long>>(coo.attr("row").attr("tolist")());
+        cols = py::cast<std::vector<long>>(coo.attr("col").attr("tolist")());
+        values = py::cast<std::vector<Real>>(coo.attr("data").attr("tolist")());
+        const py::tuple shape = coo.attr("shape");
+        require(shape[0].cast<long>() == 3 * n && shape[1].cast<long>() == 3 * n, field + " shape",
+                py::repr(shape).cast<std::string>(), "(3N, 3N) with N = " + std::to_string(n));
+      } else {
+        const auto dense = py::array_t<Real, py::array::c_style | py::array::forcecast>::ensure(m);
+        require(dense && dense.ndim() == 2 && dense.shape(0) == 3 * n && dense.shape(1) == 3 * n,
+                field, py::repr(m).cast<std::string>().substr(0, 60),
+                "a (3N, 3N) SciPy sparse matrix or array with N = " + std::to_string(n));
+        for (long r = 0; r < 3 * n; ++r)
+          for (long c = 0; c < 3 * n; ++c)
+            if (const Real value = dense.at(r, c); value != 0) {
+              rows.push_back(r);
+              cols.push_back(c);
+              values.push_back(value);
+            }
+      }
+      for (std::size_t k = 0; k < values.size(); ++k) {
+        require(rows[k] >= 0 && rows[k] < 3 * n && cols[k] >= 0 && cols[k] < 3 * n,
+                field + " entry",
+                "(" + std::to_string(rows[k]) + ", " + std::to_string(cols[k]) + ")",
+                "indices in [0, 3N)");
+        ForceJacobian::Block& b =
+            blocks[{static_cast<int>(rows[k] / 3), static_cast<int>(cols[k] / 3)}];
+        b.i = static_cast<int>(rows[k] / 3);
+        b.j = static_cast<int>(cols[k] / 3);
+        (which == 0 ? b.dfdx : b.dfdv)(rows[k] % 3, cols[k] % 3) += values[k];
+      }
+    }
+    for (const auto& [at, b] : blocks) jacobian.add(b.i, b.j, b.dfdx, b.dfdv);
+  }
+};
 
 }  // namespace
 
@@ -419,6 +513,50 @@ void bind_core(py::module_& m) {
 
   m.def("rest_state", &rest_state, py::arg("model"),
         "The model at rest in its construction pose, at t = 0.");
+  m.def("initial_state", &initial_state, py::arg("model"),
+        "The model in its construction pose at t = 0, each body moving with its scene's "
+        "velocity and angular_velocity (at rest when they are zero).");
+  py::class_<Force, PyForce, std::shared_ptr<Force>>(
+      m, "Force",
+      "A force of your own, evaluated at every force evaluation of every integrator (each RK4 "
+      "stage, each Newton iteration). Subclass it: override forces(self, t, x, v, f), which adds "
+      "the force at time t on positions x and velocities v ((N, 3) read-only arrays) into f "
+      "((N, 3), in place); optionally jacobians(self, t, x, v) returning (dfdx, dfdv), each a "
+      "(3N, 3N) SciPy sparse matrix, a dense array or None, which implicit_euler takes into its "
+      "solve (without them it treats the force explicitly within its step and the run report's "
+      "notes say so). An optional str attribute `name` names it in messages. Add it with "
+      "Simulator.add_force; an exception raised in it stops the run with that exception, the "
+      "simulator left at the last completed step.")
+      .def(py::init<>(), "A force; override forces (and optionally jacobians).")
+      .def(
+          "forces",
+          [](const Force&, Real, const py::object&, const py::object&, const py::object&) {
+            throw InputError("jelly.Force subclasses must override forces(self, t, x, v, f)");
+          },
+          py::arg("t"), py::arg("x"), py::arg("v"), py::arg("f"),
+          "Adds the force at time t on positions x and velocities v ((N, 3), read-only) into f "
+          "((N, 3), in place). Override it.")
+      .def(
+          "jacobians",
+          [](const Force&, Real, const py::object&, const py::object&) { return py::none(); },
+          py::arg("t"), py::arg("x"), py::arg("v"),
+          "(dfdx, dfdv) at (t, x, v), each a (3N, 3N) SciPy sparse matrix, a dense array or "
+          "None; None (this default) when the force gives no Jacobians. Override it to give "
+          "them.")
+      .def(
+          "check_jacobians",
+          [](const Force& f, Real t, const DoubleArray& x, const DoubleArray& v, Real step) {
+            VecX xv(x.size()), vv(v.size());
+            assign_n3(xv, x, "x");
+            assign_n3(vv, v, "v");
+            const JacobianCheck c = check_force_jacobian(f, t, xv, vv, step);
+            return py::make_tuple(c.dfdx_error, c.dfdv_error);
+          },
+          py::arg("t"), py::arg("x"), py::arg("v"), py::arg("step") = 1e-6,
+          "The relative errors (dfdx, dfdv) of jacobians() against central differences of "
+          "forces() at (t, x, v): the largest entry of |J - J_fd| over the largest of |J_fd| "
+          "(dense: for small models).");
+
   py::class_<AnchorSpring>(m, "AnchorSpring",
                            "A spring from a particle to a point in space (a pull from outside the "
                            "model, as the viewer's mouse drag): f = -k (x_p - target) - c v_p.")

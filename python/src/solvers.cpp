@@ -1,5 +1,6 @@
 // solvers/: integrators by name with their options, the Simulator (step, run_until with Python
 // observers, the state as NumPy views), run reports. The GIL is released while C++ steps.
+#include <memory>
 #include <optional>
 
 #include <jelly/core/json.hpp>
@@ -105,8 +106,121 @@ py::dict report_dict(const RunReport& r) {
   d["reason"] = r.reason;
   d["wall_seconds"] = r.wall_seconds;
   d["force_evaluations"] = r.force_evaluations;
+  d["notes"] = r.notes;
   d["statistics"] = statistics_dict(r.statistics);
   return d;
+}
+
+// A body given by index or by name, as its index; InputError naming `field` otherwise.
+int body_index(const Simulator& sim, const py::object& body) {
+  if (py::isinstance<py::str>(body)) {
+    const std::string name = body.cast<std::string>();
+    const Model& m = sim.model();
+    for (int k = 0; k < m.num_bodies(); ++k)
+      if (m.bodies[k].name == name) return k;
+    throw InputError("body", "\"" + name + "\"", "the name or index of a body of the model");
+  }
+  return body.cast<int>();
+}
+
+SpringType spring_type_of(const py::object& type) {
+  if (py::isinstance<SpringType>(type)) return type.cast<SpringType>();
+  const std::string name = py::str(type).cast<std::string>();
+  for (int t = 0; t < kSpringTypeCount; ++t)
+    if (spring_type_name(static_cast<SpringType>(t)) == name) return static_cast<SpringType>(t);
+  throw InputError("spring type", "\"" + name + "\"", "\"structural\", \"shear\" or \"bending\"");
+}
+
+// The live model's edits, the added forces and the pins driven from code.
+void bind_live_model(py::class_<Simulator>& simulator) {
+  simulator
+      .def(
+          "add_force",
+          [](py::object self, const std::shared_ptr<Force>& force) {
+            const ForceHandle handle = self.cast<Simulator&>().add_force(force);
+            // The Python object stays alive with the simulator (its overrides live there).
+            if (!py::hasattr(self, "_forces")) self.attr("_forces") = py::dict();
+            self.attr("_forces")[py::int_(handle)] = py::cast(force);
+            return handle;
+          },
+          py::arg("force"),
+          "Adds a jelly.Force, evaluated at every force evaluation of every integrator until "
+          "removed; returns its handle (an int) for remove_force.")
+      .def(
+          "remove_force",
+          [](py::object self, ForceHandle handle) {
+            const bool removed = self.cast<Simulator&>().remove_force(handle);
+            if (removed) self.attr("_forces").attr("pop")(py::int_(handle));
+            return removed;
+          },
+          py::arg("handle"), "Removes an added force; False when no force has this handle.")
+      .def_property_readonly(
+          "forces",
+          [](py::object self) {
+            py::list out;
+            if (py::hasattr(self, "_forces"))
+              for (const auto& item : self.attr("_forces").cast<py::dict>())
+                out.append(item.second);
+            return out;
+          },
+          "The added forces, in the order they act.")
+      .def(
+          "set_spring_coefficients",
+          [](Simulator& s, const py::object& body, const py::object& type, Real ks, Real kd) {
+            s.set_spring_coefficients(body_index(s, body), spring_type_of(type), {ks, kd});
+          },
+          py::arg("body"), py::arg("type"), py::arg("ks"), py::arg("kd"),
+          "Sets ks (N/m) and kd (N s/m) of every spring of `type` (\"structural\", \"shear\", "
+          "\"bending\") in `body` (index or name), for the next steps. Raises InputError naming "
+          "the scene field (bodies[i].springs.<type>.ks) and changes nothing for a bad value.")
+      .def(
+          "set_gravity", [](Simulator& s, const Vec3& g) { s.set_gravity(g); }, py::arg("gravity"),
+          "Sets gravity (m/s^2, [3]) for the next steps.")
+      .def(
+          "set_particle_mass",
+          [](Simulator& s, const py::object& body, Real mass) {
+            s.set_particle_mass(body_index(s, body), mass);
+          },
+          py::arg("body"), py::arg("particle_mass"),
+          "Gives every particle of `body` (index or name) the mass `particle_mass` (kg, > 0).")
+      .def(
+          "set_integrator",
+          [](Simulator& s, const std::string& name, const IntegratorOptions& options) {
+            s.set_integrator(make_integrator(name, options));
+          },
+          py::arg("name"), py::arg("options") = IntegratorOptions{},
+          "Switches to the named integrator, keeping the model, terrains, forces, pins, "
+          "observers, options and state (its warm starts start afresh).")
+      .def("set_dt", &Simulator::set_dt, py::arg("dt"), "Sets options.dt (s, > 0).")
+      .def("set_output_interval", &Simulator::set_output_interval, py::arg("interval"),
+           "Sets options.output_interval (s, >= 0; 0 = every step); the next frame is now.")
+      .def("remove_terrain", &Simulator::remove_terrain, py::arg("index"),
+           "Removes terrains[index].")
+      .def(
+          "set_pin",
+          [](Simulator& s, int particle, const std::optional<Vec3>& anchor,
+             const py::object& path) {
+            require(particle >= 0 && particle < s.model().num_particles(), "pin particle", particle,
+                    "a particle index in [0, N)");
+            const Vec3 at =
+                anchor ? *anchor : Vec3(s.model().rest_position.segment<3>(3 * particle));
+            s.set_pin(particle, at,
+                      path.is_none() ? Path() : Path::read(json_object_of(path, "path"), "path"));
+          },
+          py::arg("particle"), py::arg("anchor") = py::none(), py::arg("path") = py::none(),
+          "Pins a particle (global index) at `anchor` (default: its rest position), moving "
+          "along `path` (a scene's path object as a dict, e.g. {\"kind\": \"circle\", "
+          "\"center\": [0.5, 0, 0], \"axis\": [0, 1, 0], \"period\": 2}; default fixed).")
+      .def(
+          "set_pin_target",
+          [](Simulator& s, int particle, const Vec3& position, const Vec3& velocity) {
+            s.set_pin_target(particle, position, velocity);
+          },
+          py::arg("particle"), py::arg("position"), py::arg("velocity") = Vec3(Vec3::Zero()),
+          "Drives a pinned particle from now on: at time t it is at position + velocity (t - "
+          "now) (a controller's target, the mouse's drag).")
+      .def("remove_pin", &Simulator::remove_pin, py::arg("particle"),
+           "Frees a pinned particle; False when it was not pinned.");
 }
 
 }  // namespace
@@ -253,6 +367,9 @@ void bind_solvers(py::module_& m) {
       .def_readonly("wall_seconds", &RunReport::wall_seconds, "Wall time of the run (s).")
       .def_readonly("force_evaluations", &RunReport::force_evaluations,
                     "Force evaluations in this run.")
+      .def_readonly("notes", &RunReport::notes,
+                    "What to know that is not a warning (an added force without Jacobians "
+                    "that an implicit integrator treats explicitly), each said once.")
       .def_property_readonly(
           "statistics", [](const RunReport& r) { return statistics_dict(r.statistics); },
           "The integrator's counters at the end, as a dict.")
@@ -280,13 +397,15 @@ void bind_solvers(py::module_& m) {
                     "Contacts of the last step.");
 
   // dynamic_attr: the report of the last run_until is kept on the Python object (report).
-  py::class_<Simulator>(m, "Simulator", py::dynamic_attr(),
-                        "Steps a model among terrains with an integrator. Build it from a Scene, "
-                        "or from a Model, a State, an integrator name and options.")
+  py::class_<Simulator> simulator(
+      m, "Simulator", py::dynamic_attr(),
+      "Steps a model among terrains with an integrator. Build it from a Scene, "
+      "or from a Model, a State, an integrator name and options.");
+  simulator
       .def(py::init([](const Model& model, const std::optional<State>& state,
                        const std::string& integrator, const IntegratorOptions& integrator_options,
                        const SimulatorOptions& options) {
-             return Simulator(model, state ? *state : rest_state(model),
+             return Simulator(model, state ? *state : initial_state(model),
                               make_integrator(integrator, integrator_options), options);
            }),
            py::arg("model"), py::arg("state") = py::none(), py::arg("integrator") = "rk4",
@@ -447,6 +566,7 @@ void bind_solvers(py::module_& m) {
           "angular_momentum",
           [](const Simulator& s) { return angular_momentum(s.model(), s.state()); },
           "Angular momentum about the origin (kg m^2/s), [3].");
+  bind_live_model(simulator);
 }
 
 }  // namespace jelly::python

@@ -67,6 +67,28 @@ bool has_block(const SparseMatrix& a, int i, int j) {
   return std::binary_search(rows + outer[3 * j], rows + outer[3 * j + 1], 3 * i);
 }
 
+// a(i, j) += b for a dense 3x3 block (i, j) of a matrix of such blocks (full storage, sorted
+// rows) that holds it.
+void add_block(SparseMatrix& a, int i, int j, const Mat3& b) {
+  const int* outer = a.outerIndexPtr();
+  const int* rows = a.innerIndexPtr();
+  Real* values = a.valuePtr();
+  for (int c = 0; c < 3; ++c) {
+    const int col = 3 * j + c;
+    const int* at = std::lower_bound(rows + outer[col], rows + outer[col + 1], 3 * i);
+    Real* v = values + (at - rows);
+    for (int r = 0; r < 3; ++r) v[r] += b(r, c);
+  }
+}
+
+// True when an added force gives its Jacobians.
+bool has_force_jacobians(const Dynamics& dynamics) {
+  const ForceList* forces = dynamics.added_forces();
+  if (forces == nullptr) return false;
+  return std::any_of(forces->begin(), forces->end(),
+                     [](const std::shared_ptr<Force>& f) { return f->has_jacobian(); });
+}
+
 }  // namespace
 
 ImplicitLinearSolver auto_linear_solver(int dofs) {
@@ -90,6 +112,13 @@ struct ImplicitEuler::Impl {
   void add_statistics(Statistics& s) const;
   StepResult step(const Dynamics& dynamics, State& state, Real h);
   StepResult prepare(const Dynamics& dynamics, Real h);
+  // The added forces' Jacobian blocks at (t, x, v) into force_jacobian_, and their blocks in
+  // the matrix pattern (a new symbolic analysis only when a block is new).
+  StepResult collect_force_jacobians(const Dynamics& dynamics, const VecX& x, const VecX& v,
+                                     Real t);
+  // The pattern of a_: the springs' blocks, the contact pairs' and the forces' (extra_blocks_
+  // and force_blocks_); analysed again.
+  StepResult rebuild_pattern(const Model& model);
   // A = M - h D - h^2 K (+ anchors, wind drag) and kw_ = K w at (x, v), into a_ or band_.
   StepResult assemble(const Dynamics& dynamics, const VecX& x, const VecX& v, Real t, Real h);
   // The contact filter of the system and its right-hand side (constrain() of ImplicitContact,
@@ -117,14 +146,17 @@ struct ImplicitEuler::Impl {
                                  Real t, Real cg_tolerance = 0, bool resume = false);
   // Newton corrections on the nonlinear backward-Euler equations from v1_.
   StepResult newton(const Dynamics& dynamics, const State& s, Real h);
-  // Wind drag at time t: d(f)/d(v) = -drag on its particles, so A gains h drag on the diagonal.
+  // Wind drag at time t: d(f)/d(v) = -drag on its particles, so A gains h drag on the diagonal
+  // (and 1^T A = 1^T M no longer holds: damped_ says so).
   void add_external_damping_system(const Model& model, Real t, Real h) {
+    damped_ = false;
     if (model.external_forces.empty()) return;
     ensure_size(damping_, model.num_particles());
     damping_.setZero();
     add_external_damping(model.external_forces, t, damping_);
     for (int i = 0; i < model.num_particles(); ++i) {
       if (damping_[i] == 0) continue;
+      damped_ = true;
       if (matrix_free_) {
         band_->add_diagonal(i, h * damping_[i]);
       } else {
@@ -157,12 +189,17 @@ struct ImplicitEuler::Impl {
   bool bodies_seen_ = false;             // the last step's Dynamics had body contact
   bool base_saved_ = false;              // base_values_ / b_base_ hold this step's assembly
   std::vector<std::pair<int, int>> extra_blocks_;  // pair blocks in jacobian_'s pattern
+  ForceJacobian force_jacobian_;                   // the added forces' blocks of this assembly
+  std::vector<std::pair<int, int>> force_blocks_;  // their off-diagonal blocks in the pattern
   std::vector<Real> base_values_;
   VecX b_base_;
   const Terrains* contact_terrains_ = nullptr;  // the terrains contact_ resolves this step
   bool contact_active_ = false;                 // the current step constrains contacts
   bool terrains_seen_ = true;                   // the last step's Dynamics had terrains
-  bool anchored_ = false;                       // the current step's Dynamics has anchor springs
+  // The current step's A has terms off the springs' (anchors, forces' Jacobians, wind drag),
+  // which break 1^T A = 1^T M.
+  bool anchored_ = false;
+  bool damped_ = false;  // the last assembly added wind drag
   Real last_h_ = 0;
   bool have_dv_ = false;
   std::vector<Real> residuals_;
@@ -307,8 +344,10 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       kind == ImplicitLinearSolver::kCg &&
       (automatic || options_.cg_preconditioner == CgPreconditionerKind::kJacobi) &&
       bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_ &&
-      // Contact pairs between bodies add blocks off the springs' bands: the assembled matrix.
-      !(options_.contact == ImplicitContactMode::kImplicit && dynamics.body_contact() != nullptr);
+      // Contact pairs between bodies and added forces' Jacobians add blocks off the springs'
+      // bands: the assembled matrix.
+      !(options_.contact == ImplicitContactMode::kImplicit && dynamics.body_contact() != nullptr) &&
+      !has_force_jacobians(dynamics);
   const auto size_vectors = [&] {
     for (VecX* w : {&f_, &kw_, &b_, &v1_, &x1_, &g_, &delta_, &rhs_, &z_})
       if (w->size() != n) w->setZero(n);
@@ -339,6 +378,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
     matrix_free_ = false;
     band_.reset();
     extra_blocks_.clear();
+    force_blocks_.clear();
     jacobian_.emplace(model);
     a_ = jacobian_->make_matrix();
     CholmodOptions cholmod;
@@ -389,6 +429,15 @@ StepResult ImplicitEuler::Impl::assemble(const Dynamics& dynamics, const VecX& x
     jacobian_->assemble_system(model, x, v, jacobian_options_, h, h * h, a_, v, kw_, threads_);
     if (dynamics.anchors() != nullptr)
       add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, v, kw_);
+    // The added forces' Jacobians, their symmetric part S = (J + J^T) / 2: a block B at (i, j)
+    // puts B / 2 at (i, j) and B^T / 2 at (j, i); A -= h S_D + h^2 S_K, kw += S_K v.
+    for (const ForceJacobian::Block& b : force_jacobian_.blocks()) {
+      const Mat3 a = -0.5 * (h * b.dfdv + h * h * b.dfdx);
+      add_block(a_, b.i, b.j, a);
+      add_block(a_, b.j, b.i, a.transpose());
+      kw_.segment<3>(3 * b.i) += 0.5 * b.dfdx * v.segment<3>(3 * b.j);
+      kw_.segment<3>(3 * b.j) += 0.5 * b.dfdx.transpose() * v.segment<3>(3 * b.i);
+    }
   }
   add_external_damping_system(model, t, h);
   return StepResult::success();
@@ -466,12 +515,53 @@ StepResult ImplicitEuler::Impl::ensure_pattern(const Model& model) {
   for (const auto& p : pairs) extra_blocks_.emplace_back(p.i, p.j);
   std::sort(extra_blocks_.begin(), extra_blocks_.end());
   extra_blocks_.erase(std::unique(extra_blocks_.begin(), extra_blocks_.end()), extra_blocks_.end());
-  jacobian_.emplace(model, extra_blocks_);
-  a_ = jacobian_->make_matrix();
-  const LinearResult r = solver_->analyze(a_);
+  const StepResult r = rebuild_pattern(model);
   factorization_seconds_ += seconds_since(start);
+  return r;
+}
+
+StepResult ImplicitEuler::Impl::rebuild_pattern(const Model& model) {
+  std::vector<std::pair<int, int>> blocks = extra_blocks_;
+  blocks.insert(blocks.end(), force_blocks_.begin(), force_blocks_.end());
+  jacobian_.emplace(model, blocks);
+  a_ = jacobian_->make_matrix();
+  base_saved_ = false;
+  const LinearResult r = solver_->analyze(a_);
   if (!r.ok()) return StepResult::failure("implicit_euler: " + r.message);
   return StepResult::success();
+}
+
+StepResult ImplicitEuler::Impl::collect_force_jacobians(const Dynamics& dynamics, const VecX& x,
+                                                        const VecX& v, Real t) {
+  force_jacobian_.clear();
+  if (matrix_free_ || !has_force_jacobians(dynamics)) return StepResult::success();
+  const Model& model = dynamics.model();
+  for (const std::shared_ptr<Force>& force : *dynamics.added_forces()) {
+    if (!force->has_jacobian()) continue;
+    const std::size_t before = force_jacobian_.blocks().size();
+    force->add_jacobian(t, x, v, force_jacobian_);
+    for (std::size_t k = before; k < force_jacobian_.blocks().size(); ++k) {
+      const ForceJacobian::Block& b = force_jacobian_.blocks()[k];
+      const int n = model.num_particles();
+      if (b.i < 0 || b.i >= n || b.j < 0 || b.j >= n || !b.dfdx.allFinite() ||
+          !b.dfdv.allFinite()) {
+        force_jacobian_.validate(n, force->name());  // throws, naming the block
+      }
+    }
+  }
+  bool complete = true;
+  for (const ForceJacobian::Block& b : force_jacobian_.blocks())
+    if (b.i != b.j && !has_block(a_, b.i, b.j)) {
+      complete = false;
+      force_blocks_.emplace_back(std::min(b.i, b.j), std::max(b.i, b.j));
+    }
+  if (complete) return StepResult::success();
+  const auto start = Clock::now();
+  std::sort(force_blocks_.begin(), force_blocks_.end());
+  force_blocks_.erase(std::unique(force_blocks_.begin(), force_blocks_.end()), force_blocks_.end());
+  const StepResult r = rebuild_pattern(model);
+  factorization_seconds_ += seconds_since(start);
+  return r;
 }
 
 void ImplicitEuler::Impl::refresh_pair_terms() {
@@ -513,8 +603,8 @@ StepResult ImplicitEuler::Impl::finish_solve(const Model& model, const LinearRes
                                std::string(linear_status_name(r.status)) + "): " + r.message);
   if (!y.allFinite())
     return StepResult::failure("implicit_euler: the linear solve returned a non-finite value");
-  // With contact constraints or anchors momentum is not conserved (the terrain or the anchor
-  // pushes).
+  // With contact constraints, anchors or added forces momentum is not conserved (the terrain,
+  // the anchor or the force pushes).
   if (r.iterations > 0 && !constrained && !anchored_) restore_momentum(model.mass, b, y);
   return StepResult::success();
 }
@@ -538,8 +628,9 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   if (bodies_active_) {
     if (StepResult r = ensure_pattern(model); !r.ok) return r;
   }
-  anchored_ = dynamics.anchors() != nullptr;
+  if (StepResult r = collect_force_jacobians(dynamics, s.x, s.v, s.t + h); !r.ok) return r;
   if (StepResult r = assemble(dynamics, s.x, s.v, s.t + h, h); !r.ok) return r;
+  anchored_ = dynamics.anchors() != nullptr || !force_jacobian_.empty() || damped_;
   b_.resize(f_.size());
   for_each_entry(threads_, b_.size(), [&](long k) { b_[k] = h * (f_[k] + h * kw_[k]); });
   if (bodies_active_ && bodies_.any_active()) refresh_pair_terms();
@@ -632,6 +723,7 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
     g_ = -g_;
     delta_.setZero();
     const auto start = Clock::now();
+    if (StepResult r = collect_force_jacobians(dynamics, x1_, v1_, s.t + h); !r.ok) return r;
     if (StepResult r = assemble(dynamics, x1_, v1_, s.t + h, h); !r.ok) return r;
     if (bodies_active_) bodies_.add_terms(a_, nullptr);
     assembly_seconds_ += seconds_since(start);

@@ -23,6 +23,7 @@ class ImplicitEuler final : public Integrator {
   std::string_view name() const override { return "implicit_euler"; }
   int order() const override { return 1; }
   bool is_implicit() const override { return true; }
+  bool uses_force_jacobians() const override { return true; }
   // With contact = "implicit", unless the last step's Dynamics carried no terrains (then the
   // caller's resolve after the step must handle them all).
   bool resolves_contact() const override;

@@ -44,6 +44,9 @@ class Integrator {
   virtual std::string_view name() const = 0;
   virtual int order() const = 0;
   virtual bool is_implicit() const { return false; }
+  // True when the method takes the Jacobians of added forces (Force::add_jacobian) into its
+  // solve; an implicit method without them treats added forces explicitly within its step.
+  virtual bool uses_force_jacobians() const { return false; }
   // True when the method chooses its own internal steps within each step(h) (error control):
   // the h-convergence of fixed-step methods does not apply to it.
   virtual bool is_adaptive() const { return false; }

@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/contact/detail/position_contact.hpp>
 
@@ -134,11 +133,10 @@ StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
   terrains_seen_ = terrains != nullptr;
   const Real t_end = s.t + h;
   for (int sub = 0; sub < substeps; ++sub) {
-    // External forces: gravity, the model's external forces and the seed model's contact
-    // forces.
+    // External forces: gravity, the model's external and added forces and the seed model's
+    // contact forces.
     for (int i = 0; i < n; ++i) particle(f_, i) = model.mass[i] * model.gravity;
-    if (!model.external_forces.empty())
-      add_external_forces(model.external_forces, model.mass, s.t, s.v, f_);
+    dynamics.add_applied_forces(s.t, s.x, s.v, f_);
     dynamics.contacts().add_forces(s.v, f_);
     const Real t1 = sub + 1 == substeps ? t_end : s.t + hs;
     contact_active_ = resolves_contact() && contact_->begin(model, *terrains, s, hs);

@@ -1,0 +1,77 @@
+#pragma once
+// Forces as plugins: a Force adds its forces at (t, x, v) at every force evaluation of every
+// integrator, and may give its Jacobians df/dx and df/dv as 3x3 blocks, which implicit_euler
+// takes into its solve. A user's force and jelly's own (core/builtin_forces.hpp) are peers.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+using Mat3 = Eigen::Matrix3d;
+
+// The Jacobians of a force as 3x3 blocks: block (i, j) holds d f_i / d x_j and d f_i / d v_j
+// (i, j particle indices). Blocks may repeat; repeated blocks add up.
+class ForceJacobian {
+ public:
+  struct Block {
+    int i = 0, j = 0;
+    Mat3 dfdx = Mat3::Zero();
+    Mat3 dfdv = Mat3::Zero();
+  };
+  void add(int i, int j, const Mat3& dfdx, const Mat3& dfdv) {
+    blocks_.push_back({i, j, dfdx, dfdv});
+  }
+  // Forgets the blocks, keeping the memory (no allocation in steady state).
+  void clear() { blocks_.clear(); }
+  bool empty() const { return blocks_.empty(); }
+  const std::vector<Block>& blocks() const { return blocks_; }
+  // y += (df/dx) p and z += (df/dv) p (dense 3N vectors).
+  void multiply(const VecX& p, VecX& dfdx_p, VecX& dfdv_p) const;
+  // Throws InputError naming `force` when a block's index is outside [0, num_particles) or a
+  // value is not finite.
+  void validate(int num_particles, const std::string& force) const;
+
+ private:
+  std::vector<Block> blocks_;
+};
+
+class Force {
+ public:
+  virtual ~Force() = default;
+  // A short name for messages and notes ("vortex", "spring_to_anchor").
+  virtual std::string name() const = 0;
+  // f += this force at time t on positions x and velocities v (all of size 3N). Called at every
+  // force evaluation (each stage of a multi-stage method), from the thread that steps.
+  virtual void add_forces(Real t, const VecX& x, const VecX& v, VecX& f) const = 0;
+  // True when add_jacobian() gives the force's df/dx and df/dv. Without them an implicit
+  // integrator treats the force explicitly within its step (the run report's notes say so).
+  virtual bool has_jacobian() const { return false; }
+  // Adds the blocks of df/dx and df/dv at (t, x, v). The implicit solve uses their symmetric
+  // part (Cholesky and CG need a symmetric matrix); a force whose Jacobian is not symmetric
+  // still gets its exact force, with a less exact linearization.
+  virtual void add_jacobian(Real /*t*/, const VecX& /*x*/, const VecX& /*v*/,
+                            ForceJacobian& /*jacobian*/) const {}
+  // Throws InputError when the force cannot act on a model of `num_particles` particles (an
+  // index out of range); called when the force is added and when the model changes.
+  virtual void validate(int /*num_particles*/) const {}
+};
+
+// The forces added to a simulator, evaluated in this order after jelly's own.
+using ForceList = std::vector<std::shared_ptr<Force>>;
+
+// How far a force's Jacobians are from central differences of its forces at (t, x, v): the
+// largest entry of |J - J_fd| over the largest entry of |J_fd| (or of |J|; 1 when both are 0),
+// for df/dx and df/dv. Dense: meant for tests on small models.
+struct JacobianCheck {
+  Real dfdx_error = 0;
+  Real dfdv_error = 0;
+  Real dfdx_scale = 0;  // largest entry of |df/dx|, for stating an absolute tolerance
+  Real dfdv_scale = 0;
+};
+JacobianCheck check_force_jacobian(const Force& force, Real t, const VecX& x, const VecX& v,
+                                   Real step = 1e-6);
+
+}  // namespace jelly
