@@ -662,9 +662,9 @@ void H5Recorder::on_frame(const Simulator& sim) {
   // add_observer checked the simulator (check_simulator); a frame never reads past its arrays.
   if (sim.state().x.size() != 3 * m.n || sim.terrains().size() < m.terrains.size()) {
     check_simulator(sim);
-    throw InputError("simulator", std::to_string(sim.state().x.size() / 3) + " particles",
-                     "the " + std::to_string(m.n) + " particles of the recorder of '" + m.path +
-                         "'");
+    throw InputError(
+        "simulator", std::to_string(sim.state().x.size() / 3) + " particles",
+        "the " + std::to_string(m.n) + " particles of the recorder of '" + m.path + "'");
   }
   Batch& b = *m.current;
   const State& s = sim.state();

@@ -114,17 +114,17 @@ void check_run_limits(const Scene& scene, Real t_start, const RunLimits& limits,
   const double memory = limits.memory_bytes >= 0 ? limits.memory_bytes : available_memory_bytes();
   if (memory >= 0 && e.memory_bytes > memory) {
     // A one-cube scene names its size; others their bodies' particle count.
-    const bool one_cube = scene.bodies.size() == 1 && scene.bodies[0].shape &&
-                          scene.bodies[0].shape.is<CubeShape>();
-    throw InputError(
-        one_cube ? "cube.n" : "bodies",
-        one_cube ? std::to_string(scene.bodies[0].shape.as<CubeShape>().n)
-                 : count(static_cast<double>(e.particles)) + " particles",
-        std::string(one_cube ? "a cube that fits" : "bodies that fit") +
-            " in memory: the run needs about " +
-            bytes_text(e.memory_bytes) + " (" + count(static_cast<double>(e.particles)) +
-            " particles, " + count(static_cast<double>(e.springs)) + " springs, " +
-            scene.integrator.name + "), more than the " + bytes_text(memory) + " available");
+    const bool one_cube =
+        scene.bodies.size() == 1 && scene.bodies[0].shape && scene.bodies[0].shape.is<CubeShape>();
+    throw InputError(one_cube ? "cube.n" : "bodies",
+                     one_cube ? std::to_string(scene.bodies[0].shape.as<CubeShape>().n)
+                              : count(static_cast<double>(e.particles)) + " particles",
+                     std::string(one_cube ? "a cube that fits" : "bodies that fit") +
+                         " in memory: the run needs about " + bytes_text(e.memory_bytes) + " (" +
+                         count(static_cast<double>(e.particles)) + " particles, " +
+                         count(static_cast<double>(e.springs)) + " springs, " +
+                         scene.integrator.name + "), more than the " + bytes_text(memory) +
+                         " available");
   }
   // Compression saves at most about a third of a recording (docs/output.md): refuse only what
   // cannot fit even so.

@@ -171,8 +171,8 @@ void bind_io(py::module_& m) {
           "__exit__", [](PyH5Recorder& r, py::args) { r.close(); },
           "Closes the recorder (which removes it from its simulators).")
       .def("__repr__", [](const PyH5Recorder& r) {
-        return "<jelly.H5Recorder '" + r.path() + "', " + std::to_string(r.frames()) +
-               " frames" + (r.closed() ? ", closed>" : ">");
+        return "<jelly.H5Recorder '" + r.path() + "', " + std::to_string(r.frames()) + " frames" +
+               (r.closed() ? ", closed>" : ">");
       });
 
   py::class_<PyRecording>(m, "Recording",

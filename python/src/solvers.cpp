@@ -4,8 +4,8 @@
 #include <optional>
 
 #include <jelly/core/json.hpp>
-#include <jelly/io/run_limits.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/io/run_limits.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/run_report.hpp>
@@ -233,8 +233,7 @@ void bind_solvers(py::module_& m) {
       .def("__repr__", [](const Integrator& i) {
         return "<jelly.Integrator " + std::string(i.name()) + ": order " +
                std::to_string(i.order()) + (i.is_implicit() ? ", implicit" : ", explicit") +
-               (i.is_adaptive() ? ", adaptive" : "") + ", " + std::to_string(i.steps()) +
-               " steps>";
+               (i.is_adaptive() ? ", adaptive" : "") + ", " + std::to_string(i.steps()) + " steps>";
       });
 
   py::class_<DivergenceGuard>(m, "DivergenceGuard",
