@@ -294,7 +294,12 @@ void bind_io(py::module_& m) {
                     "The output interval of the run that wrote it (s).")
       .def_readonly("scene_json", &Checkpoint::scene_json,
                     "The scene of the run that wrote it (empty when none was stored).")
-      .def("snapshot", &Checkpoint::snapshot, "As a SimulatorSnapshot (Simulator.restore).");
+      .def("snapshot", &Checkpoint::snapshot, "As a SimulatorSnapshot (Simulator.restore).")
+      .def("__repr__", [](const Checkpoint& c) {
+        return "<jelly.Checkpoint t=" + to_text(c.state.t) + " after " +
+               std::to_string(c.total_steps) + " steps, " + c.integrator + ", dt " + to_text(c.dt) +
+               ">";
+      });
   m.def(
       "_check_run_limits",
       [](const Scene& scene, const std::string& output) {

@@ -62,8 +62,9 @@ TEST(RunLimits, RunUntilRefusesAbsurdRunsNamingTheField) {
   Simulator sim(model, rest_state(model), make_integrator("rk4"));
   EXPECT_NO_THROW(check_run_until(sim, 1.0));
   EXPECT_NO_THROW(check_run_until(sim, -1.0));  // no step
-  EXPECT_THAT([&] { check_run_until(sim, 1e9); },
-              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("t_end = 1000000000")));
+  EXPECT_THAT(
+      [&] { check_run_until(sim, 1e9); },
+      ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("t_end = 1e+09 is invalid")));
   EXPECT_THROW(check_run_until(sim, std::nan("")), InputError);
   State far = sim.state();
   far.t = -1e12;

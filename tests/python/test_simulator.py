@@ -383,6 +383,8 @@ def test_pickling_copies_and_reprs(scenes):
     assert "dt=0.002" in repr(options) and "max_speed=40" in repr(options)
     assert repr(sim).startswith("<jelly.Simulator rk4")
     assert repr(sim.integrator).startswith("<jelly.Integrator rk4")
+    assert repr(sim.model.springs) == "<jelly.Springs 12876 springs>"
+    assert repr(sim.model.pins).startswith("<jelly.Pins 0 particles")
     assert "jelly.InputError" not in (jelly.InputError.__doc__ or "") and jelly.InputError.__doc__
 
 
