@@ -6,6 +6,8 @@
 #include <mutex>
 #include <string>
 
+#include <jelly/solvers/simulator.hpp>
+
 #include "common.hpp"
 
 namespace jelly::python {
@@ -16,6 +18,10 @@ namespace {
 constexpr const char* kLockAttribute = "_jelly_lock";
 
 std::recursive_mutex& lock_of(py::handle simulator, py::object& holder) {
+  if (!py::isinstance<Simulator>(simulator)) {
+    throw py::type_error("expected a jelly.Simulator, not " +
+                         std::string(py::str(py::type::of(simulator).attr("__name__"))));
+  }
   holder = py::getattr(simulator, kLockAttribute, py::none());
   if (holder.is_none()) {  // made under the GIL: no other thread makes it at the same time
     holder = py::capsule(new std::recursive_mutex,

@@ -151,3 +151,10 @@ def test_ctrl_c_stops_run_until_and_leaves_the_simulator_usable():
                             text=True, timeout=120, env=os.environ.copy())
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("interrupted at"), result.stdout
+
+
+def test_a_wrong_simulator_argument_is_a_type_error(tmp_path):
+    with pytest.raises(TypeError, match="expected a jelly.Simulator, not str"):
+        jelly.H5Recorder(str(tmp_path / "r.h5"), "sim")
+    with pytest.raises(TypeError, match="expected a jelly.Simulator, not int"):
+        jelly.Simulator.step(3)
