@@ -58,28 +58,34 @@ def test_two_threads_stepping_one_simulator_lose_no_step():
     assert np.array_equal(sim.state.x, alone.state.x)
 
 
-def test_add_terrain_and_reads_during_another_thread_s_run_until():
-    sim = implicit_cube()
-    started = threading.Event()
-    reads = []
+@pytest.mark.parametrize("contact", ["seed", "coulomb"])
+def test_add_terrain_and_reads_during_another_thread_s_run_until(scenes, contact):
+    # Before the lock, planes added during a run crashed it now and then (seed contact).
+    for _ in range(6):
+        sim = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json", {"cube.n": 6}))
+        started = threading.Event()
+        reads = []
 
-    def run():
-        sim.run_until(0.3, callback=lambda s: started.set())
+        def run():
+            sim.run_until(0.5, callback=lambda s: started.set())
 
-    def meddle():
-        started.wait()
-        for k in range(20):
-            sim.add_terrain({"kind": "sphere", "center": [10 + k, 0, 0], "radius": 0.5})
-            reads.append((sim.t, sim.total_steps, float(sim.state.x[0, 1]), sim.kinetic_energy(),
-                          sim.snapshot().total_steps, repr(sim)))
+        def meddle():
+            started.wait()
+            params = jelly.ContactParams()
+            params.model = contact
+            for k in range(300):
+                sim.add_terrain(jelly.Plane.slope(20 + 0.01 * k, [0, 0.001 * k, 0], params))
+                if k % 30 == 0:
+                    reads.append((sim.t, sim.total_steps, float(sim.state.x[0, 1]),
+                                  sim.kinetic_energy(), sim.snapshot().total_steps, repr(sim)))
 
-    run_in_threads(run, meddle)
-    assert sim.report.status == "completed" and sim.report.steps == 300
-    assert len(sim.terrains) == 21
-    assert len(reads) == 20
-    # Each read saw a whole step: its time and step count agree.
-    for t, steps, *_ in reads:
-        assert t == pytest.approx(steps * 1e-3, abs=1e-9)
+        run_in_threads(run, meddle)
+        assert sim.report.status == "completed" and sim.report.steps == 500
+        assert len(sim.terrains) == 301
+        assert len(reads) == 10
+        # Each read saw a whole step: its time and step count agree.
+        for t, steps, *_ in reads:
+            assert t == pytest.approx(steps * 1e-3, abs=1e-9)
 
 
 def test_snapshot_restore_and_set_threads_from_threads():
