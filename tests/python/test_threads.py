@@ -164,3 +164,23 @@ def test_a_wrong_simulator_argument_is_a_type_error(tmp_path):
         jelly.H5Recorder(str(tmp_path / "r.h5"), "sim")
     with pytest.raises(TypeError, match="expected a jelly.Simulator, not int"):
         jelly.Simulator.step(3)
+
+
+def test_two_simulators_run_at_the_same_time_in_two_threads():
+    # Each run waits, inside its first frame, until the other has started: this ends only if
+    # the two run_until calls are in progress at the same time (a lock per simulator, not one
+    # for all, and the GIL released while stepping).
+    sims = [implicit_cube(3), implicit_cube(3)]
+    started = [threading.Event(), threading.Event()]
+    met = []
+
+    def run(i):
+        def first_frame(sim):
+            if not started[i].is_set():
+                started[i].set()
+                met.append(started[1 - i].wait(timeout=60))
+        sims[i].run_until(0.05, callback=first_frame)
+
+    run_in_threads(lambda: run(0), lambda: run(1))
+    assert met == [True, True]
+    assert [s.total_steps for s in sims] == [50, 50]
