@@ -6,9 +6,22 @@
 
 namespace jelly {
 
-std::int64_t cube_particle_count(std::int64_t n) { return n * n * n; }
+namespace {
+// Counts of larger cubes overflow 64 bits (the springs are about 13 n^3).
+constexpr std::int64_t kMaxCountedEdge = 500000;
+void check_edge(std::int64_t n) {
+  require(n >= 0 && n <= kMaxCountedEdge, "n", n,
+          "an integer in [0, " + std::to_string(kMaxCountedEdge) + "] (particles per edge)");
+}
+}  // namespace
+
+std::int64_t cube_particle_count(std::int64_t n) {
+  check_edge(n);
+  return n * n * n;
+}
 
 std::int64_t cube_spring_count(std::int64_t n) {
+  check_edge(n);
   if (n < 2) return 0;
   const std::int64_t m = n - 1;
   return 3 * n * n * m + 6 * n * m * m + 4 * m * m * m + 3 * n * n * (n - 2);

@@ -13,6 +13,7 @@ namespace jelly {
 // Particles and springs of an n x n x n cube: n^3 and
 // 3 n^2 (n - 1) + 6 n (n - 1)^2 + 4 (n - 1)^3 + 3 n^2 (n - 2) (structural, face and body
 // diagonals, bending; 12,876 for n = 10).
+// Throw InputError naming n for n < 0 or n > 500000 (whose counts would overflow).
 std::int64_t cube_particle_count(std::int64_t n);
 std::int64_t cube_spring_count(std::int64_t n);
 

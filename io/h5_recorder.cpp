@@ -616,8 +616,56 @@ H5Recorder::~H5Recorder() {
   if (!unfinished.empty()) std::remove(unfinished.c_str());
 }
 
+namespace {
+
+// "27000 particles, 1 body (jelly), 287820 springs".
+std::string model_text(const Model& model) {
+  std::string bodies;
+  for (const Body& b : model.bodies) bodies += (bodies.empty() ? "" : ", ") + b.name;
+  const std::size_t count = std::max<std::size_t>(model.bodies.size(), 1);
+  return std::to_string(model.num_particles()) + " particles, " + std::to_string(count) +
+         (count == 1 ? " body" : " bodies") + (bodies.empty() ? "" : " (" + bodies + ")") + ", " +
+         std::to_string(model.springs.size()) + " springs";
+}
+
+bool same_bodies(const Model& a, const Model& b) {
+  if (a.num_particles() != b.num_particles() || a.springs.size() != b.springs.size() ||
+      a.bodies.size() != b.bodies.size())
+    return false;
+  for (std::size_t i = 0; i < a.bodies.size(); ++i) {
+    const Body &p = a.bodies[i], &q = b.bodies[i];
+    if (p.name != q.name || p.first_particle != q.first_particle ||
+        p.num_particles != q.num_particles || p.first_spring != q.first_spring ||
+        p.num_springs != q.num_springs)
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void H5Recorder::check_simulator(const Simulator& sim) const {
+  const Impl& m = *impl_;
+  if (!same_bodies(m.model, sim.model())) {
+    throw InputError("simulator", model_text(sim.model()),
+                     "the simulator the recorder of '" + m.path + "' was made for (" +
+                         model_text(m.model) + "): make a recorder for each simulator");
+  }
+  require(sim.terrains().size() >= m.terrains.size(), "simulator",
+          std::to_string(sim.terrains().size()) + " terrains",
+          "at least the " + std::to_string(m.terrains.size()) + " terrains the recorder of '" +
+              m.path + "' was made with");
+}
+
 void H5Recorder::on_frame(const Simulator& sim) {
   Impl& m = *impl_;
+  // add_observer checked the simulator (check_simulator); a frame never reads past its arrays.
+  if (sim.state().x.size() != 3 * m.n || sim.terrains().size() < m.terrains.size()) {
+    check_simulator(sim);
+    throw InputError(
+        "simulator", std::to_string(sim.state().x.size() / 3) + " particles",
+        "the " + std::to_string(m.n) + " particles of the recorder of '" + m.path + "'");
+  }
   Batch& b = *m.current;
   const State& s = sim.state();
   b.step.push_back(sim.total_steps());

@@ -53,6 +53,10 @@ class H5Recorder final : public Observer {
   // its path. May be called after each of several run_until() calls. Throws std::runtime_error
   // if a write failed.
   void on_finish(const Simulator& sim, const RunReport& report) override;
+  // Throws InputError naming both particle counts and bodies when `sim` is not the simulator
+  // this recorder was made for (another model: other particles, springs or bodies) or has fewer
+  // terrains than it had then.
+  void check_simulator(const Simulator& sim) const override;
 
   const std::string& path() const;
   long frames() const;  // frames received so far

@@ -114,17 +114,17 @@ void check_run_limits(const Scene& scene, Real t_start, const RunLimits& limits,
   const double memory = limits.memory_bytes >= 0 ? limits.memory_bytes : available_memory_bytes();
   if (memory >= 0 && e.memory_bytes > memory) {
     // A one-cube scene names its size; others their bodies' particle count.
-    const bool one_cube = scene.bodies.size() == 1 && scene.bodies[0].shape &&
-                          scene.bodies[0].shape.is<CubeShape>();
-    throw InputError(
-        one_cube ? "cube.n" : "bodies",
-        one_cube ? std::to_string(scene.bodies[0].shape.as<CubeShape>().n)
-                 : count(static_cast<double>(e.particles)) + " particles",
-        std::string(one_cube ? "a cube that fits" : "bodies that fit") +
-            " in memory: the run needs about " +
-            bytes_text(e.memory_bytes) + " (" + count(static_cast<double>(e.particles)) +
-            " particles, " + count(static_cast<double>(e.springs)) + " springs, " +
-            scene.integrator.name + "), more than the " + bytes_text(memory) + " available");
+    const bool one_cube =
+        scene.bodies.size() == 1 && scene.bodies[0].shape && scene.bodies[0].shape.is<CubeShape>();
+    throw InputError(one_cube ? "cube.n" : "bodies",
+                     one_cube ? std::to_string(scene.bodies[0].shape.as<CubeShape>().n)
+                              : count(static_cast<double>(e.particles)) + " particles",
+                     std::string(one_cube ? "a cube that fits" : "bodies that fit") +
+                         " in memory: the run needs about " + bytes_text(e.memory_bytes) + " (" +
+                         count(static_cast<double>(e.particles)) + " particles, " +
+                         count(static_cast<double>(e.springs)) + " springs, " +
+                         scene.integrator.name + "), more than the " + bytes_text(memory) +
+                         " available");
   }
   // Compression saves at most about a third of a recording (docs/output.md): refuse only what
   // cannot fit even so.
@@ -133,6 +133,36 @@ void check_run_limits(const Scene& scene, Real t_start, const RunLimits& limits,
                      bytes_text(e.recording_bytes) + " (" + count(e.frames) + " frames, about " +
                      bytes_text(0.6 * e.recording_bytes) + " compressed), more than the " +
                      bytes_text(limits.disk_bytes) + " free on its file system");
+  }
+}
+
+void check_run_until(const Simulator& sim, Real t_end, const RunLimits& limits) {
+  const Real t = sim.state().t;
+  const Real dt = sim.options().dt;
+  require(std::isfinite(t_end), "t_end", number(t_end), "a finite time (s)");
+  require(std::isfinite(t), "state.t", number(t), "a finite time (s)");
+  if (!(t_end > t + 0.5 * dt)) return;  // no step
+  // The time farther from 0 names itself in messages.
+  const bool state_largest = std::abs(t) > std::abs(t_end);
+  const char* field = state_largest ? "state.t" : "t_end";
+  const double largest = std::max(std::abs(t), std::abs(t_end));
+  const double value = state_largest ? t : t_end;
+  require(dt > largest * kResolution, field, number(value),
+          "a time at which the step dt = " + number(dt) + " s is not lost to rounding: |t| < " +
+              number(dt / kResolution) + " s");
+  const double steps = std::ceil((t_end - t) / dt - 0.5);
+  require(steps <= limits.max_steps, "t_end", number(t_end),
+          "a time at most " + count(limits.max_steps) + " steps of dt = " + number(dt) +
+              " s after the state's t = " + number(t) + " s: the run would take " + count(steps) +
+              " steps");
+  const Real interval = sim.options().output_interval;
+  if (interval > 0) {
+    require(interval > largest * kResolution, field, number(value),
+            "a time at which the output interval " + number(interval) +
+                " s is not lost to rounding: |t| < " + number(interval / kResolution) + " s");
+    require((t_end - t) / interval <= limits.max_steps, "t_end", number(t_end),
+            "a time at most " + count(limits.max_steps) + " output intervals of " +
+                number(interval) + " s after the state's t = " + number(t) + " s");
   }
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include <jelly/io/scene.hpp>
+#include <jelly/solvers/simulator.hpp>
 
 namespace jelly {
 
@@ -39,6 +40,13 @@ RunEstimate estimate_run(const Scene& scene, Real t_start = 0, bool recording = 
 // from in messages ("" = the scene's start). `output` is the recording's path ("" = none).
 void check_run_limits(const Scene& scene, Real t_start, const RunLimits& limits,
                       const std::string& output = "", const std::string& restart = "");
+
+// The step and interval limits of check_run_limits for Simulator::run_until(t_end) from the
+// simulator's current time (Python's run_until): throws InputError naming t_end or state.t when
+// either is not finite, when options().dt or output_interval is lost to rounding at the run's
+// times, or when the run would take more than limits.max_steps steps or intervals. A run that
+// takes no step is allowed.
+void check_run_until(const Simulator& sim, Real t_end, const RunLimits& limits = {});
 
 // Free bytes on the file system that holds `path` (a file that may not exist yet), or < 0.
 double free_disk_bytes(const std::string& path);

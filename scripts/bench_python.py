@@ -9,8 +9,11 @@
 2. view: reading the positions of a 64,000-particle jelly (n = 40): the view's address is the
    C++ buffer's, and reading costs the same whatever the size, against copying them.
 3. sweep: the same 8 runs on a 2-worker LocalCluster and in a serial loop.
+4. threads: 2 simulators (seed cube, rk4, 1 thread each) run in 2 Python threads against the
+   same two runs one after the other, best and median of the repeats (the GIL is released while
+   C++ steps, and each simulator has its own lock).
 
-    PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python.py [step|view|sweep ...]
+    PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python.py [step|view|sweep|threads ...]
 """
 
 import os
@@ -132,7 +135,43 @@ def bench_sweep(workers=2):
           f"{table['wall_seconds'].sum():.2f} s")
 
 
+def bench_threads(repeats=7, seconds=1.0):
+    import threading
+
+    def fresh():
+        sim = seed_simulator(10)
+        sim.set_threads(1)  # one core each: the threads are the parallelism measured
+        return sim
+
+    def run(sim):
+        sim.run_until(sim.t + seconds)
+
+    serial, threaded = [], []
+    for _ in range(repeats):
+        a, b = fresh(), fresh()
+        start = time.perf_counter()
+        run(a)
+        run(b)
+        serial.append(time.perf_counter() - start)
+        a, b = fresh(), fresh()
+        threads = [threading.Thread(target=run, args=(s,)) for s in (a, b)]
+        start = time.perf_counter()
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        threaded.append(time.perf_counter() - start)
+    print(f"2 seed cubes x {seconds:g} s (rk4, dt 1 ms, 1 thread each), {repeats} repeats, "
+          f"load average {os.getloadavg()[0]:.2f}")
+    print(f"  one after the other: best {min(serial):.3f} s, median {statistics.median(serial):.3f} s")
+    print(f"  2 Python threads:    best {min(threaded):.3f} s, "
+          f"median {statistics.median(threaded):.3f} s")
+    print(f"  speed-up: best {min(serial) / min(threaded):.2f}, median "
+          f"{statistics.median(serial) / statistics.median(threaded):.2f}")
+
+
 if __name__ == "__main__":
-    chosen = sys.argv[1:] or ["step", "view", "sweep"]
+    chosen = sys.argv[1:] or ["step", "view", "sweep", "threads"]
     for name in chosen:
-        {"step": bench_step, "view": bench_view, "sweep": bench_sweep}[name]()
+        {"step": bench_step, "view": bench_view, "sweep": bench_sweep,
+         "threads": bench_threads}[name]()

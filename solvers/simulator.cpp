@@ -185,6 +185,14 @@ Observer::~Observer() {
   for (ObserverList* list : lists) list->forget(this);
 }
 
+void Observer::leave_simulators() {
+  // remove() edits lists_ of this observer too: iterate over a copy. A list that shared the
+  // observer's ownership may destroy it, which removes it from the other lists by itself (the
+  // next remove() then finds nothing).
+  const std::vector<ObserverList*> lists = lists_;
+  for (ObserverList* list : lists) list->remove(*this);
+}
+
 ObserverList::ObserverList(ObserverList&& other) noexcept
     : observers_(std::move(other.observers_)), owned_(std::move(other.owned_)) {
   other.observers_.clear();
@@ -267,10 +275,14 @@ void ObserverList::forget(const Observer* observer) {
     observers_.erase(at);
 }
 
-void Simulator::add_observer(Observer& observer) { observers_.add(observer); }
+void Simulator::add_observer(Observer& observer) {
+  observer.check_simulator(*this);
+  observers_.add(observer);
+}
 
 void Simulator::add_observer(std::shared_ptr<Observer> observer) {
   require(observer != nullptr, "observer", "null", "an observer");
+  observer->check_simulator(*this);
   observers_.add(std::move(observer));
 }
 

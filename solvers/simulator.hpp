@@ -38,6 +38,12 @@ class Observer {
 
   virtual void on_frame(const Simulator& simulator) = 0;
   virtual void on_finish(const Simulator& /*simulator*/, const RunReport& /*report*/) {}
+  // Called by Simulator::add_observer before adding it: an observer made for one simulator's
+  // model (a recorder) throws InputError for a simulator it does not fit.
+  virtual void check_simulator(const Simulator& /*simulator*/) const {}
+  // Removes this observer from every simulator it was added to (as its destruction does; a
+  // simulator that shared its ownership releases its share, which may destroy it).
+  void leave_simulators();
 
  private:
   friend class ObserverList;

@@ -73,4 +73,62 @@ def _recording_scene(self: Recording) -> Scene:
 
 Recording.scene = property(_recording_scene, doc=_recording_scene.__doc__)
 
+# Option and spec classes: plain values whose state is their read-write fields (CubeSpec also
+# its springs' coefficients). They pickle (Dask sends them, copy.deepcopy copies them) and print
+# as their fields.
+_OPTION_CLASSES = (ArkodeOptions, ContactParams, CubeSpec, DivergenceGuard, ElevatorSpec,
+                   FitOptions, ImplicitEulerOptions, IntegratorOptions, RecorderOptions,
+                   SimulatorOptions)
+
+
+def _option_fields(cls: type) -> list:
+    return [name for name, value in vars(cls).items()
+            if isinstance(value, property) and value.fset is not None and not name.startswith("_")]
+
+
+def _option_state(obj: _Any) -> dict:
+    state = {name: getattr(obj, name) for name in _option_fields(type(obj))}
+    if isinstance(obj, CubeSpec):
+        state["springs"] = {t: (obj.springs(t).ks, obj.springs(t).kd) for t in spring_type_names()}
+    return state
+
+
+def _options_from_state(cls: type, state: dict) -> _Any:
+    """An option or spec object from its fields (unpickling)."""
+    obj = cls()
+    for name, value in state.items():
+        if name == "springs" and cls is CubeSpec:
+            for t, (ks, kd) in value.items():
+                obj.set_springs(t, ks, kd)
+        else:
+            setattr(obj, name, value)
+    return obj
+
+
+def _option_reduce(self: _Any) -> tuple:
+    return (_options_from_state, (type(self), _option_state(self)))
+
+
+def _option_repr(self: _Any) -> str:
+    fields = ", ".join(f"{name}={value!r}" for name, value in _option_state(self).items())
+    return f"{type(self).__name__}({fields})"
+
+
+for _cls in _OPTION_CLASSES:
+    _cls.__reduce__ = _option_reduce
+    _cls.__repr__ = _option_repr
+
+
+def _state_reduce(self: State) -> tuple:
+    import numpy
+    return (State, (numpy.array(self.x), numpy.array(self.v), self.t))
+
+
+State.__reduce__ = _state_reduce  # pickles and deep-copies as a copy of its arrays
+AnchorSpring.__reduce__ = lambda self: (
+    AnchorSpring, (self.particle, tuple(self.target), self.stiffness, self.damping))
+SpringCoefficients.__reduce__ = lambda self: (_options_from_state, (SpringCoefficients,
+                                                                     {"ks": self.ks,
+                                                                      "kd": self.kd}))
+
 __all__ = sorted(name for name in dir() if not name.startswith("_"))

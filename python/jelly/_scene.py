@@ -67,22 +67,27 @@ class Scene(_jelly._Scene):
     """A scene (docs/scenes.md): fields are attributes (``scene.integrator.dt``), lists index
     (``scene.terrains[0].contact.restitution``), every write is validated by the C++ parser.
 
-    ``Scene(json_text_or_dict, overrides=(), source="scene")``; ``jelly.load_scene(path)`` reads a
-    file. ``jelly.Simulator(scene)`` builds what ``jelly run`` builds from the same scene.
+    ``Scene(json_text_or_dict, overrides=(), source="scene", base_directory="")``;
+    ``jelly.load_scene(path)`` reads a file. Files the scene names (a body's ``file``) are
+    relative to ``base_directory`` (``""``: the current directory; ``load_scene`` gives the scene
+    file's folder, as ``jelly run`` does). ``jelly.Simulator(scene)`` builds what ``jelly run``
+    builds from the same scene.
     """
 
     def __init__(self, json_text: Union[str, Mapping[str, Any]], overrides: Overrides = (),
-                 source: str = "scene") -> None:
+                 source: str = "scene", base_directory: Union[str, os.PathLike] = "") -> None:
         if isinstance(json_text, Mapping):
             json_text = json.dumps(json_text)
+        base = os.path.abspath(os.fspath(base_directory)) if os.fspath(base_directory) else ""
         todo = assignments(overrides)
         for assignment in todo:
-            json_text = _override_target(json_text, assignment, source)
-        super().__init__(json_text, todo, source)  # validates, C++ messages
+            json_text = _override_target(json_text, assignment, source, base)
+        super().__init__(json_text, todo, source, base)  # validates, C++ messages
         for assignment in todo:
             json_text = _jelly.apply_override(json_text, assignment)
         object.__setattr__(self, "_source", json_text)
         object.__setattr__(self, "_name", source)
+        object.__setattr__(self, "_base", base)
         object.__setattr__(self, "_cache", None)
 
     # --- whole-scene operations -------------------------------------------------------------
@@ -100,7 +105,11 @@ class Scene(_jelly._Scene):
         value: Any = self._full()
         steps = _split(path)
         if steps and steps[0] not in value:
-            value = self._source_dict()
+            alias = _one_cube_alias(steps, value)
+            if alias is not None:  # the same field as the parser read it (1400 -> 1400.0)
+                steps = alias
+            else:
+                value = self._source_dict()
         for step in steps:
             try:
                 value = value[step]
@@ -118,19 +127,19 @@ class Scene(_jelly._Scene):
         together; raises InputError and leaves the scene unchanged if the result is invalid."""
         text = self._source
         for assignment in assignments(overrides):
-            text = _jelly.apply_override(_override_target(text, assignment, self._name),
-                                         assignment)
-        self._assign(text, self._name)  # raises before anything changes
+            text = _jelly.apply_override(
+                _override_target(text, assignment, self._name, self._base), assignment)
+        self._assign(text, self._name, self._base)  # raises before anything changes
         object.__setattr__(self, "_source", text)
         object.__setattr__(self, "_cache", None)
 
     def with_overrides(self, overrides: Overrides) -> "Scene":
         """A new scene: this one with overrides applied ({path: value} or 'path=value')."""
-        return Scene(self._source, overrides, self._name)
+        return Scene(self._source, overrides, self._name, self._base)
 
     def copy(self) -> "Scene":
         """An independent copy."""
-        return Scene(self._source, (), self._name)
+        return Scene(self._source, (), self._name, self._base)
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the full JSON (to_json()) to a file."""
@@ -142,6 +151,12 @@ class Scene(_jelly._Scene):
         """The JSON the scene was made from, with every change applied (only the fields that
         were written; to_json() writes them all)."""
         return self._source
+
+    @property
+    def base_directory(self) -> str:
+        """The absolute folder that files named in the scene are relative to ("" = the current
+        directory): the scene file's folder for load_scene."""
+        return self._base
 
     # --- attribute access by JSON path ---------------------------------------------------------
     def _full(self) -> dict[str, Any]:
@@ -185,7 +200,7 @@ class Scene(_jelly._Scene):
                 f"dt {full['integrator']['dt']}, duration {full['duration']}>")
 
     def __reduce__(self):
-        return (Scene, (self._source, (), self._name))
+        return (Scene, (self._source, (), self._name, self._base))
 
     def __copy__(self) -> "Scene":
         return self.copy()
@@ -194,7 +209,7 @@ class Scene(_jelly._Scene):
         return self.copy()
 
 
-def _override_target(text: str, assignment: str, source: str) -> str:
+def _override_target(text: str, assignment: str, source: str, base: str = "") -> str:
     """The JSON an override applies to: the scene's text, unless the path indexes a list that
     only the full JSON has (``bodies[0]...`` of a one-cube scene file written with ``cube`` and
     ``springs``): then the full JSON, the same scene with its bodies."""
@@ -207,8 +222,29 @@ def _override_target(text: str, assignment: str, source: str) -> str:
         return text  # the C++ parser says what is wrong with it
     if not isinstance(own, dict) or steps[0] in own:
         return text
-    full = json.loads(_jelly._Scene(text, [], source).to_json())
+    full = json.loads(_jelly._Scene(text, [], source, base).to_json())
     return json.dumps(full) if isinstance(full.get(steps[0]), list) else text
+
+
+def _one_cube_alias(steps: list[Union[str, int]], full: dict[str, Any]):
+    """The full JSON's path of a one-cube scene file's ``springs...`` or ``cube.<field>`` path
+    (``bodies[0].springs...``, ``bodies[0].<field>``), or None when it has none."""
+    bodies = full.get("bodies")
+    if not isinstance(bodies, list) or len(bodies) != 1:
+        return None
+    if steps[0] == "springs":
+        alias = ["bodies", 0, *steps]
+    elif steps[0] == "cube" and len(steps) > 1:
+        alias = ["bodies", 0, *steps[1:]]
+    else:
+        return None
+    value: Any = full
+    for step in alias:
+        try:
+            value = value[step]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return alias
 
 
 def _wrap(scene: Scene, path: str, value: Any) -> Any:
@@ -238,7 +274,10 @@ class _Node:
         if name not in value:
             raise AttributeError(f"the scene has no field '{_child(self._path, name)}'; fields "
                                  f"of {self._path}: " + ", ".join(value))
-        return _wrap(self._scene, _child(self._path, name), value[name])
+        path = _child(self._path, name)
+        if not isinstance(value[name], (dict, list)):
+            return self._scene.get(path)  # as the parser read it
+        return _wrap(self._scene, path, value[name])
 
     def __setattr__(self, name: str, value: Any) -> None:
         self._scene.set(_child(self._path, name), value)
@@ -344,4 +383,4 @@ def load_scene(path: Union[str, os.PathLike], overrides: Overrides = ()) -> Scen
     except OSError:
         _jelly._load_scene(path)  # raises the C++ InputError for an unreadable file
         raise
-    return Scene(text, overrides, path)
+    return Scene(text, overrides, path, os.path.dirname(os.path.abspath(path)))

@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <mutex>
 #include <string>
 
 #include <jelly/core/errors.hpp>
@@ -74,6 +75,7 @@ inline VecX flat_n3(const DoubleArray& in, const std::string& field) {
 // first use (io.cpp binds it as jelly.Recording; fit.cpp fits one).
 struct PyRecording {
   Recording recording;
+  std::string path;  // absolute; pickles by it
   py::object position, velocity;
 };
 
@@ -92,6 +94,26 @@ inline SpringType spring_type_from(const py::object& type) {
 // A terrain of any registered kind from its scene JSON (a dict or JSON text), validated with
 // messages naming "terrain.<field>" (terrain.cpp).
 std::unique_ptr<Terrain> terrain_from_spec(const py::object& spec);
+
+// Holds the lock of a Python Simulator object (threads.cpp) for its scope: every call that
+// reads or changes a simulator takes it, so that calls from several threads run one after the
+// other. Waits with the GIL released; the same thread may take it again (a callback of
+// run_until calling the simulator).
+class SimulatorLock {
+ public:
+  explicit SimulatorLock(py::handle simulator);
+  ~SimulatorLock();
+  SimulatorLock(const SimulatorLock&) = delete;
+  SimulatorLock& operator=(const SimulatorLock&) = delete;
+
+ private:
+  py::object holder_;  // keeps the lock alive
+  std::recursive_mutex* mutex_;
+};
+
+// Makes every method and property of jelly.Simulator (and the module functions that take a
+// simulator) take its SimulatorLock; called by module.cpp after every binding is made.
+void serialise_simulator(py::module_& m);
 
 // One binding function per C++ module folder, called in layer order by module.cpp.
 void bind_core(py::module_& m);

@@ -171,6 +171,10 @@ void bind_core(py::module_& m) {
   py::class_<Springs>(m, "Springs",
                       "Springs stored once each as parallel arrays (read-only NumPy views of the "
                       "C++ memory; other coefficients: a scene with them, or build_cube).")
+      .def("__repr__",
+           [](const Springs& sp) {
+             return "<jelly.Springs " + std::to_string(sp.size()) + " springs>";
+           })
       .def_property_readonly(
           "a",
           [](py::object self) {
@@ -374,7 +378,11 @@ void bind_core(py::module_& m) {
           },
           py::arg("t"), "Where their paths put them at time t (m), [P, 3].")
       .def_property_readonly("all_fixed", &Pins::all_fixed, "Whether no pin moves.")
-      .def("__len__", &Pins::size, "The number of pinned particles.");
+      .def("__len__", &Pins::size, "The number of pinned particles.")
+      .def("__repr__", [](const Pins& p) {
+        return "<jelly.Pins " + std::to_string(p.size()) + " particles, " +
+               std::to_string(p.paths.size()) + " paths>";
+      });
 
   py::class_<ExternalForce>(m, "ExternalForce",
                             "A force from outside the bodies (a scene body's \"forces\"): "
@@ -398,7 +406,11 @@ void bind_core(py::module_& m) {
       .def_readonly("gust_frequency", &ExternalForce::gust_frequency, "f (Hz).")
       .def_readonly("start", &ExternalForce::start, "It acts for start <= t < end (s).")
       .def_readonly("end", &ExternalForce::end, "See start (s; inf = for ever).")
-      .def("vector_at", &ExternalForce::vector_at, py::arg("t"), "vector(t).");
+      .def("vector_at", &ExternalForce::vector_at, py::arg("t"), "vector(t).")
+      .def("__repr__", [](const ExternalForce& f) {
+        return "<jelly.ExternalForce " + std::string(external_force_kind_name(f.kind)) + " on " +
+               std::to_string(f.particles.size()) + " particles>";
+      });
 
   py::class_<Model>(m, "Model",
                     "The mass-spring model: particle masses, springs and gravity. Arrays are "

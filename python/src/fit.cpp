@@ -96,7 +96,12 @@ void bind_fit(py::module_& m) {
           "The estimates as {name: value}.")
       .def("report", &FitResult::report,
            "The report jelly fit prints: estimates +- sd, costs, iterations.")
-      .def("__str__", &FitResult::report, "The report.");
+      .def("__str__", &FitResult::report, "The report.")
+      .def("__repr__", [](const FitResult& r) {
+        return "<jelly.FitResult " + std::to_string(r.parameters.size()) + " parameters, " +
+               std::to_string(r.iterations) + " iterations, " +
+               (r.converged ? "converged" : "not converged") + ">";
+      });
 
   m.def(
       "parse_free_parameters",

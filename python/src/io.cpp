@@ -3,6 +3,7 @@
 #include <jelly/io/checkpoint.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
+#include <jelly/io/run_limits.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/io/xdmf.hpp>
 
@@ -22,7 +23,16 @@ class PyH5Recorder final : public Observer {
   void on_finish(const Simulator& sim, const RunReport& report) override {
     open().on_finish(sim, report);
   }
+  void check_simulator(const Simulator& sim) const override {
+    if (!impl_) {
+      throw InputError("the recorder of '" + path_ +
+                       "' is closed: make a new H5Recorder to record another run");
+    }
+    impl_->check_simulator(sim);
+  }
+  // Leaves every simulator it was added to, then closes the file.
   void close() {
+    leave_simulators();
     if (impl_) frames_ = impl_->frames();
     impl_.reset();
   }
@@ -56,19 +66,22 @@ py::array stack_frames(const std::vector<VecX>& frames, int n) {
 void bind_io(py::module_& m) {
   py::class_<Scene>(m, "_Scene",
                     "The C++ scene (jelly.Scene wraps it: attribute access by JSON path).")
-      .def(py::init(
-               [](const std::string& json_text, const std::vector<std::string>& overrides,
-                  const std::string& source) { return parse_scene(json_text, overrides, source); }),
+      .def(py::init([](const std::string& json_text, const std::vector<std::string>& overrides,
+                       const std::string& source, const std::string& base_directory) {
+             return parse_scene(json_text, overrides, source, base_directory);
+           }),
            py::arg("json_text"), py::arg("overrides") = std::vector<std::string>{},
-           py::arg("source") = "scene",
+           py::arg("source") = "scene", py::arg("base_directory") = "",
            "Parses and validates scene JSON (after applying overrides); raises InputError naming "
-           "the JSON path of the first invalid field.")
+           "the JSON path of the first invalid field. Files the scene names (a body's mesh) are "
+           "relative to base_directory (\"\" = the current directory).")
       .def(
           "_assign",
-          [](Scene& s, const std::string& json_text, const std::string& source) {
-            s = parse_scene(json_text, {}, source);
+          [](Scene& s, const std::string& json_text, const std::string& source,
+             const std::string& base_directory) {
+            s = parse_scene(json_text, {}, source, base_directory);
           },
-          py::arg("json_text"), py::arg("source") = "scene",
+          py::arg("json_text"), py::arg("source") = "scene", py::arg("base_directory") = "",
           "Replaces this scene by the parsed JSON text; unchanged when it is invalid.")
       .def(
           "to_json", [](const Scene& s) { return scene_to_json(s); },
@@ -129,8 +142,10 @@ void bind_io(py::module_& m) {
                                      "An observer recording a run to HDF5 (+ XDMF sidecar). Add it "
                                      "with sim.add_observer(recorder); close() (or a with block) "
                                      "before reading the file in the same process.")
-      .def(py::init([](const std::string& path, const Simulator& sim, const Scene* scene,
+      .def(py::init([](const std::string& path, const py::object& sim_object, const Scene* scene,
                        std::optional<RecorderOptions> options) {
+             SimulatorLock lock(sim_object);
+             const Simulator& sim = sim_object.cast<const Simulator&>();
              RecorderOptions o = options ? *options : RecorderOptions{};
              if (scene != nullptr) {  // as `jelly run -o` records a scene
                o.scene_json = scene_to_json(*scene);
@@ -142,16 +157,23 @@ void bind_io(py::module_& m) {
            py::arg("options") = py::none(),
            "Creates the file and writes the static parts of the simulator. With a scene, the "
            "scene's JSON and integrator name are stored as jelly run stores them. Raises "
-           "InputError when the file cannot be created.")
+           "InputError when the file cannot be created. It records only that simulator's "
+           "model: add_observer raises InputError for another.")
       .def("close", &PyH5Recorder::close,
-           "Writes what is pending and closes the file (afterwards frames raise).")
+           "Removes the recorder from every simulator it was added to, writes what is pending "
+           "and closes the file.")
       .def_property_readonly("closed", &PyH5Recorder::closed, "Whether close() was called.")
       .def_property_readonly("path", &PyH5Recorder::path, "The file's path.")
       .def_property_readonly("frames", &PyH5Recorder::frames, "Frames received so far.")
       .def(
           "__enter__", [](py::object self) { return self; }, "Returns the recorder.")
       .def(
-          "__exit__", [](PyH5Recorder& r, py::args) { r.close(); }, "Closes the recorder.");
+          "__exit__", [](PyH5Recorder& r, py::args) { r.close(); },
+          "Closes the recorder (which removes it from its simulators).")
+      .def("__repr__", [](const PyH5Recorder& r) {
+        return "<jelly.H5Recorder '" + r.path() + "', " + std::to_string(r.frames()) + " frames" +
+               (r.closed() ? ", closed>" : ">");
+      });
 
   py::class_<PyRecording>(m, "Recording",
                           "A recording read back from HDF5: arrays of time, positions, "
@@ -223,6 +245,16 @@ void bind_io(py::module_& m) {
       .def_property_readonly(
           "frames", [](const PyRecording& r) { return r.recording.frames(); },
           "Number of frames T.")
+      .def_property_readonly(
+          "path", [](const PyRecording& r) { return r.path; },
+          "The absolute path of the file it was read from.")
+      .def(py::pickle([](const PyRecording& r) { return py::make_tuple(r.path); },
+                      [](const py::tuple& t) {
+                        PyRecording r;
+                        r.path = t[0].cast<std::string>();
+                        r.recording = read_recording(r.path);
+                        return r;
+                      }))
       .def("__repr__", [](const PyRecording& r) {
         return "<jelly.Recording " + std::to_string(r.recording.frames()) + " frames of " +
                std::to_string(r.recording.model.num_particles()) + " particles>";
@@ -232,6 +264,7 @@ void bind_io(py::module_& m) {
       "read_recording",
       [](const std::string& path) {
         PyRecording r;
+        r.path = py::module_::import("os").attr("path").attr("abspath")(path).cast<std::string>();
         {
           py::gil_scoped_release release;
           r.recording = read_recording(path);
@@ -250,7 +283,8 @@ void bind_io(py::module_& m) {
       "path.");
 
   py::class_<Checkpoint>(m, "Checkpoint", "A restart point stored in a recording's /checkpoint.")
-      .def_readonly("state", &Checkpoint::state, "The state (a copy).")
+      .def_property_readonly(
+          "state", [](const Checkpoint& c) { return State(c.state); }, "The state (a copy).")
       .def_readonly("total_steps", &Checkpoint::total_steps, "Steps taken by then.")
       .def_readonly("next_output", &Checkpoint::next_output, "Time of the next frame (s).")
       .def_readonly("integrator", &Checkpoint::integrator,
@@ -260,7 +294,22 @@ void bind_io(py::module_& m) {
                     "The output interval of the run that wrote it (s).")
       .def_readonly("scene_json", &Checkpoint::scene_json,
                     "The scene of the run that wrote it (empty when none was stored).")
-      .def("snapshot", &Checkpoint::snapshot, "As a SimulatorSnapshot (Simulator.restore).");
+      .def("snapshot", &Checkpoint::snapshot, "As a SimulatorSnapshot (Simulator.restore).")
+      .def("__repr__", [](const Checkpoint& c) {
+        return "<jelly.Checkpoint t=" + to_text(c.state.t) + " after " +
+               std::to_string(c.total_steps) + " steps, " + c.integrator + ", dt " + to_text(c.dt) +
+               ">";
+      });
+  m.def(
+      "_check_run_limits",
+      [](const Scene& scene, const std::string& output) {
+        RunLimits limits;
+        if (!output.empty()) limits.disk_bytes = free_disk_bytes(output);
+        check_run_limits(scene, 0, limits, output);
+      },
+      py::arg("scene"), py::arg("output") = "",
+      "The limits jelly run checks before a run of the scene (steps, frames, memory, the "
+      "recording's size at `output`); raises InputError naming the field.");
   m.def("read_checkpoint", &read_checkpoint, py::arg("path"),
         "The checkpoint a recording holds. Raises InputError for a missing or invalid file.");
   m.def(

@@ -9,8 +9,11 @@ PYBIND11_MODULE(_jelly, m) {
   m.doc() = "jelly: a mass-spring soft-body solver (C++17), bound with pybind11.";
   // Bad user input: the C++ message names the field (a scene's JSON path), the value and what
   // is allowed.
-  py::register_exception<jelly::InputError>(m, "InputError", PyExc_ValueError).attr("__module__") =
-      "jelly";
+  auto input_error = py::register_exception<jelly::InputError>(m, "InputError", PyExc_ValueError);
+  input_error.attr("__module__") = "jelly";
+  input_error.attr("__doc__") =
+      "Bad user input (a scene, an option, an argument, a file): the message names the field "
+      "(a scene's JSON path), the value and what is allowed. A ValueError.";
   m.attr("__version__") = JELLY_VERSION_STRING;
   jelly::python::bind_core(m);
   jelly::python::bind_geometry(m);
@@ -18,4 +21,5 @@ PYBIND11_MODULE(_jelly, m) {
   jelly::python::bind_solvers(m);
   jelly::python::bind_io(m);
   jelly::python::bind_fit(m);
+  jelly::python::serialise_simulator(m);
 }

@@ -1,10 +1,12 @@
 // solvers/: integrators by name with their options, the Simulator (step, run_until with Python
 // observers, the state as NumPy views), run reports. The GIL is released while C++ steps.
+#include <chrono>
 #include <memory>
 #include <optional>
 
 #include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/io/run_limits.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/run_report.hpp>
@@ -62,6 +64,25 @@ class CallbackObserver final : public Observer {
 
  private:
   py::object callback_, simulator_;
+};
+
+// Lets Ctrl-C stop run_until: at its frames (every output interval; every step when it is 0),
+// at most every kInterval of wall time, takes the GIL and runs Python's signal handlers; a
+// KeyboardInterrupt (or any exception they raise) leaves run_until after a whole step, with the
+// simulator usable. Python runs handlers in its main thread only.
+class InterruptCheck final : public Observer {
+ public:
+  void on_frame(const Simulator& /*sim*/) override {
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_) return;
+    next_ = now + kInterval;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  }
+
+ private:
+  static constexpr std::chrono::milliseconds kInterval{20};
+  std::chrono::steady_clock::time_point next_ = std::chrono::steady_clock::now() + kInterval;
 };
 
 // Removes the callback observer however run_until ends (also by a Python exception).
@@ -322,7 +343,12 @@ void bind_solvers(py::module_& m) {
       .def_property_readonly("steps", &Integrator::steps, "Steps taken.")
       .def(
           "statistics", [](const Integrator& i) { return statistics_dict(i.statistics()); },
-          "Its counters and timings as a dict {name: value}.");
+          "Its counters and timings as a dict {name: value}.")
+      .def("__repr__", [](const Integrator& i) {
+        return "<jelly.Integrator " + std::string(i.name()) + ": order " +
+               std::to_string(i.order()) + (i.is_implicit() ? ", implicit" : ", explicit") +
+               (i.is_adaptive() ? ", adaptive" : "") + ", " + std::to_string(i.steps()) + " steps>";
+      });
 
   py::class_<DivergenceGuard>(m, "DivergenceGuard",
                               "What counts as diverged (scene key divergence).")
@@ -338,6 +364,9 @@ void bind_solvers(py::module_& m) {
       .def_readwrite("output_interval", &SimulatorOptions::output_interval,
                      "Seconds between observer frames; 0 = every step.")
       .def_readwrite("divergence", &SimulatorOptions::divergence, "The DivergenceGuard.")
+      .def_readwrite("threads", &SimulatorOptions::threads,
+                     "Threads for the force loop, the solves and the contact; 0 = all cores "
+                     "(the same results bit for bit for any count).")
       .def("validate", &SimulatorOptions::validate,
            "Raises InputError naming the first invalid option.");
 
@@ -376,7 +405,34 @@ void bind_solvers(py::module_& m) {
       .def("brief", &RunReport::brief, "One line: status, time, steps, wall time (and the reason).")
       .def("as_dict", &report_dict,
            "The report as a dict (status, t, steps, reason, wall_seconds, ...).")
-      .def("__repr__", [](const RunReport& r) { return "<jelly.RunReport " + r.brief() + ">"; });
+      .def("__repr__", [](const RunReport& r) { return "<jelly.RunReport " + r.brief() + ">"; })
+      .def(py::pickle(
+          [](const RunReport& r) {
+            return py::make_tuple(std::string(run_status_name(r.status)), r.t, r.steps, r.reason,
+                                  r.wall_seconds, r.force_evaluations, r.statistics);
+          },
+          [](const py::tuple& t) {
+            require(t.size() == 7, "RunReport state", std::to_string(t.size()) + " items",
+                    "the 7 items of a pickled RunReport");
+            RunReport r;
+            const std::string status = t[0].cast<std::string>();
+            bool known = false;
+            for (RunStatus s : {RunStatus::kCompleted, RunStatus::kCompletedWithWarnings,
+                                RunStatus::kDiverged, RunStatus::kSolverFailed}) {
+              if (run_status_name(s) == status) {
+                r.status = s;
+                known = true;
+              }
+            }
+            require(known, "RunReport.status", status, "a run status name");
+            r.t = t[1].cast<Real>();
+            r.steps = t[2].cast<long>();
+            r.reason = t[3].cast<std::string>();
+            r.wall_seconds = t[4].cast<double>();
+            r.force_evaluations = t[5].cast<long>();
+            r.statistics = t[6].cast<Statistics>();
+            return r;
+          }));
 
   py::class_<Observer, PyObserver>(m, "Observer",
                                    "Subclass and override on_frame(sim) (and optionally "
@@ -390,11 +446,44 @@ void bind_solvers(py::module_& m) {
   py::class_<SimulatorSnapshot>(m, "SimulatorSnapshot",
                                 "Everything the future of a run depends on besides the model, "
                                 "terrains, integrator and options (bit-for-bit restarts).")
-      .def_readonly("state", &SimulatorSnapshot::state, "The state (a copy).")
+      .def_property_readonly(
+          "state", [](const SimulatorSnapshot& s) { return State(s.state); }, "The state (a copy).")
       .def_readonly("total_steps", &SimulatorSnapshot::total_steps, "Steps taken so far.")
       .def_readonly("next_output", &SimulatorSnapshot::next_output, "Time of the next frame (s).")
       .def_readonly("contact_count", &SimulatorSnapshot::contact_count,
-                    "Contacts of the last step.");
+                    "Contacts of the last step.")
+      .def("__repr__",
+           [](const SimulatorSnapshot& s) {
+             return "<jelly.SimulatorSnapshot t=" + to_text(s.state.t) + " after " +
+                    std::to_string(s.total_steps) + " steps, " +
+                    std::to_string(s.state.x.size() / 3) + " particles>";
+           })
+      .def(py::pickle(
+          [](const SimulatorSnapshot& s) {
+            py::list contacts;
+            for (const ContactSolver::SeedContact& c : s.seed_contacts)
+              contacts.append(py::make_tuple(c.particle, c.normal, c.friction));
+            return py::make_tuple(s.state.t, s.state.x, s.state.v, contacts, s.contact_count,
+                                  s.total_steps, s.next_output, s.integrator_state);
+          },
+          [](const py::tuple& t) {
+            require(t.size() == 8, "SimulatorSnapshot state", std::to_string(t.size()) + " items",
+                    "the 8 items of a pickled SimulatorSnapshot");
+            SimulatorSnapshot s;
+            s.state.t = t[0].cast<Real>();
+            s.state.x = t[1].cast<VecX>();
+            s.state.v = t[2].cast<VecX>();
+            for (const py::handle c : t[3].cast<py::list>()) {
+              const auto item = c.cast<py::tuple>();
+              s.seed_contacts.push_back(
+                  {item[0].cast<int>(), item[1].cast<Vec3>(), item[2].cast<Real>()});
+            }
+            s.contact_count = t[4].cast<int>();
+            s.total_steps = t[5].cast<long>();
+            s.next_output = t[6].cast<Real>();
+            s.integrator_state = t[7].cast<std::vector<Real>>();
+            return s;
+          }));
 
   // dynamic_attr: the report of the last run_until is kept on the Python object (report).
   py::class_<Simulator> simulator(
@@ -412,7 +501,8 @@ void bind_solvers(py::module_& m) {
            py::arg("integrator_options") = IntegratorOptions{},
            py::arg("options") = SimulatorOptions{},
            "A simulator of a model (copied) from a state (default: at rest) with the named "
-           "integrator. Raises InputError for an invalid model, state or option.")
+           "integrator; options.threads chooses its thread count. Raises InputError for an "
+           "invalid model, state or option.")
       .def(
           "add_terrain",
           [](Simulator& s, const Plane& p) { s.add_terrain(std::make_unique<Plane>(p)); },
@@ -445,6 +535,9 @@ void bind_solvers(py::module_& m) {
               observer.emplace(callback, self);
               guard.emplace(sim, *observer);
             }
+            check_run_until(sim, t_end);  // jelly run's limits: steps, rounding
+            InterruptCheck interrupt;
+            ObserverGuard interrupt_guard(sim, interrupt);
             RunReport report;
             {
               py::gil_scoped_release release;
@@ -457,7 +550,9 @@ void bind_solvers(py::module_& m) {
           "Steps until t_end, calling observers (and callback(sim), if given) at every output "
           "frame, and returns a RunReport; stops early on divergence or solver failure, which "
           "the report's status says (no exception). The GIL is released while stepping and "
-          "taken back for each Python call.")
+          "taken back for each Python call. Raises InputError for a run jelly run refuses "
+          "(more than 10^9 steps, a time at which dt is lost to rounding). Ctrl-C "
+          "(KeyboardInterrupt) stops it at the next frame; the simulator stays usable.")
       .def_property_readonly(
           "report",
           [](py::object self) -> py::object {
@@ -491,7 +586,13 @@ void bind_solvers(py::module_& m) {
       .def_property_readonly(
           "integrator", [](Simulator& s) -> Integrator& { return s.integrator(); },
           py::return_value_policy::reference_internal, "The Integrator (name, statistics()).")
-      .def_property_readonly("options", &Simulator::options, "The SimulatorOptions (a copy).")
+      .def_property_readonly(
+          "options", [](const Simulator& s) { return SimulatorOptions(s.options()); },
+          "The SimulatorOptions (a copy: writing to it changes nothing; options.threads is "
+          "set_threads).")
+      .def("set_threads", &Simulator::set_threads, py::arg("threads"),
+           "Sets options.threads: threads for the force loop, the solves and the contact, 0 = "
+           "all cores (the same results bit for bit). Raises InputError for a negative count.")
       .def_property_readonly(
           "terrains",
           [](py::object self) {
@@ -565,7 +666,14 @@ void bind_solvers(py::module_& m) {
       .def(
           "angular_momentum",
           [](const Simulator& s) { return angular_momentum(s.model(), s.state()); },
-          "Angular momentum about the origin (kg m^2/s), [3].");
+          "Angular momentum about the origin (kg m^2/s), [3].")
+      .def("__repr__", [](const Simulator& s) {
+        return "<jelly.Simulator " + std::string(s.integrator().name()) + ", dt " +
+               to_text(s.options().dt) + ", t=" + to_text(s.state().t) + ", " +
+               std::to_string(s.model().num_particles()) + " particles, " +
+               std::to_string(s.terrains().size()) + " terrains, " +
+               std::to_string(s.total_steps()) + " steps>";
+      });
   bind_live_model(simulator);
 }
 

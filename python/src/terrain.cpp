@@ -120,8 +120,11 @@ void bind_terrain(py::module_& m) {
           "The kind's dimensions as {name: number} (what a recording stores).")
       .def("__repr__",
            [](const Terrain& t) { return "<jelly.Terrain " + std::string(t.kind()) + ">"; })
-      .def_property("contact", &Terrain::contact, &Terrain::set_contact,
-                    "Its ContactParams (a copy).");
+      .def_property(
+          "contact", [](const Terrain& t) { return ContactParams(t.contact()); },
+          &Terrain::set_contact,
+          "Its ContactParams (a copy: writing to its fields changes nothing; assigning a whole "
+          "ContactParams validates it and replaces the terrain's).");
 
   m.def("make_terrain", &terrain_from_spec, py::arg("spec"),
         "A terrain of any kind (terrain_kinds()) from its scene JSON: a dict or JSON text such "
@@ -158,7 +161,9 @@ void bind_terrain(py::module_& m) {
            py::arg("contact") = ContactParams{},
            "An elevator from its spec and contact parameters.")
       .def("height", &Elevator::height, py::arg("t"), "Platform height at time t (m).")
-      .def_property_readonly("spec", &Elevator::spec, "Its ElevatorSpec (a copy).");
+      .def_property_readonly(
+          "spec", [](const Elevator& e) { return ElevatorSpec(e.spec()); },
+          "Its ElevatorSpec (a copy: writing to it changes nothing).");
 }
 
 }  // namespace jelly::python

@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <hdf5.h>
@@ -38,6 +39,41 @@ Frames record_slope(const std::string& path, RecorderOptions options = {}) {
   sim.add_observer(probe);
   EXPECT_TRUE(sim.run_until(0.5).ok());
   return frames;
+}
+
+// A recorder made for one simulator refuses another model's simulator when it is added (issue
+// 38: a 27-particle recorder on an 8-particle simulator read past its arrays), naming both.
+TEST(Recorder, RefusesTheSimulatorOfAnotherModel) {
+  TempDir dir;
+  Simulator small = testing::slope_sim(ContactModel::kCoulomb, 2);
+  Simulator large = testing::slope_sim(ContactModel::kCoulomb, 3);
+  H5Recorder recorder(dir.file("large.h5"), large);
+  try {
+    small.add_observer(recorder);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("simulator = 8 particles"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("27 particles"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("large.h5"));
+  }
+  EXPECT_EQ(small.num_observers(), 0u);
+  // The simulator it was made for, or another of the same model, is accepted.
+  Simulator same = testing::slope_sim(ContactModel::kCoulomb, 3);
+  same.add_observer(recorder);
+  large.add_observer(recorder);
+  EXPECT_TRUE(large.run_until(0.01).ok());
+}
+
+// leave_simulators() removes an observer from every simulator it was added to.
+TEST(Recorder, LeavesEverySimulator) {
+  Simulator a = testing::slope_sim(), b = testing::slope_sim();
+  testing::Probe probe([](const Simulator&) {});
+  a.add_observer(probe);
+  b.add_observer(probe);
+  probe.leave_simulators();
+  EXPECT_EQ(a.num_observers(), 0u);
+  EXPECT_EQ(b.num_observers(), 0u);
+  EXPECT_FALSE(a.remove_observer(probe));
 }
 
 class RoundTrip : public ::testing::TestWithParam<bool> {};

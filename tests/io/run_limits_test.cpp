@@ -2,14 +2,16 @@
 // rounding, cubes beyond memory and recordings beyond the disk are InputErrors naming the field.
 #include <jelly/io/run_limits.hpp>
 
+#include <cmath>
 #include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/io/memory_estimate.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
 namespace {
@@ -44,6 +46,31 @@ TEST(MemoryEstimate, CubeCountsAreThoseOfTheBuilder) {
   }
   EXPECT_EQ(cube_spring_count(10), 12876);
   EXPECT_EQ(cube_spring_count(400), 1018727196);  // fits an int, as Springs::size() needs
+  // Counts that would overflow, or of a negative edge, are refused naming n (issue 44).
+  EXPECT_THROW(cube_spring_count(2000000), InputError);
+  EXPECT_THROW(cube_particle_count(-5), InputError);
+  EXPECT_THAT([] { cube_particle_count(-5); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("n = -5 is invalid")));
+  EXPECT_GT(cube_spring_count(500000), 0);
+}
+
+// Python's run_until applies jelly run's limits to a simulator's run (issue 44).
+TEST(RunLimits, RunUntilRefusesAbsurdRunsNamingTheField) {
+  CubeSpec spec;
+  spec.n = 2;
+  const Model model = build_cube(spec);
+  Simulator sim(model, rest_state(model), make_integrator("rk4"));
+  EXPECT_NO_THROW(check_run_until(sim, 1.0));
+  EXPECT_NO_THROW(check_run_until(sim, -1.0));  // no step
+  EXPECT_THAT(
+      [&] { check_run_until(sim, 1e9); },
+      ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("t_end = 1e+09 is invalid")));
+  EXPECT_THROW(check_run_until(sim, std::nan("")), InputError);
+  State far = sim.state();
+  far.t = -1e12;
+  sim.set_state(far);
+  EXPECT_THAT([&] { check_run_until(sim, 1.0); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("state.t = -1e+12")));
 }
 
 TEST(MemoryEstimate, GrowsWithTheCubeAndTheImplicitSolver) {

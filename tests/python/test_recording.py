@@ -86,10 +86,11 @@ def test_recorder_errors_and_close(scenes, tmp_path):
     sim.run_until(0.1)
     recorder.close()
     assert recorder.closed and recorder.frames == 7
-    with pytest.raises(jelly.InputError, match="is closed"):
-        sim.run_until(0.2)
-    sim.remove_observer(recorder)
+    # Closing removed it from the simulator (issue 38): the next run goes on without it.
+    assert not sim.remove_observer(recorder)
     assert sim.run_until(0.3).ok
+    with pytest.raises(jelly.InputError, match="is closed"):
+        sim.add_observer(recorder)
     rec = jelly.read_recording(str(tmp_path / "r.h5"))
     assert rec.frames == 7 and rec.scene_json == ""
     assert not (tmp_path / "r.xdmf").exists()
@@ -125,3 +126,44 @@ def test_a_recording_s_bodies_and_their_surfaces(scenes, tmp_path):
                                    rtol=0, atol=1e-12)
     last = rec.model.body("stiff").surface_vertices(rec.position[-1])
     assert np.array_equal(last, sim.model.body("stiff").surface_vertices(sim.state))
+
+
+def test_the_with_block_of_the_docs_leaves_no_recorder_attached(scenes, tmp_path):
+    scene = jelly.load_scene(scenes / "drop_coulomb.json", {"duration": 0.05})
+    sim = jelly.Simulator(scene)
+    with jelly.H5Recorder(str(tmp_path / "slope.h5"), sim, scene) as recorder:
+        sim.add_observer(recorder)
+        sim.run_until(scene.duration)
+    assert sim.run_until(0.1).ok  # raised "is closed" before
+    assert jelly.read_recording(str(tmp_path / "slope.h5")).frames == recorder.frames
+
+
+def test_a_recorder_refuses_another_simulator(scenes, tmp_path):
+    small = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json", {"cube.n": 2}))
+    large = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json", {"cube.n": 30}))
+    recorder = jelly.H5Recorder(str(tmp_path / "large.h5"), large)
+    with pytest.raises(jelly.InputError, match=r"simulator = 8 particles.*27000 particles"):
+        small.add_observer(recorder)
+    with pytest.raises(ValueError, match="large.h5"):
+        small.add_observer(recorder)
+    assert small.run_until(0.01).ok  # nothing attached
+    # The same particle count in other bodies: refused too, naming them.
+    two = jelly.Simulator(jelly.load_scene(scenes / "two_jellies.json"))
+    renamed = jelly.Simulator(jelly.load_scene(scenes / "two_jellies.json",
+                                               {"bodies[0].name": "other"}))
+    two_recorder = jelly.H5Recorder(str(tmp_path / "two.h5"), two)
+    with pytest.raises(jelly.InputError, match=r"\(other, stiff\).*\(soft, stiff\)"):
+        renamed.add_observer(two_recorder)
+    two.add_observer(two_recorder)  # its own simulator
+    two_recorder.close()
+    recorder.close()
+
+
+def test_recordings_pickle_by_their_path(scenes, tmp_path):
+    import pickle
+    scene = jelly.load_scene(scenes / "drop_coulomb.json")
+    record(scene, str(tmp_path / "r.h5"), 0.05)
+    rec = jelly.read_recording(str(tmp_path / "r.h5"))
+    again = pickle.loads(pickle.dumps(rec))
+    assert again.path == rec.path == str(tmp_path / "r.h5")
+    assert np.array_equal(again.position, rec.position)

@@ -1,6 +1,8 @@
 """Simulation from Python: equal to `jelly run` bit for bit, NumPy views of the C++ state,
 callbacks at every frame, reports (also of diverged runs), the GIL released while stepping."""
 
+import copy
+import pickle
 import re
 import threading
 import weakref
@@ -327,3 +329,71 @@ def test_contact_screening_equals_jelly_run_and_is_validated(scenes, run_cli, tm
     model = jelly.build_cube(jelly.CubeSpec())
     with pytest.raises(jelly.InputError, match="contact_screening_tolerance = 1.5 is invalid"):
         jelly.Simulator(model, integrator="implicit_euler", integrator_options=options)
+
+
+def test_members_documented_as_copies_are_copies(scenes):
+    # Writes to them changed the simulator without validation (issue 38).
+    sim = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json"))
+    sim.options.dt = 5.0
+    sim.options.output_interval = -3
+    sim.options.divergence.max_speed = -1
+    assert sim.options.dt != 5.0 and sim.options.output_interval >= 0
+    assert sim.options.divergence.max_speed == 500
+    sim.terrains[0].contact.restitution = 5.0
+    assert sim.terrains[0].contact.restitution <= 1
+    with pytest.raises(jelly.InputError, match=r"contact\.restitution = 5"):
+        contact = sim.terrains[0].contact
+        contact.restitution = 5.0
+        sim.terrains[0].contact = contact  # the validated way
+    elevator = jelly.Elevator()
+    elevator.spec.size_x = -4
+    assert elevator.spec.size_x == 5
+    snapshot = sim.snapshot()
+    snapshot.state.t = 99
+    assert snapshot.state.t == 0
+
+
+def test_pickling_copies_and_reprs(scenes):
+    scene = jelly.load_scene(scenes / "seed_slope.json")
+    sim = jelly.Simulator(scene)
+    report = sim.run_until(0.01)
+    state = copy.deepcopy(sim.state)
+    assert np.array_equal(state.x, sim.state.x) and not np.shares_memory(state.x, sim.state.x)
+    again = pickle.loads(pickle.dumps(sim.state))
+    assert again.t == sim.t and np.array_equal(again.v, sim.state.v)
+    assert repr(pickle.loads(pickle.dumps(report))) == repr(report)
+    # A pickled snapshot restores bit for bit.
+    snapshot = pickle.loads(pickle.dumps(sim.snapshot()))
+    sim.run_until(0.02)
+    x = np.array(sim.state.x)
+    sim.restore(snapshot)
+    sim.run_until(0.02)
+    assert np.array_equal(sim.state.x, x)
+    options = jelly.SimulatorOptions()
+    options.dt = 0.002
+    options.divergence.max_speed = 40
+    spec = jelly.CubeSpec()
+    spec.set_springs("shear", 10, 2)
+    for value in (options, spec, jelly.IntegratorOptions(), jelly.ContactParams(),
+                  jelly.ElevatorSpec(), jelly.RecorderOptions(), jelly.FitOptions(),
+                  jelly.AnchorSpring(3, [0, 1, 0], 20)):
+        copied = pickle.loads(pickle.dumps(value))
+        assert repr(copied) == repr(value) and type(copied) is type(value)
+    assert pickle.loads(pickle.dumps(spec)).springs("shear").ks == 10
+    assert "dt=0.002" in repr(options) and "max_speed=40" in repr(options)
+    assert repr(sim).startswith("<jelly.Simulator rk4")
+    assert repr(sim.integrator).startswith("<jelly.Integrator rk4")
+    assert repr(sim.model.springs) == "<jelly.Springs 12876 springs>"
+    assert repr(sim.model.pins).startswith("<jelly.Pins 0 particles")
+    assert "jelly.InputError" not in (jelly.InputError.__doc__ or "") and jelly.InputError.__doc__
+
+
+def test_a_simulator_of_a_model_chooses_its_threads():
+    options = jelly.SimulatorOptions()
+    options.threads = 1
+    sim = jelly.Simulator(jelly.build_cube(jelly.CubeSpec()), options=options)
+    assert sim.options.threads == 1
+    sim.set_threads(2)
+    assert sim.options.threads == 2
+    with pytest.raises(jelly.InputError):
+        sim.set_threads(-1)

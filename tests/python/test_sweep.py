@@ -1,6 +1,8 @@
 """Sweeps on Dask distributed: a LocalCluster of 2 workers gives what a serial loop gives."""
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pandas
@@ -87,3 +89,60 @@ def test_sweep_over_a_body_s_path(scenes, client):
         assert table.iloc[i]["status"] == report.status == "completed"
         assert table.iloc[i]["final_energy"] == sim.total_energy()
     assert table.iloc[0]["final_energy"] != table.iloc[1]["final_energy"]
+
+
+def test_a_failing_run_keeps_the_other_rows(scenes, tmp_path, client):
+    # Run 1 cannot write its file (a directory is in the way): its row says so, naming its
+    # parameters; the other runs and summary.csv are kept (issue 38).
+    out = tmp_path / "sweep"
+    (out / "run_0001.h5").mkdir(parents=True)
+    parameters = {"springs.structural.ks": [800, 4000]}
+    with pytest.warns(RuntimeWarning, match=r"1 of 2 runs failed"):
+        table = jelly.sweep(small_scene(scenes), parameters, client=client, out_dir=out,
+                            duration=0.05, overwrite=True)
+    assert list(table["status"]) == ["completed", "failed"]
+    assert table.iloc[1]["reason"].startswith("run 1 (springs.structural.ks=4000): InputError")
+    assert (out / "run_0000.h5").is_file()
+    assert pandas.read_csv(out / "summary.csv")["status"].tolist() == ["completed", "failed"]
+
+
+def test_an_earlier_sweep_s_files_are_kept_unless_overwrite(scenes, tmp_path, client):
+    out = tmp_path / "sweep"
+    parameters = {"springs.shear.kd": [5, 40]}
+    jelly.sweep(small_scene(scenes), parameters, client=client, out_dir=out, duration=0.02)
+    summary = (out / "summary.csv").read_bytes()
+    with pytest.raises(jelly.InputError, match=r"out_dir = .* holds the files of an earlier "
+                                               r"sweep \(summary.csv, run_0000.h5.*overwrite=True"):
+        jelly.sweep(small_scene(scenes), parameters, client=client, out_dir=out, duration=0.03)
+    assert (out / "summary.csv").read_bytes() == summary
+    table = jelly.sweep(small_scene(scenes), parameters, client=client, out_dir=out,
+                        duration=0.03, overwrite=True)
+    assert list(table["status"]) == ["completed", "completed"]
+    assert list(table["t_end"]) == pytest.approx([0.03, 0.03])
+
+
+def test_sweep_applies_the_run_limits_of_jelly_run(scenes, tmp_path):
+    with pytest.raises(jelly.InputError, match=r"integrator\.dt = 1e-06 is invalid: a step "
+                                               r"giving at most 1000000000 steps"):
+        jelly.sweep(small_scene(scenes), {"integrator.dt": [1e-6]}, out_dir=None,
+                    duration=1e4)
+
+
+UNGUARDED_SCRIPT = """
+import jelly
+scene = jelly.load_scene({scene!r}, {{"cube.n": 3, "duration": 0.01}})
+table = jelly.sweep(scene, {{"springs.structural.ks": [700, 1400]}}, out_dir=None)
+print(table)
+"""
+
+
+def test_an_unguarded_script_is_refused_before_any_process_starts(scenes, tmp_path):
+    # The README's snippet pasted into a script without `if __name__ == "__main__":` spun for
+    # ever, every worker importing the script and sweeping again.
+    script = tmp_path / "unguarded.py"
+    script.write_text(UNGUARDED_SCRIPT.format(scene=str(scenes / "seed_slope.json")))
+    result = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                            timeout=120, cwd=tmp_path)
+    assert result.returncode != 0
+    assert "if __name__ == \"__main__\":" in result.stderr
+    assert f"{script}, line 4" in result.stderr
