@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <jelly/core/detail/input_file.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly::detail {
@@ -29,7 +30,8 @@ void require_mesh_file(const std::string& path, const std::string& field,
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   require(fs::exists(status), field, value, "an existing mesh file (not found: " + path + ")");
-  require(fs::is_regular_file(status), field, value, "a regular file (" + path + " is not one)");
+  const std::string why = why_not_a_regular_file(path);
+  require(why.empty(), field, value, "a regular file (" + path + ": " + why + ")");
   const std::uintmax_t bytes = fs::file_size(path, ec);
   require(!ec && bytes <= kMaxMeshFileBytes, field, value,
           "a mesh file of at most 1 GiB (this one has " + std::to_string(bytes) + " bytes)");
