@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
 #include <unordered_map>
 
 #include <assimp/postprocess.h>
@@ -53,32 +52,6 @@ class Welder {
   };
   std::unordered_map<Key, int, Hash> map_;
 };
-
-// Throws InputError unless every element count in the header of the PLY file `path` fits in the
-// file (each element takes at least a byte): assimp allocates them before reading any.
-void require_ply_counts_fit(const std::string& path, const std::string& field,
-                            const std::string& value) {
-  std::error_code ec;
-  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  for (int lines = 0; lines < 1000 && std::getline(in, line); ++lines) {
-    std::istringstream words(line);
-    std::string key, name, count;
-    words >> key;
-    if (key == "end_header") return;
-    if (key != "element") continue;
-    words >> name >> count;
-    const bool digits = !count.empty() && count.size() <= 19 &&
-                        count.find_first_not_of("0123456789") == std::string::npos;
-    if (!digits || ec || std::stoull(count) > bytes) {
-      throw InputError(field, value,
-                       "a PLY file whose element counts fit in it (its header says element " +
-                           name + " " + count + "; the file has " + std::to_string(bytes) +
-                           " bytes)");
-    }
-  }
-}
 
 }  // namespace
 
@@ -156,7 +129,7 @@ MeshFile read_mesh(const std::string& path, const std::string& field) {
   require(ext == ".obj" || ext == ".stl" || ext == ".ply", field, value,
           "a mesh file ending in .obj, .stl or .ply");
   detail::require_mesh_file(path, field, value);
-  if (ext == ".ply") require_ply_counts_fit(path, field, value);
+  if (ext == ".ply") detail::require_ply_counts_fit(path, field, value);
 
   Assimp::Importer importer;
   // ValidateDataStructure runs first and refuses a face naming a vertex the mesh does not have

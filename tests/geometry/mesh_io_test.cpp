@@ -1,4 +1,6 @@
 // Reading meshes: formats, welding, vertex groups, topology, and each kind of bad file.
+#include <cstdint>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -143,9 +145,25 @@ TEST(MeshIo, FaceIndicesOutsideTheVerticesAreRefusedNotFollowed) {
   EXPECT_THAT(error("past.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 9\n"), HasSubstr(field));
   // A vertex count far beyond the file's content (assimp allocated 20 GB for it).
   EXPECT_THAT(error("count.ply", tetrahedron_ply("3 1 2 3", "2000000000")),
-              HasSubstr("element counts fit in it (its header says element vertex 2000000000"));
+              HasSubstr("counts fit in it (its header says element vertex 2000000000"));
   EXPECT_THAT(error("negative.ply", tetrahedron_ply("3 1 2 3", "-4")),
               HasSubstr("element vertex -4"));
+  // A face's list length far beyond the file (assimp allocated 16 GB for it), ASCII and binary.
+  const std::string header =
+      "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+      "property list uint int vertex_indices\nend_header\n";
+  EXPECT_THAT(error("list.ply", "ply\nformat ascii 1.0\n" + header +
+                                    "0 0 0\n1 0 0\n0 1 0\n0 0 1\n4000000000 0 1 2\n"),
+              HasSubstr("element face 0 has a list of 4000000000 items"));
+  std::string binary = "ply\nformat binary_little_endian 1.0\n" + header;
+  const float xyz[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  binary.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  const std::uint32_t length = 4000000000u;
+  const std::int32_t items[3] = {0, 1, 2};
+  binary.append(reinterpret_cast<const char*>(&length), 4);
+  binary.append(reinterpret_cast<const char*>(items), sizeof items);
+  EXPECT_THAT(error("list_binary.ply", binary),
+              HasSubstr("element face 0 has a list of 4000000000 items"));
 }
 
 TEST(MeshIo, WriteRefusesOtherExtensions) {
