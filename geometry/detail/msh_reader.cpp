@@ -6,6 +6,7 @@
 #include <charconv>
 #include <climits>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -57,7 +58,11 @@ std::string shown(std::string_view word) {
   return word.size() > 40 ? s + "..." : s;
 }
 
-// The whitespace-separated words of the file, with the line each starts on.
+// How a number is stored in a binary MSH 4.1 section: an int (4 bytes) or a size_t (8).
+enum class Width { kInt, kSize };
+
+// The whitespace-separated words of the file, with the line each starts on; or, in the sections
+// of a binary file, its numbers (little-endian, as the file's endianness check requires).
 class MshWords {
  public:
   MshWords(const std::string& path, std::string field)
@@ -81,7 +86,37 @@ class MshWords {
     if (w.empty()) fail(what + ", found the end of the file");
     return w;
   }
-  long long integer(const std::string& what, long long lo, long long hi) {
+  // Enters (skipping the newline after the section's name) or leaves a binary section.
+  void set_binary(bool binary) {
+    binary_ = binary;
+    if (binary && pos_ < text_.size() && text_[pos_] == '\n') {
+      ++pos_;
+      ++line_;
+    }
+  }
+  long long integer(const std::string& what, long long lo, long long hi,
+                    Width width = Width::kInt) {
+    if (binary_) {
+      const std::size_t bytes = width == Width::kInt ? 4 : 8;
+      if (text_.size() - pos_ < bytes) fail(what + ", found the end of the file");
+      std::int32_t i = 0;
+      std::uint64_t u = 0;
+      if (width == Width::kInt) {
+        std::memcpy(&i, text_.data() + pos_, 4);
+      } else {
+        std::memcpy(&u, text_.data() + pos_, 8);
+      }
+      pos_ += bytes;
+      const bool in_range = width == Width::kInt ? (i >= lo && i <= hi)
+                                                 : (u <= static_cast<std::uint64_t>(LLONG_MAX) &&
+                                                    static_cast<long long>(u) >= lo &&
+                                                    static_cast<long long>(u) <= hi);
+      if (!in_range) {
+        fail(what + " from " + std::to_string(lo) + " to " + std::to_string(hi) + ", found " +
+             (width == Width::kInt ? std::to_string(i) : std::to_string(u)) + " (binary)");
+      }
+      return width == Width::kInt ? i : static_cast<long long>(u);
+    }
     const std::string_view w = word(what);
     long long v = 0;
     const auto [end, error] = std::from_chars(w.data(), w.data() + w.size(), v);
@@ -91,14 +126,26 @@ class MshWords {
     }
     return v;
   }
-  // A number of items in the file: each takes at least two bytes (a digit and a separator).
+  // A number of items in the file: each takes at least two bytes (a digit and a separator), or
+  // four in a binary section.
   long long count(const std::string& what) {
+    if (binary_) {
+      return integer(what + " (at most one per 4 bytes of the file)", 0,
+                     static_cast<long long>(text_.size() / 4), Width::kSize);
+    }
     return integer(what + " (at most one per 2 bytes of the file)", 0,
                    static_cast<long long>(text_.size() / 2));
   }
   int tag(const std::string& what) { return static_cast<int>(integer(what, INT_MIN, INT_MAX)); }
-  NodeTag node_tag() { return integer("a node tag", 1, LLONG_MAX); }
+  NodeTag node_tag() { return integer("a node tag", 1, LLONG_MAX, Width::kSize); }
   double real(const char* what) {
+    if (binary_) {
+      if (text_.size() - pos_ < 8) fail(std::string(what) + ", found the end of the file");
+      double v = 0;
+      std::memcpy(&v, text_.data() + pos_, 8);
+      pos_ += 8;
+      return v;
+    }
     const std::string_view w = word(what);
     double v = 0;
     const auto [end, error] = std::from_chars(w.data(), w.data() + w.size(), v);
@@ -126,13 +173,14 @@ class MshWords {
     fail_file("line " + std::to_string(line_) + ": " + why);
   }
   [[noreturn]] void fail_file(const std::string& why) const {
-    throw InputError(field_, value_, "an ASCII Gmsh mesh (MSH 2.2 or 4.1): " + why);
+    throw InputError(field_, value_, "a Gmsh mesh (MSH 2.2 or 4.1): " + why);
   }
 
  private:
   std::string field_, value_, text_;
   std::size_t pos_ = 0;
   int line_ = 1;
+  bool binary_ = false;
 };
 
 class MshParser {
@@ -189,12 +237,21 @@ class MshParser {
               "Mesh.MshFileVersion = 2.2 or 4.1)");
     }
     const std::string file_type(w_.word("a file-type"));
-    if (file_type != "0") {
-      w_.fail("file-type " + shown(file_type) + (file_type == "1" ? " (binary)" : "") +
-              ": ASCII MSH 2.2 or 4.1 (file-type 0) is what is read (Gmsh writes it with "
-              "Mesh.Binary = 0)");
+    binary_ = file_type == "1" && v4_;
+    if (file_type != "0" && !binary_) {
+      w_.fail("file-type " + shown(file_type) + (file_type == "1" ? " (binary MSH 2)" : "") +
+              ": ASCII MSH 2.2 or 4.1 (file-type 0) or binary MSH 4.1 is what is read (Gmsh "
+              "writes them with Mesh.MshFileVersion = 2.2 or 4.1, binary with Mesh.Binary = 1 "
+              "and 4.1 only)");
     }
-    w_.integer("a data-size", 1, 16);
+    if (binary_) {
+      w_.integer("a data-size (that of a size_t)", 8, 8);
+      w_.set_binary(true);
+      w_.integer("the binary one (1 in this machine's byte order: little-endian)", 1, 1);
+      w_.set_binary(false);
+    } else {
+      w_.integer("a data-size", 1, 16);
+    }
     w_.expect("$EndMeshFormat");
   }
 
@@ -214,6 +271,7 @@ class MshParser {
   }
 
   void entities() {
+    w_.set_binary(binary_);
     long long counts[4];
     for (long long& c : counts) c = w_.count("the number of entities of a dimension");
     for (int dim = 0; dim < 4; ++dim) {
@@ -229,6 +287,7 @@ class MshParser {
         }
       }
     }
+    w_.set_binary(false);
     w_.expect("$EndEntities");
   }
 
@@ -243,10 +302,11 @@ class MshParser {
       const long long n = w_.count("the number of nodes");
       for (long long i = 0; i < n; ++i) add_node(w_.node_tag());
     } else {
+      w_.set_binary(binary_);
       const long long blocks = w_.count("the number of node blocks");
       const long long total = w_.count("the number of nodes");
-      w_.integer("the smallest node tag", 0, LLONG_MAX);
-      w_.integer("the largest node tag", 0, LLONG_MAX);
+      w_.integer("the smallest node tag", 0, LLONG_MAX, Width::kSize);
+      w_.integer("the largest node tag", 0, LLONG_MAX, Width::kSize);
       long long read = 0;
       std::vector<NodeTag> tags;
       for (long long b = 0; b < blocks; ++b) {
@@ -266,6 +326,7 @@ class MshParser {
         w_.fail("as many nodes in the blocks as the section's header says (" +
                 std::to_string(total) + "; the blocks have " + std::to_string(read) + ")");
       }
+      w_.set_binary(false);
     }
     w_.expect("$EndNodes");
   }
@@ -312,10 +373,11 @@ class MshParser {
         add_element(type, physicals);
       }
     } else {
+      w_.set_binary(binary_);
       const long long blocks = w_.count("the number of element blocks");
       const long long total = w_.count("the number of elements");
-      w_.integer("the smallest element tag", 0, LLONG_MAX);
-      w_.integer("the largest element tag", 0, LLONG_MAX);
+      w_.integer("the smallest element tag", 0, LLONG_MAX, Width::kSize);
+      w_.integer("the largest element tag", 0, LLONG_MAX, Width::kSize);
       long long read = 0;
       for (long long b = 0; b < blocks; ++b) {
         const int dim = static_cast<int>(w_.integer("an entity dimension", 0, 3));
@@ -325,7 +387,7 @@ class MshParser {
         const auto it = entity_physicals_.find({dim, entity});
         physicals = it == entity_physicals_.end() ? std::vector<int>() : it->second;
         for (long long i = 0; i < n; ++i) {
-          w_.integer("an element tag", 1, LLONG_MAX);
+          w_.integer("an element tag", 1, LLONG_MAX, Width::kSize);
           add_element(type, physicals);
         }
         read += n;
@@ -334,6 +396,7 @@ class MshParser {
         w_.fail("as many elements in the blocks as the section's header says (" +
                 std::to_string(total) + "; the blocks have " + std::to_string(read) + ")");
       }
+      w_.set_binary(false);
     }
     w_.expect("$EndElements");
   }
@@ -392,6 +455,7 @@ class MshParser {
 
   MshWords& w_;
   bool v4_ = false;
+  bool binary_ = false;  // a binary MSH 4.1 file: its sections but $PhysicalNames are binary
   std::map<Key, std::string> names_;
   std::map<Key, std::vector<int>> entity_physicals_;  // (dim, entity) -> physical tags (4.1)
   std::vector<std::pair<NodeTag, Vec3>> nodes_;

@@ -1,5 +1,6 @@
-// Tet mesh files read as data: Gmsh MSH 2.2 and 4.1 (ASCII) without Gmsh's parser, TetGen
+// Tet mesh files read as data: Gmsh MSH 2.2 and 4.1 (ASCII; 4.1 binary) without Gmsh, TetGen
 // .node/.ele, and every count, index and line of a hostile file refused naming the field.
+#include <cstdint>
 #include <filesystem>
 #include <map>
 
@@ -56,6 +57,38 @@ constexpr const char* kCubeMsh41 =
     "3 1 4 5\n1 1 2 3 5\n2 4 3 2 8\n3 6 2 5 8\n4 7 5 3 8\n5 2 3 5 8\n"
     "$EndElements\n";
 
+// The unit cube's 5 tets as binary MSH 4.1 (little-endian), its volume in physical group 2; with
+// `nodes` as the node count of the section's header.
+std::string cube_binary_msh41(std::uint64_t nodes = 8) {
+  std::string b = "$MeshFormat\n4.1 1 8\n";
+  const auto i32 = [&](std::int32_t v) { b.append(reinterpret_cast<const char*>(&v), 4); };
+  const auto u64 = [&](std::uint64_t v) { b.append(reinterpret_cast<const char*>(&v), 8); };
+  const auto f64 = [&](double v) { b.append(reinterpret_cast<const char*>(&v), 8); };
+  i32(1);
+  b += "\n$EndMeshFormat\n$Entities\n";
+  for (std::uint64_t c : {0, 0, 0, 1}) u64(c);
+  i32(1);
+  for (double v : {0, 0, 0, 1, 1, 1}) f64(v);
+  u64(1);
+  i32(2);
+  u64(0);
+  b += "\n$EndEntities\n$Nodes\n";
+  for (std::uint64_t v : {std::uint64_t{1}, nodes, std::uint64_t{1}, std::uint64_t{8}}) u64(v);
+  i32(3), i32(1), i32(0), u64(8);
+  for (int t = 1; t <= 8; ++t) u64(t);
+  for (int c = 0; c < 8; ++c) f64(c & 1), f64((c >> 1) & 1), f64((c >> 2) & 1);
+  b += "\n$EndNodes\n$Elements\n";
+  for (std::uint64_t v : {1, 5, 1, 5}) u64(v);
+  i32(3), i32(1), i32(4), u64(5);
+  const int tets[5][4] = {{1, 2, 3, 5}, {4, 3, 2, 8}, {6, 2, 5, 8}, {7, 5, 3, 8}, {2, 3, 5, 8}};
+  for (int e = 0; e < 5; ++e) {
+    u64(e + 1);
+    for (int c : tets[e]) u64(c);
+  }
+  b += "\n$EndElements\n";
+  return b;
+}
+
 std::map<std::string, std::size_t> group_sizes(const TetMesh& m) {
   std::map<std::string, std::size_t> sizes;
   for (const VertexGroup& g : m.groups) sizes[g.name] = g.vertices.size();
@@ -78,6 +111,11 @@ TEST(TetMeshIo, Msh22And41AreReadWithoutGmsh) {
   EXPECT_EQ(v4.vertices[0], Vec3(0, 0, 0));
   EXPECT_EQ(group_sizes(v4), (std::map<std::string, std::size_t>{
                                  {"physical_0_1", 1}, {"physical_2_5", 3}, {"volume", 8}}));
+  const TetMesh binary =
+      read_tet_mesh(write_text(dir.file("cube_bin.msh"), cube_binary_msh41()), "file");
+  EXPECT_EQ(binary.vertices, v4.vertices);
+  EXPECT_EQ(binary.tets, v4.tets);
+  EXPECT_EQ(group_sizes(binary), (std::map<std::string, std::size_t>{{"physical_3_2", 8}}));
 }
 
 // A file of Gmsh script named .msh runs nothing, reads no other file and does not hang.
@@ -118,8 +156,14 @@ TEST(TetMeshIo, MshFilesOtherThanAsciiTetMeshesAreRefusedNamingWhat) {
   const auto error = [&](const std::string& name, const std::string& text) {
     return input_error([&] { read_tet_mesh(write_text(dir.file(name), text), field); });
   };
-  EXPECT_THAT(error("binary.msh", "$MeshFormat\n4.1 1 8\n\x01\x00\x00\x00\n$EndMeshFormat\n"),
-              HasSubstr("file-type 1 (binary): ASCII MSH 2.2 or 4.1 (file-type 0)"));
+  EXPECT_THAT(error("binary.msh", "$MeshFormat\n2.2 1 8\n\x01\x00\x00\x00\n$EndMeshFormat\n"),
+              HasSubstr("file-type 1 (binary MSH 2): ASCII MSH 2.2 or 4.1 (file-type 0) or "
+                        "binary MSH 4.1"));
+  EXPECT_THAT(error("binary_count.msh", cube_binary_msh41(1ull << 40)),
+              HasSubstr("found 1099511627776 (binary)"));
+  std::string big_endian = cube_binary_msh41();
+  std::swap(big_endian[20], big_endian[23]);  // the binary one, byte-swapped
+  EXPECT_THAT(error("big_endian.msh", big_endian), HasSubstr("the binary one"));
   EXPECT_THAT(error("v3.msh", "$MeshFormat\n3.0 0 8\n$EndMeshFormat\n"),
               HasSubstr("version 3.0: ASCII MSH 2.2 or 4.1"));
   EXPECT_THAT(error("v40.msh", "$MeshFormat\n4 0 8\n$EndMeshFormat\n"), HasSubstr("version 4"));
