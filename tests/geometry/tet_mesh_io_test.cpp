@@ -150,7 +150,7 @@ TEST(TetMeshIo, GmshScriptInAMshFileIsRefusedNotRun) {
               HasSubstr("found 'While(1)'"));
 }
 
-TEST(TetMeshIo, MshFilesOtherThanAsciiTetMeshesAreRefusedNamingWhat) {
+TEST(TetMeshIo, MshFilesOtherThanTetMeshesAreRefusedNamingWhat) {
   TempDir dir;
   const std::string field = "bodies[0].file";
   const auto error = [&](const std::string& name, const std::string& text) {
