@@ -1,10 +1,13 @@
 // jelly: simulate scenes (run), describe recordings (info), fit coefficients to a recording
 // (fit), list what a scene can name (list), watch scenes and recordings (view), render videos
 // (render), export surfaces for other tools (export), fill surfaces with tetrahedra (mesh).
+#include <charconv>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <new>
 #include <string>
+#include <system_error>
 
 #include <CLI/CLI.hpp>
 
@@ -23,6 +26,19 @@ const CLI::Validator kNonEmpty(
       return value.empty() ? std::string("an empty value") : std::string();
     },
     "", "NONEMPTY");
+
+// --threads: a count of threads, 0 for all cores (CLI11's NonNegativeNumber named the range of a
+// double, a number of 310 digits).
+const CLI::Validator kThreadCount(
+    [](std::string& value) {
+      int n = -1;
+      const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), n);
+      return error == std::errc() && end == value.data() + value.size() && n >= 0
+                 ? std::string()
+                 : value + " is invalid: an integer from 0 (all cores) to " +
+                       std::to_string(std::numeric_limits<int>::max());
+    },
+    "", "THREADS");
 
 constexpr const char* kFooter =
     "Exit codes: 0 ok, 2 bad input (scene, option or argument), 3 the run diverged or the solver "
@@ -76,7 +92,7 @@ int main(int argc, char** argv) {
                   "Threads for the force loop, the solves and contact (default: the scene's "
                   "`threads`, 0 = all cores; the results are the same for any number)")
       ->type_name("N")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kThreadCount);
 
   std::string info_path;
   CLI::App* info = app.add_subcommand("info", "Describe an HDF5 file written by `jelly run -o`");

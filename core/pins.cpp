@@ -19,13 +19,20 @@ void Pins::add(int particle, const Vec3& anchor, int path_index) {
   path.push_back(path_index);
 }
 
-void Pins::add_fixed(int particle, const Vec3& anchor) {
-  int fixed = -1;
-  for (int p = 0; p < static_cast<int>(paths.size()); ++p) {
-    if (paths[p].is_fixed()) fixed = p;
+void Pins::add_fixed(int particle, const Vec3& anchor) { add(particle, anchor, fixed_path()); }
+
+void Pins::add_new(const std::vector<int>& new_particles, const std::vector<Vec3>& new_anchors,
+                   int path_index) {
+  particles.insert(particles.end(), new_particles.begin(), new_particles.end());
+  anchors.insert(anchors.end(), new_anchors.begin(), new_anchors.end());
+  path.insert(path.end(), new_particles.size(), path_index);
+}
+
+int Pins::fixed_path() {
+  for (int p = static_cast<int>(paths.size()) - 1; p >= 0; --p) {
+    if (paths[p].is_fixed()) return p;
   }
-  if (fixed < 0) fixed = add_path(Path());
-  add(particle, anchor, fixed);
+  return add_path(Path());
 }
 
 int Pins::find(int particle) const {

@@ -21,7 +21,8 @@ struct Pins {
   // Adds a path and returns its index.
   int add_path(Path p);
   // Pins `particle` at `anchor` (t = 0) moving along paths[path_index]; a particle pinned
-  // twice keeps its first pin.
+  // twice keeps its first pin. Linear in the number of pins (it looks for the particle): many
+  // new particles go through add_new.
   void add(int particle, const Vec3& anchor, int path_index);
   void add_fixed(int particle, const Vec3& anchor);
   // The pin of `particle` (its index k), or -1 when it is not pinned.
@@ -32,6 +33,11 @@ struct Pins {
   void set(int particle, const Vec3& anchor, Path p);
   // Frees `particle`; false when it was not pinned.
   bool remove(int particle);
+  // Pins particles[j] at anchors[j] moving along paths[path_index], in time linear in their
+  // number: the caller has checked that none is pinned yet and that each appears once.
+  void add_new(const std::vector<int>& particles, const std::vector<Vec3>& anchors, int path_index);
+  // The index of a fixed path, added if there is none.
+  int fixed_path();
   bool all_fixed() const;
 
   Vec3 position(int k, Real t) const;

@@ -78,8 +78,10 @@ std::vector<int> ParticleSelection::resolve(const Model& model, const Body& body
 ParticleSelection ParticleSelection::read(JsonFields& f) {
   ParticleSelection s;
   if (const Json* idx = f.value("indices")) {
-    if (!idx->is_array()) {
-      throw InputError(f.path("indices"), json_text(*idx), "a list of particle indices");
+    if (!idx->is_array() || idx->empty()) {
+      throw InputError(f.path("indices"), json_text(*idx),
+                       "a list of at least one particle index (leave \"indices\", \"region\" "
+                       "and \"group\" out to choose the whole body)");
     }
     for (std::size_t i = 0; i < idx->size(); ++i) {
       s.indices.push_back(json_integer((*idx)[i], json_element(f.path("indices"), i)));
@@ -232,16 +234,31 @@ void add_body(Model& model, const BodySpec& spec, const std::string& prefix) {
   model.bodies[index].velocity = spec.velocity;
   model.bodies[index].angular_velocity = spec.angular_velocity;
   const Body& body = model.bodies[index];
+  // The body's particles are new: no pin holds them yet. Each may be in one of its pins only
+  // (two would give it two paths).
+  std::vector<int> pinned_by(body.num_particles, -1);
   for (std::size_t k = 0; k < spec.pins.size(); ++k) {
-    const std::string at = prefix + "pins[" + std::to_string(k) + "].";
+    const std::string at = prefix + "pins[" + std::to_string(k) + "]";
     const PinSpec& pin = spec.pins[k];
-    const int path = pin.path.is_fixed() ? -1 : model.pins.add_path(pin.path);
-    for (int i : pin.select.resolve(model, body, at)) {
-      if (path < 0)
-        model.pins.add_fixed(i, particle(model.rest_position, i));
-      else
-        model.pins.add(i, particle(model.rest_position, i), path);
+    const std::vector<int> chosen = pin.select.resolve(model, body, at + ".");  // sorted, unique
+    std::vector<Vec3> anchors;
+    anchors.reserve(chosen.size());
+    for (int i : chosen) {
+      int& by = pinned_by[i - body.first_particle];
+      if (by >= 0) {
+        Json selection = Json::object();
+        pin.select.write(selection);
+        throw InputError(at, json_text(selection),
+                         "pins that share no particle (particle " +
+                             std::to_string(i - body.first_particle) + " of body \"" + body.name +
+                             "\" is also in " + prefix + "pins[" + std::to_string(by) +
+                             "]: give it one pin, one path)");
+      }
+      by = static_cast<int>(k);
+      anchors.push_back(particle(model.rest_position, i));
     }
+    const int path = pin.path.is_fixed() ? model.pins.fixed_path() : model.pins.add_path(pin.path);
+    model.pins.add_new(chosen, anchors, path);
   }
   for (std::size_t k = 0; k < spec.forces.size(); ++k) {
     const std::string at = prefix + "forces[" + std::to_string(k) + "].";

@@ -129,9 +129,13 @@ MeshFile read_mesh(const std::string& path, const std::string& field) {
   require(ext == ".obj" || ext == ".stl" || ext == ".ply", field, value,
           "a mesh file ending in .obj, .stl or .ply");
   detail::require_mesh_file(path, field, value);
+  if (ext == ".ply") detail::require_ply_counts_fit(path, field, value);
 
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate);
+  // ValidateDataStructure runs first and refuses a face naming a vertex the mesh does not have
+  // (before Triangulate reads the vertices of polygons).
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate);
   if (scene == nullptr) {
     throw InputError(
         field, value,
@@ -160,6 +164,14 @@ MeshFile read_mesh(const std::string& path, const std::string& field) {
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines
+      for (int k = 0; k < 3; ++k) {
+        if (face.mIndices[k] >= am->mNumVertices) {
+          throw InputError(field, value,
+                           "a mesh whose faces name its vertices (a face names vertex " +
+                               std::to_string(static_cast<int>(face.mIndices[k])) + " of " +
+                               std::to_string(am->mNumVertices) + ")");
+        }
+      }
       const Triangle t{index[face.mIndices[0]], index[face.mIndices[1]], index[face.mIndices[2]]};
       if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
         ++dropped;

@@ -55,6 +55,21 @@ void validate_tet_mesh(const TetMesh& mesh, const std::string& field, const std:
           "a mesh of tetrahedra with a volume (tet " + std::to_string(t) + " is flat)");
     }
   }
+  // Each tet once: the tets sorted by their sorted corners, neighbours compared.
+  std::vector<std::pair<Tet, int>> sorted(mesh.tets.size());
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    sorted[t] = {mesh.tets[t], t};
+    std::sort(sorted[t].first.begin(), sorted[t].first.end());
+  }
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t i = 1; i < sorted.size(); ++i) {
+    if (sorted[i].first == sorted[i - 1].first) {
+      throw InputError(field, value,
+                       "a mesh in which each tetrahedron appears once (tets " +
+                           std::to_string(sorted[i - 1].second) + " and " +
+                           std::to_string(sorted[i].second) + " have the same vertices)");
+    }
+  }
 }
 
 void drop_unused_vertices(TetMesh& mesh) {

@@ -26,7 +26,8 @@ struct TetMesh {
 };
 
 // Throws InputError naming `field` = "`file`" unless there is a tet, every index is in range,
-// every coordinate finite and every tet has a volume above 1e-12 times its longest edge cubed.
+// every coordinate finite, every tet has a volume above 1e-12 times its longest edge cubed and
+// no two tets have the same vertices.
 void validate_tet_mesh(const TetMesh& mesh, const std::string& field, const std::string& file);
 
 // Removes the vertices no tet uses, renumbering the tets and the groups (a group left empty

@@ -2,9 +2,11 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include <jelly/core/detail/input_file.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly {
@@ -41,6 +43,8 @@ void write_obj(const std::string& path, const std::vector<ObjObject>& objects,
 }
 
 std::vector<ObjObject> read_obj(const std::string& path) {
+  const std::string why = detail::why_not_a_regular_file(path);
+  if (!why.empty()) throw InputError("file", path, "an OBJ file that can be read (" + why + ")");
   std::ifstream in(path);
   if (!in) throw InputError("file", path, "an OBJ file that can be read");
   std::vector<ObjObject> objects;
@@ -120,6 +124,8 @@ void Pc2Writer::close() {
 }
 
 Pc2Data read_pc2(const std::string& path) {
+  const std::string why = detail::why_not_a_regular_file(path);
+  if (!why.empty()) throw InputError("file", path, "a PC2 file that can be read (" + why + ")");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("file", path, "a PC2 file that can be read");
   char signature[12];
@@ -134,6 +140,14 @@ Pc2Data read_pc2(const std::string& path) {
   if (!in || std::memcmp(signature, kPc2Signature, 12) != 0 || version != 1 || points < 0 ||
       samples < 0)
     throw InputError("file", path, "a PC2 file (POINTCACHE2 header, version 1)");
+  // The counts are checked against the file's size before anything is allocated from them.
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (ec || 12.0 * points * samples > static_cast<double>(bytes)) {
+    throw InputError("file", path,
+                     "a complete PC2 file (its header promises " + std::to_string(samples) +
+                         " samples of " + std::to_string(points) + " points, more than it holds)");
+  }
   d.num_points = points;
   for (int s = 0; s < samples; ++s) {
     d.samples.emplace_back(static_cast<size_t>(3 * points));

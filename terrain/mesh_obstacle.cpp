@@ -79,8 +79,7 @@ std::shared_ptr<const MeshObstacleShape> MeshObstacleSpec::shape(const std::stri
 void MeshObstacleSpec::validate(const std::string& prefix) const {
   require(!file.empty(), prefix + "file", "\"\"", "the name of an OBJ, STL or PLY file");
   pose.validate(prefix);
-  require(angular_velocity_degrees.allFinite(), prefix + "angular_velocity_degrees",
-          angular_velocity_degrees.transpose(), "finite rates (degrees per second)");
+  validate_angular_velocity(angular_velocity_degrees, prefix + "angular_velocity_degrees");
   shape(prefix);
 }
 

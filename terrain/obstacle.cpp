@@ -121,8 +121,7 @@ void ObstacleSpec::validate(const std::string& prefix) const {
   require(center.allFinite(), prefix + "center", center.transpose(), "finite coordinates");
   require(rotation_degrees.allFinite(), prefix + "rotation_degrees", rotation_degrees.transpose(),
           "finite angles (degrees)");
-  require(angular_velocity_degrees.allFinite(), prefix + "angular_velocity_degrees",
-          angular_velocity_degrees.transpose(), "finite rates (degrees per second)");
+  validate_angular_velocity(angular_velocity_degrees, prefix + "angular_velocity_degrees");
   const ObstacleGeometry& g = geometry;
   if (g.shape != ObstacleShape::kBox) {
     require(std::isfinite(g.radius) && g.radius > 0, prefix + "radius", g.radius,

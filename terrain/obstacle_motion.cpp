@@ -3,6 +3,7 @@
 #include <cmath>
 #include <utility>
 
+#include <jelly/core/errors.hpp>
 #include <jelly/geometry/pose.hpp>
 
 namespace jelly {
@@ -10,6 +11,13 @@ namespace jelly {
 namespace {
 constexpr Real kDegree = M_PI / 180;
 }  // namespace
+
+void validate_angular_velocity(const Vec3& degrees_per_second, const std::string& field) {
+  require(degrees_per_second.allFinite() && degrees_per_second.norm() <= kMaxAngularVelocityDegrees,
+          field, degrees_per_second.transpose(),
+          "finite rates (degrees per second) whose norm is at most 1e6 (about 2,800 turns a "
+          "second)");
+}
 
 ObstacleMotion::ObstacleMotion(const Vec3& position, const Vec3& rotation_degrees, Path path,
                                const Vec3& angular_velocity_degrees)

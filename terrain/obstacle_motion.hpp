@@ -2,12 +2,21 @@
 // The rigid motion of an obstacle (terrain/obstacle.hpp, terrain/mesh_obstacle.hpp): its origin
 // at `position` plus a prescribed path's offset at time t, its orientation the initial rotation
 // spun about the origin at a constant angular velocity.
+#include <string>
+
 #include <Eigen/Geometry>
 
 #include <jelly/core/path.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {
+
+// The fastest spin an obstacle may have: the norm of its angular velocity in degrees per second
+// (about 2,800 turns a second; rates near a double's range overflowed the contact velocities).
+constexpr Real kMaxAngularVelocityDegrees = 1e6;
+// Throws InputError naming `field` unless the rates are finite and their norm is at most
+// kMaxAngularVelocityDegrees.
+void validate_angular_velocity(const Vec3& degrees_per_second, const std::string& field);
 
 class ObstacleMotion {
  public:

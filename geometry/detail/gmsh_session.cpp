@@ -38,7 +38,7 @@ std::string GmshSession::last_error() const {
 
 TetMesh GmshSession::tet_mesh(const std::string& field, const std::string& value) const {
   const auto fail = [&](const std::string& why) {
-    throw InputError(field, value, "a mesh file Gmsh reads: " + why);
+    throw InputError(field, value, "a surface Gmsh fills with tetrahedra: " + why);
   };
   std::vector<int> types;
   gmsh::model::mesh::getElementTypes(types, 3);

@@ -2,10 +2,17 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string_view>
+#include <vector>
 
+#include <jelly/core/detail/input_file.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly::detail {
@@ -29,11 +36,171 @@ void require_mesh_file(const std::string& path, const std::string& field,
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   require(fs::exists(status), field, value, "an existing mesh file (not found: " + path + ")");
-  require(fs::is_regular_file(status), field, value, "a regular file (" + path + " is not one)");
+  const std::string why = why_not_a_regular_file(path);
+  require(why.empty(), field, value, "a regular file (" + path + ": " + why + ")");
   const std::uintmax_t bytes = fs::file_size(path, ec);
   require(!ec && bytes <= kMaxMeshFileBytes, field, value,
           "a mesh file of at most 1 GiB (this one has " + std::to_string(bytes) + " bytes)");
   require(static_cast<bool>(std::ifstream(path)), field, value, "a readable file");
+}
+
+namespace {
+
+struct Property {
+  int size = 0;        // bytes of a scalar, or of a list's items
+  int count_size = 0;  // bytes of a list's length; 0 for a scalar
+  bool count_signed = false;
+};
+
+struct Element {
+  std::string name;
+  long long count = 0;
+  std::vector<Property> properties;
+};
+
+// Bytes of a PLY scalar type, 0 for an unknown one; `is_signed` tells a signed integer.
+int type_size(const std::string& type, bool* is_signed = nullptr) {
+  static const struct {
+    const char* name;
+    int size;
+    bool is_signed;
+  } kTypes[] = {
+      {"char", 1, true},  {"int8", 1, true},    {"uchar", 1, false},  {"uint8", 1, false},
+      {"short", 2, true}, {"int16", 2, true},   {"ushort", 2, false}, {"uint16", 2, false},
+      {"int", 4, true},   {"int32", 4, true},   {"uint", 4, false},   {"uint32", 4, false},
+      {"float", 4, true}, {"float32", 4, true}, {"double", 8, true},  {"float64", 8, true}};
+  for (const auto& t : kTypes) {
+    if (type == t.name) {
+      if (is_signed != nullptr) *is_signed = t.is_signed;
+      return t.size;
+    }
+  }
+  return 0;
+}
+
+// A list length stored in `bytes` bytes at p (little or big endian), as a signed number.
+long long read_count(const char* p, int bytes, bool is_signed, bool big_endian) {
+  std::uint64_t u = 0;
+  for (int k = 0; k < bytes; ++k) {
+    const auto byte = static_cast<unsigned char>(p[big_endian ? k : bytes - 1 - k]);
+    u = (u << 8) | byte;
+  }
+  if (is_signed && bytes < 8 && (u >> (8 * bytes - 1)) != 0) {
+    return static_cast<long long>(u) - (1LL << (8 * bytes));  // negative
+  }
+  return static_cast<long long>(u);
+}
+
+}  // namespace
+
+void require_ply_counts_fit(const std::string& path, const std::string& field,
+                            const std::string& value) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto fail = [&](const std::string& why) {
+    throw InputError(field, value, "a PLY file whose counts fit in it (" + why + ")");
+  };
+
+  // The header.
+  const std::size_t header_end = text.find("end_header");
+  if (text.compare(0, 3, "ply") != 0 || header_end == std::string::npos) {
+    return;  // not PLY at all: assimp says so
+  }
+  std::istringstream header(text.substr(0, header_end));
+  std::string line, format;
+  std::vector<Element> elements;
+  while (std::getline(header, line)) {
+    std::istringstream words(line);
+    std::string key;
+    words >> key;
+    if (key == "format") {
+      words >> format;
+    } else if (key == "element") {
+      Element e;
+      std::string count;
+      words >> e.name >> count;
+      const auto [end, error] = std::from_chars(count.data(), count.data() + count.size(), e.count);
+      if (error != std::errc() || end != count.data() + count.size() || e.count < 0 ||
+          e.count > static_cast<long long>(text.size())) {
+        fail("its header says element " + e.name + " " + count + "; the file has " +
+             std::to_string(text.size()) + " bytes");
+      }
+      elements.push_back(std::move(e));
+    } else if (key == "property") {
+      if (elements.empty()) fail("a property before any element");
+      std::string type;
+      words >> type;
+      Property p;
+      if (type == "list") {
+        std::string count_type, item_type;
+        words >> count_type >> item_type;
+        p.count_size = type_size(count_type, &p.count_signed);
+        p.size = type_size(item_type);
+        if (p.count_size == 0 || p.size == 0) {
+          fail("a list of unknown type '" + count_type + " " + item_type + "'");
+        }
+      } else {
+        p.size = type_size(type);
+        if (p.size == 0) fail("a property of unknown type '" + type + "'");
+      }
+      elements.back().properties.push_back(p);
+    }
+  }
+  std::size_t pos = text.find('\n', header_end);
+  pos = pos == std::string::npos ? text.size() : pos + 1;
+
+  // The body: each list's length against what is left.
+  const bool ascii = format == "ascii";
+  const bool big_endian = format == "binary_big_endian";
+  if (!ascii && !big_endian && format != "binary_little_endian") return;  // assimp refuses it
+  const auto next_word = [&](std::string_view* word) {
+    while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
+    const std::size_t start = pos;
+    while (pos < text.size() && !std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
+    *word = std::string_view(text).substr(start, pos - start);
+    return !word->empty();
+  };
+  for (const Element& e : elements) {
+    for (long long i = 0; i < e.count; ++i) {
+      for (const Property& p : e.properties) {
+        long long items = 1;
+        if (p.count_size > 0) {
+          if (ascii) {
+            std::string_view word;
+            if (!next_word(&word)) return;  // truncated: assimp says so
+            double length = 0;
+            const auto [end, error] =
+                std::from_chars(word.data(), word.data() + word.size(), length);
+            if (error != std::errc() || end != word.data() + word.size()) return;
+            if (!(length >= 0 && length <= static_cast<double>(text.size() - pos) / 2 + 1)) {
+              fail("element " + e.name + " " + std::to_string(i) + " has a list of " +
+                   std::string(word) + " items, more than the " +
+                   std::to_string(text.size() - pos) + " bytes left can hold");
+            }
+            items = static_cast<long long>(length);
+          } else {
+            if (pos + p.count_size > text.size()) return;
+            items = read_count(text.data() + pos, p.count_size, p.count_signed, big_endian);
+            pos += p.count_size;
+            if (items < 0 || static_cast<unsigned long long>(items) * p.size > text.size() - pos) {
+              fail("element " + e.name + " " + std::to_string(i) + " has a list of " +
+                   std::to_string(items) + " items, more than the " +
+                   std::to_string(text.size() - pos) + " bytes left can hold");
+            }
+          }
+        }
+        if (ascii) {
+          std::string_view word;
+          for (long long k = 0; k < items; ++k) {
+            if (!next_word(&word)) return;
+          }
+        } else {
+          pos += static_cast<std::size_t>(items) * p.size;
+          if (pos > text.size()) return;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace jelly::detail

@@ -15,4 +15,11 @@ std::string lower_extension(const std::string& path);
 // most 1 GiB (a larger one is most likely a mistaken path).
 void require_mesh_file(const std::string& path, const std::string& field, const std::string& value);
 
+// Walks the header and the body of the PLY file at `path` (ASCII or binary) without keeping
+// anything, and throws InputError(field, value, ...) for an element count or a list length larger
+// than what is left of the file, a negative one, or a property of unknown type: assimp allocates
+// what they say before reading the items.
+void require_ply_counts_fit(const std::string& path, const std::string& field,
+                            const std::string& value);
+
 }  // namespace jelly::detail

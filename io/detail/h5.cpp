@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <jelly/core/detail/input_file.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly::h5 {
@@ -199,6 +200,10 @@ Handle create_file(const std::string& path, bool exclusive) {
 }
 
 Handle open_file(const std::string& path, bool writable) {
+  // A pipe or a device would block HDF5's first read for ever.
+  if (const std::string why = detail::why_not_a_regular_file(path); !why.empty()) {
+    throw InputError("cannot open '" + path + "': " + why);
+  }
   if (H5Fis_hdf5(path.c_str()) <= 0) {
     FILE* f = std::fopen(path.c_str(), "rb");
     if (f == nullptr) throw InputError("cannot open '" + path + "': no such readable file");

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include <jelly/core/detail/input_file.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly::detail {
@@ -136,17 +137,9 @@ std::string read_json_file(const std::string& path, const std::string& what) {
   const auto fail = [&](const std::string& why) {
     return InputError("cannot read the " + what + " '" + path + "': " + why);
   };
+  if (const std::string why = why_not_a_regular_file(path); !why.empty()) throw fail(why);
   struct stat info {};
   if (stat(path.c_str(), &info) != 0) throw fail(std::strerror(errno));
-  if (S_ISDIR(info.st_mode)) throw fail("it is a directory");
-  if (!S_ISREG(info.st_mode)) {
-    throw fail(std::string("it is ") +
-               (S_ISCHR(info.st_mode)    ? "a character device"
-                : S_ISBLK(info.st_mode)  ? "a block device"
-                : S_ISFIFO(info.st_mode) ? "a pipe"
-                                         : "not a regular file") +
-               ", not a file");
-  }
   if (info.st_size > kMaxJsonFileBytes) {
     throw fail("it holds " + std::to_string(info.st_size) + " bytes, more than a JSON file can (" +
                std::to_string(kMaxJsonFileBytes) + ")");

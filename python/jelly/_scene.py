@@ -15,6 +15,7 @@ from __future__ import annotations
 import copy as _copy
 import json
 import os
+import stat
 from typing import Any, Iterable, Iterator, Mapping, Union
 
 from . import _jelly
@@ -378,6 +379,8 @@ def load_scene(path: Union[str, os.PathLike], overrides: Overrides = ()) -> Scen
     naming the JSON path of the first invalid field."""
     path = os.fspath(path)
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # a pipe or a device: open() would block
+            _jelly._load_scene(path)  # raises the C++ InputError naming what the path is
         with open(path, encoding="utf-8") as f:
             text = f.read()
     except OSError:

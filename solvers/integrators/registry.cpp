@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <string>
 #include <type_traits>
 #include <utility>
 
@@ -39,6 +40,19 @@ constexpr auto kArkode = &IntegratorOptions::arkode;
 constexpr auto kPd = &IntegratorOptions::pd;
 constexpr auto kXpbd = &IntegratorOptions::xpbd;
 
+// arkode_erk's options: ArkodeOptions without arkode_dirk's linear solver.
+IntegratorOptionsIo arkode_erk_options() {
+  IntegratorOptionsIo io = options_io<kArkode>();
+  io.validate = [](const IntegratorOptions& o, const std::string& prefix) {
+    o.arkode.validate(prefix);
+    require(o.arkode.linear_solver == ArkodeLinearSolver::kAuto, prefix + "linear_solver",
+            "\"" + std::string(name_of(arkode_linear_solvers(), o.arkode.linear_solver)) + "\"",
+            "\"auto\" (arkode_erk solves no linear system: linear_solver is arkode_dirk's "
+            "option)");
+  };
+  return io;
+}
+
 struct Entry {
   IntegratorInfo info;
   Factory make;
@@ -59,7 +73,7 @@ const std::vector<Entry>& table() {
           options_io<kArkode>()},
          [](const IntegratorOptions& o) { return std::make_unique<ArkodeDirk>(o.arkode); }},
         {{"arkode_erk", "SUNDIALS ARKODE adaptive explicit Runge-Kutta (default 5(4) pair)",
-          options_io<kArkode>()},
+          arkode_erk_options()},
          [](const IntegratorOptions& o) { return std::make_unique<ArkodeErk>(o.arkode); }},
         {{"explicit_euler", "forward Euler, order 1, explicit", kNoOptions},
          plain<ExplicitEuler>()},

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -178,6 +179,46 @@ TEST(Hangs, ACharacterDeviceAsTheSceneExitsTwo) {
   EXPECT_EQ(r.err,
             "error: cannot read the scene file '/dev/zero': it is a character device, "
             "not a file\n");
+}
+
+TEST(Hangs, APipeAsAnInputFileExitsTwo) {
+  const std::string fifo = temp_path(".h5");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& command :
+       {"info " + quoted(fifo), "xdmf " + quoted(fifo), "fit " + quoted(fifo),
+        "run " + kSmallSlope + " --restart " + quoted(fifo)}) {
+    const Result r = jelly(command);
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_THAT(r.err, HasSubstr("it is a pipe, not a file")) << command;
+  }
+  const std::string msh = temp_path(".msh");
+  ASSERT_EQ(mkfifo(msh.c_str(), 0600), 0);
+  const Result r =
+      jelly("run " +
+            quoted(write_scene(R"({"bodies": [{"kind": "tetmesh", "file": ")" + msh +
+                               R"("}], "integrator": {"name": "rk4"}, "duration": 1})")) +
+            " -q");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("bodies[0].file = \"" + msh + "\" is invalid: a regular file"));
+}
+
+// ---- Security ----
+
+TEST(Security, AMeshFileOfGmshScriptRunsNothingAndExitsTwo) {
+  const std::string touched = temp_path(".touched");
+  const std::string msh = temp_path(".msh");
+  std::ofstream(msh) << "SystemCall \"touch " << touched << "\";\n";
+  const std::string scene = write_scene(R"({"bodies": [{"kind": "tetmesh", "file": ")" + msh +
+                                        R"("}], "integrator": {"name": "rk4"}, "duration": 1})");
+  const Result r = jelly("run " + quoted(scene) + " -q");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("found 'SystemCall' (a mesh file is data"));
+  EXPECT_FALSE(exists(touched));
+  // jelly mesh reads its surface with the mesh readers: a .msh is not handed to Gmsh.
+  const Result m = jelly("mesh " + quoted(msh) + " -o " + quoted(temp_path(".msh")));
+  EXPECT_EQ(m.code, 2);
+  EXPECT_THAT(m.err, HasSubstr("a mesh file ending in .obj, .stl or .ply"));
+  EXPECT_FALSE(exists(touched));
 }
 
 TEST(Hangs, AbsurdStepAndFrameCountsExitTwoBeforeTheRun) {

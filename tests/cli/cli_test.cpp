@@ -233,6 +233,19 @@ TEST(Cli, CommandLineParseErrorsExitTwo) {
   EXPECT_THAT(r.err, StartsWith("error: --dt: 1 required H missing"));
 }
 
+// CLI11's NonNegativeNumber answered --threads -1 with the range of a double (310 digits).
+TEST(Cli, AThreadCountOutOfRangeExitsTwoNamingWhatIsAllowed) {
+  for (const std::string value : {"-1", "1.5", "99999999999", "x"}) {
+    const Result r = jelly("run " + kSmallSlope + " --threads " + value);
+    EXPECT_EQ(r.code, 2) << value;
+    EXPECT_EQ(
+        r.err.substr(0, r.err.find('\n')),
+        "error: --threads: " + value + " is invalid: an integer from 0 (all cores) to 2147483647")
+        << value;
+  }
+  EXPECT_EQ(jelly("run " + kSmallSlope + " --threads 1 --duration 0.01 -q").code, 0);
+}
+
 // Runs `jelly ARGS` on a pseudo-terminal (util-linux `script`), stdout and stderr together.
 Result jelly_on_a_terminal(const std::string& args) {
   const std::string out = temp_path(".tty");

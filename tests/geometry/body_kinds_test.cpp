@@ -215,6 +215,40 @@ std::string body_error(const std::string& text) {
   return "";
 }
 
+TEST(BodySpec, PinsShareNoParticleAndChooseAtLeastOne) {
+  // "indices": [] chose the whole body.
+  EXPECT_THAT(body_error(R"({"kind": "cube", "n": 3, "pins": [{"indices": []}]})"),
+              ::testing::StartsWith("bodies[0].pins[0].indices = [] is invalid: a list of at "
+                                    "least one particle index"));
+  EXPECT_THAT(body_error(R"({"kind": "cube", "n": 3,
+                            "forces": [{"kind": "point", "force": [1, 0, 0], "indices": []}]})"),
+              ::testing::StartsWith("bodies[0].forces[0].indices = [] is invalid"));
+  // Two pins on particle 1: one path was kept silently.
+  EXPECT_EQ(body_error(R"({"kind": "cube", "n": 3, "pins": [{"indices": [0, 1]},
+              {"indices": [2, 1], "path": {"kind": "oscillation", "amplitude": [0, 0.1, 0],
+               "frequency": 1}}]})"),
+            "bodies[0].pins[1] = {\"indices\":[2,1]} is invalid: pins that share no particle "
+            "(particle 1 of body \"jelly\" is also in bodies[0].pins[0]: give it one pin, one "
+            "path)");
+  EXPECT_THAT(body_error(R"({"kind": "cube", "n": 3, "pins": [{"indices": [26]},
+              {"region": {"min": [-99, -99, -99], "max": [99, 99, 99]}}]})"),
+              ::testing::HasSubstr("(particle 26 of body \"jelly\" is also in bodies[0].pins[0]"));
+}
+
+// Pinning a whole cloth of 1.44 million particles: the pins were added in quadratic time (minutes,
+// beyond the test's time limit).
+TEST(BodySpec, PinningAWholeLargeBodyIsNotQuadratic) {
+  const Json json = Json::parse(R"({"kind": "cloth", "nu": 1200, "nv": 1200,
+    "pins": [{"region": {"min": [-100, -100, -100], "max": [100, 100, 100]}}]})");
+  JsonFields f(json, "bodies[0]");
+  Model model;
+  add_body(model, BodySpec::read(f), "bodies[0].");
+  ASSERT_EQ(model.pins.size(), 1440000);
+  for (int k = 0; k < model.pins.size(); ++k) ASSERT_EQ(model.pins.particles[k], k);
+  EXPECT_TRUE(model.pins.all_fixed());
+  model.pins.validate(model.num_particles());
+}
+
 TEST(BodySpec, BadInputNamesTheField) {
   EXPECT_EQ(body_error(R"({"kind": "cube", "n": 3, "pins": [{"indices": [27]}]})"),
             "bodies[0].pins[0].indices = 27 is invalid: particle indices of body \"jelly\" in "

@@ -1,4 +1,6 @@
 // Reading meshes: formats, welding, vertex groups, topology, and each kind of bad file.
+#include <cstdint>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -114,6 +116,54 @@ TEST(MeshIo, BadFilesAreInputErrorsNamingFieldAndFile) {
                                          "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
                                          "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 4 3\n");
   EXPECT_THAT(error(flipped), HasSubstr("consistently oriented"));
+}
+
+// A tetrahedron as ASCII PLY whose last face is `last_face`.
+std::string tetrahedron_ply(const std::string& last_face, const std::string& vertices = "4") {
+  return "ply\nformat ascii 1.0\nelement vertex " + vertices +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement face 4\n"
+         "property list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n" +
+         last_face + "\n";
+}
+
+TEST(MeshIo, FaceIndicesOutsideTheVerticesAreRefusedNotFollowed) {
+  TempDir dir;
+  const std::string field = "terrains[0].file";
+  const auto error = [&](const std::string& name, const std::string& text) {
+    return input_error([&] { read_mesh(write_text(dir.file(name), text), field); });
+  };
+  EXPECT_EQ(read_mesh(write_text(dir.file("ok.ply"), tetrahedron_ply("3 1 2 3")), field)
+                .mesh.num_triangles(),
+            4);
+  for (const char* face : {"3 1 2 -5", "3 1 2 4", "3 1 2 2147483647", "3 -1 2 3"}) {
+    SCOPED_TRACE(face);
+    const std::string message = error("bad.ply", tetrahedron_ply(face));
+    EXPECT_THAT(message, HasSubstr(field + " = \"" + dir.file("bad.ply") + "\" is invalid"));
+  }
+  EXPECT_THAT(error("past.ply", tetrahedron_ply("3 1 2 9")), HasSubstr("out of range"));
+  EXPECT_THAT(error("past.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 9\n"), HasSubstr(field));
+  // A vertex count far beyond the file's content (assimp allocated 20 GB for it).
+  EXPECT_THAT(error("count.ply", tetrahedron_ply("3 1 2 3", "2000000000")),
+              HasSubstr("counts fit in it (its header says element vertex 2000000000"));
+  EXPECT_THAT(error("negative.ply", tetrahedron_ply("3 1 2 3", "-4")),
+              HasSubstr("element vertex -4"));
+  // A face's list length far beyond the file (assimp allocated 16 GB for it), ASCII and binary.
+  const std::string header =
+      "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+      "property list uint int vertex_indices\nend_header\n";
+  EXPECT_THAT(error("list.ply", "ply\nformat ascii 1.0\n" + header +
+                                    "0 0 0\n1 0 0\n0 1 0\n0 0 1\n4000000000 0 1 2\n"),
+              HasSubstr("element face 0 has a list of 4000000000 items"));
+  std::string binary = "ply\nformat binary_little_endian 1.0\n" + header;
+  const float xyz[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  binary.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  const std::uint32_t length = 4000000000u;
+  const std::int32_t items[3] = {0, 1, 2};
+  binary.append(reinterpret_cast<const char*>(&length), 4);
+  binary.append(reinterpret_cast<const char*>(items), sizeof items);
+  EXPECT_THAT(error("list_binary.ply", binary),
+              HasSubstr("element face 0 has a list of 4000000000 items"));
 }
 
 TEST(MeshIo, WriteRefusesOtherExtensions) {

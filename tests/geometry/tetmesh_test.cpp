@@ -204,7 +204,8 @@ TEST(Tetmesh, BadInputNamesFieldAndValue) {
   const std::string missing = dir.file("missing.msh");
   EXPECT_THAT(error(missing), HasSubstr(field + " = \"" + missing + "\" is invalid: an existing"));
   EXPECT_THAT(error(dir.file("x.vtk")), HasSubstr(".msh (Gmsh) or .node/.ele (TetGen)"));
-  EXPECT_THAT(error(write_text(dir.file("junk.msh"), "junk\n")), HasSubstr("Gmsh reads"));
+  EXPECT_THAT(error(write_text(dir.file("junk.msh"), "junk\n")),
+              HasSubstr("a Gmsh mesh (MSH 2.2 or 4.1): line 1"));
   EXPECT_THAT(error(write_text(dir.file("empty.msh"), "")), HasSubstr(field));
   // A mesh of one hexahedron.
   const std::string hex =

@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <hdf5.h>
+#include <sys/stat.h>
 
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -227,6 +229,22 @@ TEST_F(DamagedRecording, CheckpointTimesFarFromTheRunAreRefused) {
   EXPECT_THAT(checkpoint_error(path_),
               HasSubstr("checkpoint next_output = -1.0000000000000001e+300 "
                         "is invalid: a time within an output interval"));
+}
+
+// A pipe blocked HDF5's first read for ever (jelly info, Python's read_recording).
+TEST(Readers, APipeIsRefusedBeforeItIsOpened) {
+  TempDir dir;
+  const std::string fifo = dir.file("pipe.h5");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  for (const auto& read : {std::function<void()>([&] { read_recording(fifo); }),
+                           std::function<void()>([&] { read_checkpoint(fifo); })}) {
+    try {
+      read();
+      ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("it is a pipe, not a file"));
+    }
+  }
 }
 
 }  // namespace

@@ -506,6 +506,12 @@ TEST(SceneIntegratorOptions, BadOptionsNameTheirPath) {
   EXPECT_THAT(error_of(kGood, {"integrator.name=implicit_euler",
                                "integrator.options.definiteness=\"soft\""}),
               StartsWith("integrator.options.definiteness = \"soft\" is invalid"));
+  // The linear solver is arkode_dirk's: arkode_erk solves nothing (it was accepted, unused).
+  EXPECT_EQ(error_of(kGood, {"integrator.name=arkode_erk", "integrator.options.linear_solver=klu"}),
+            "integrator.options.linear_solver = \"klu\" is invalid: \"auto\" (arkode_erk "
+            "solves no linear system: linear_solver is arkode_dirk's option)");
+  EXPECT_NO_THROW(
+      parse_scene(kGood, {"integrator.name=arkode_erk", "integrator.options.linear_solver=auto"}));
   // rtol belongs to the ARKODE integrators, not to implicit_euler.
   EXPECT_THAT(error_of(kGood, {"integrator.name=implicit_euler", "integrator.options.rtol=1e-3"}),
               StartsWith("integrator.options.rtol = 0.001 is invalid: unknown key"));

@@ -3,6 +3,7 @@ parser on every write, JSON out."""
 
 import copy
 import json
+import os
 import pickle
 
 import pytest
@@ -91,6 +92,13 @@ def test_load_scene_overrides_and_bad_files(scenes, tmp_path):
         jelly.load_scene(bad)
     with pytest.raises(jelly.InputError, match="cannot read the scene file"):
         jelly.load_scene(tmp_path / "missing.json")
+
+
+def test_load_scene_refuses_a_pipe_without_blocking(tmp_path):
+    fifo = tmp_path / "scene.json"
+    os.mkfifo(fifo)
+    with pytest.raises(jelly.InputError, match="it is a pipe, not a file"):
+        jelly.load_scene(fifo)
 
 
 def test_to_json_round_trip_equals_cpp(scenes):

@@ -107,6 +107,11 @@ TEST(MeshObstacle, BadInputNamesTheField) {
     return error_of(
         [&] { read_terrain_spec(Json::parse(text), "terrains[1]", dir.path().string()); });
   };
+  dir.write("box.obj", box_mesh(Vec3(1, 1, 1)));
+  EXPECT_NE(
+      read(R"({"kind": "mesh", "file": "box.obj", "angular_velocity_degrees": [1e300, 0, 0]})")
+          .find("angular_velocity_degrees = "),
+      std::string::npos);
   // Missing file.
   const std::string missing = read(R"({"kind": "mesh", "file": "nowhere.obj"})");
   EXPECT_EQ(missing.rfind("terrains[1].file = ", 0), 0u) << missing;

@@ -172,5 +172,24 @@ TEST(Obstacle, BadInputNamesTheField) {
   EXPECT_NE(error_of([&] { Obstacle{s}; }).find("obstacle.center"), std::string::npos);
 }
 
+// A spin near a double's range overflowed omega's norm to inf and every particle to NaN.
+TEST(Obstacle, AnAngularVelocityBeyondAnyPhysicalSpinIsRefused) {
+  ObstacleSpec s = spec_of(ObstacleShape::kSphere);
+  s.angular_velocity_degrees = Vec3(0, 1e300, 1e300);
+  const std::string message = error_of([&] { s.validate("terrains[2]."); });
+  EXPECT_EQ(message.rfind("terrains[2].angular_velocity_degrees = ", 0), 0u) << message;
+  EXPECT_NE(message.find("e+300 is invalid: finite rates (degrees per second) whose norm is at "
+                         "most 1e6 (about 2,800 turns a second)"),
+            std::string::npos)
+      << message;
+  s.angular_velocity_degrees = Vec3(0, 2e6, 0);
+  EXPECT_NE(error_of([&] { s.validate("terrains[2]."); }).find("angular_velocity_degrees"),
+            std::string::npos);
+  s.angular_velocity_degrees = Vec3(0, 36000, 0);
+  s.validate("terrains[2].");
+  const Obstacle spinning(s);
+  EXPECT_TRUE(spinning.surface_velocity(Vec3(0, 0, 2), 1).allFinite());
+}
+
 }  // namespace
 }  // namespace jelly

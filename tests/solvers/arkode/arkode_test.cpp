@@ -50,8 +50,10 @@ ArkodeRun oscillator_run(const std::string& name, Real rtol,
   sys.kd = 2;
   ArkodeOptions o;
   o.rtol = rtol;
-  o.atol = rtol * 1e-2;  // |x| ~ 1 m, |v| ~ 1 m/s: the relative test dominates
-  o.linear_solver = value_of(arkode_linear_solvers(), linear_solver, "linear_solver");
+  o.atol = rtol * 1e-2;         // |x| ~ 1 m, |v| ~ 1 m/s: the relative test dominates
+  if (name == "arkode_dirk") {  // (arkode_erk solves nothing: it refuses a linear solver)
+    o.linear_solver = value_of(arkode_linear_solvers(), linear_solver, "linear_solver");
+  }
   Simulator sim = make_arkode_sim(sys.model(), sys.initial(), name, o, 0.1);
   EXPECT_TRUE(sim.run_until(2.0).ok());
   const State& s = sim.state();
