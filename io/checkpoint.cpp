@@ -3,9 +3,9 @@
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/detail/checkpoint_h5.hpp>
 #include <jelly/io/detail/h5.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 
 namespace jelly {
@@ -59,6 +59,27 @@ void overwrite(hid_t dataset, hid_t memory_type, std::vector<hsize_t> dims, cons
 
 }  // namespace
 
+constexpr const char* kModelValues = "model_values";
+
+void write_model_values(hid_t checkpoint, const ModelValues& m) {
+  if (exists(checkpoint, kModelValues))
+    check(H5Ldelete(checkpoint, kModelValues, H5P_DEFAULT), "replace checkpoint/model_values");
+  Handle g = create_group(checkpoint, kModelValues);
+  write_dataset(g.get(), "ks", {m.ks.size()}, m.ks.data());
+  write_dataset(g.get(), "kd", {m.kd.size()}, m.kd.data());
+  write_dataset(g.get(), "mass", {static_cast<hsize_t>(m.mass.size())}, m.mass.data());
+  write_dataset(g.get(), "gravity", {3}, m.gravity.data());
+  const hsize_t p = m.pins.particles.size();
+  std::vector<double> anchors;
+  for (const Vec3& a : m.pins.anchors) anchors.insert(anchors.end(), a.data(), a.data() + 3);
+  write_dataset(g.get(), "pin_particle", {p}, m.pins.particles.data());
+  write_dataset(g.get(), "pin_anchor", {p, 3}, anchors.data());
+  write_dataset(g.get(), "pin_path", {p}, m.pins.path.data());
+  Json paths = Json::array();
+  for (const Path& path : m.pins.paths) paths.push_back(path.to_json());
+  write_attribute(g.get(), "pin_paths", paths.dump());
+}
+
 void CheckpointWriter::write(const SimulatorSnapshot& s) {
   check(
       H5Dwrite(position_.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.state.x.data()),
@@ -80,6 +101,7 @@ void CheckpointWriter::write(const SimulatorSnapshot& s) {
   overwrite(seed_friction_.get(), H5T_NATIVE_DOUBLE, {k}, frictions_.data());
   overwrite(integrator_state_.get(), H5T_NATIVE_DOUBLE, {s.integrator_state.size()},
             s.integrator_state.data());
+  if (s.model_values) write_model_values(group_.get(), *s.model_values);
   write_attribute(group_.get(), "t", s.state.t);
   write_attribute(group_.get(), "total_steps", s.total_steps);
   write_attribute(group_.get(), "next_output", s.next_output);
@@ -89,8 +111,41 @@ void CheckpointWriter::write(const SimulatorSnapshot& s) {
 }  // namespace h5
 
 SimulatorSnapshot Checkpoint::snapshot() const {
-  return {state, seed_contacts, contact_count, total_steps, next_output, integrator_state};
+  return {state,       seed_contacts,    contact_count, total_steps,
+          next_output, integrator_state, model_values};
 }
+
+namespace {
+// The edited model values of a checkpoint's model_values group (validated when restored).
+ModelValues read_model_values(hid_t checkpoint) {
+  h5::Handle g = h5::open_group(checkpoint, "model_values");
+  ModelValues m;
+  m.ks = h5::read_doubles(g.get(), "ks");
+  m.kd = h5::read_doubles(g.get(), "kd");
+  const std::vector<double> mass = h5::read_doubles(g.get(), "mass");
+  m.mass = Eigen::Map<const VecX>(mass.data(), static_cast<Eigen::Index>(mass.size()));
+  const std::vector<double> gravity = h5::read_doubles(g.get(), "gravity");
+  if (gravity.size() != 3) throw std::runtime_error("model_values/gravity is not [3]");
+  m.gravity = Vec3(gravity[0], gravity[1], gravity[2]);
+  m.pins.particles = h5::read_ints(g.get(), "pin_particle");
+  m.pins.path = h5::read_ints(g.get(), "pin_path");
+  const std::vector<double> anchors = h5::read_doubles(g.get(), "pin_anchor");
+  if (anchors.size() != 3 * m.pins.particles.size() ||
+      m.pins.path.size() != m.pins.particles.size())
+    throw std::runtime_error("model_values: pin_particle, pin_anchor and pin_path differ in size");
+  for (std::size_t k = 0; k < m.pins.particles.size(); ++k)
+    m.pins.anchors.emplace_back(anchors[3 * k], anchors[3 * k + 1], anchors[3 * k + 2]);
+  const Json paths = detail::parse_json(h5::read_string_attribute(g.get(), "pin_paths"),
+                                        "checkpoint/model_values pin_paths");
+  if (!paths.is_array()) throw std::runtime_error("model_values pin_paths is not a list");
+  for (std::size_t k = 0; k < paths.size(); ++k)
+    m.pins.paths.push_back(Path::read(paths[k], "checkpoint pin_paths[" + std::to_string(k) + "]"));
+  for (int path : m.pins.path)
+    if (path < 0 || path >= static_cast<int>(m.pins.paths.size()))
+      throw std::runtime_error("model_values pin_path " + std::to_string(path) + " names no path");
+  return m;
+}
+}  // namespace
 
 Checkpoint read_checkpoint(const std::string& path) {
   std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
@@ -132,6 +187,7 @@ Checkpoint read_checkpoint(const std::string& path) {
     }
     if (h5::exists(g.get(), "integrator_state"))
       cp.integrator_state = h5::read_doubles(g.get(), "integrator_state");
+    if (h5::exists(g.get(), "model_values")) cp.model_values = read_model_values(g.get());
     cp.integrator = h5::read_string_attribute(g.get(), "integrator");
     cp.dt = h5::read_double_attribute(g.get(), "dt");
     if (h5::exists(file.get(), "parameters")) {
@@ -175,8 +231,7 @@ void restore(Simulator& sim, const Checkpoint& cp) {
 namespace {
 
 // The first JSON path at which a and b differ, or "" when they are equal.
-std::string first_difference(const Json& a, const Json& b,
-                             const std::string& path) {
+std::string first_difference(const Json& a, const Json& b, const std::string& path) {
   if (a.is_object() && b.is_object()) {
     for (auto it = a.begin(); it != a.end(); ++it) {
       const std::string child = json_child(path, it.key());

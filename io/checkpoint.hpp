@@ -1,6 +1,7 @@
 #pragma once
 // A restart point of a run, stored in a recording's /checkpoint group: everything a simulator
 // with the same model, terrains, integrator and options needs to continue bit for bit.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,8 @@ struct Checkpoint {
   Real dt = 0;                         // of the run that wrote it
   Real output_interval = 0;            // of the run that wrote it
   std::string scene_json;  // the scene of the run that wrote it (empty when none was stored)
+  // The model's values after live edits of the run that wrote it (none without edits).
+  std::optional<ModelValues> model_values;
 
   SimulatorSnapshot snapshot() const;
 };

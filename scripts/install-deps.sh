@@ -25,6 +25,8 @@ packages=(
   pybind11-dev python3-pybind11 python3-dev python3-pytest python3-distributed python3-pandas
   # sparse Jacobians of forces written in Python (jelly.Force.jacobians)
   python3-scipy
+  # the wheel test (tests/python/wheel_test.sh): python3 -m build
+  python3-build python3-venv
 )
 if [ "${1:-}" = "--tests" ]; then
   # The test jelly_paraview (tests/io/paraview_test.py; it skips without them): ParaView and its

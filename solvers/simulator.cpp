@@ -164,6 +164,7 @@ void Simulator::set_pin_target(int particle, const Vec3& position, const Vec3& v
 bool Simulator::remove_pin(int particle) { return model_.pins.remove(particle); }
 
 void Simulator::model_changed() {
+  ++model_revision_;
   bands_ = std::make_unique<const SpringBands>(model_);
   for (const std::shared_ptr<Force>& force : forces_) force->validate(model_.num_particles());
 }
@@ -312,8 +313,17 @@ void Simulator::set_state(State state) {
 }
 
 SimulatorSnapshot Simulator::snapshot() const {
-  return {state_,       contacts_.seed_contacts(),    contacts_.contact_count(), total_steps_,
-          next_output_, integrator_->internal_state()};
+  SimulatorSnapshot s{state_,
+                      contacts_.seed_contacts(),
+                      contacts_.contact_count(),
+                      total_steps_,
+                      next_output_,
+                      integrator_->internal_state(),
+                      std::nullopt};
+  if (model_revision_ > 0)
+    s.model_values =
+        ModelValues{model_.springs.ks, model_.springs.kd, model_.mass, model_.gravity, model_.pins};
+  return s;
 }
 
 void Simulator::restore(SimulatorSnapshot snapshot) {
@@ -328,6 +338,25 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
   for (const ContactSolver::SeedContact& c : snapshot.seed_contacts) {
     require(c.particle >= 0 && c.particle < model_.num_particles(),
             "snapshot.seed_contacts.particle", c.particle, "a particle index of the model");
+  }
+  if (snapshot.model_values) {
+    // The edited values onto a copy, validated as a whole before anything changes.
+    ModelValues& values = *snapshot.model_values;
+    require(values.ks.size() == model_.springs.ks.size() &&
+                values.kd.size() == model_.springs.kd.size(),
+            "snapshot.model_values.ks.size", values.ks.size(),
+            "the model's spring count (" + std::to_string(model_.springs.size()) + ")");
+    require(values.mass.size() == model_.mass.size(), "snapshot.model_values.mass.size",
+            values.mass.size(), "the model's particle count");
+    Model edited = model_;
+    edited.springs.ks = std::move(values.ks);
+    edited.springs.kd = std::move(values.kd);
+    edited.mass = std::move(values.mass);
+    edited.gravity = values.gravity;
+    edited.pins = std::move(values.pins);
+    edited.validate();
+    model_ = std::move(edited);
+    model_changed();
   }
   integrator_->restore_internal_state(snapshot.integrator_state);
   assign_state(state_, s);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -108,6 +109,15 @@ struct SimulatorOptions {
   void validate() const;
 };
 
+// The values of a model that live edits change (Simulator::set_spring_coefficients, set_gravity,
+// set_particle_mass, pins): a snapshot of an edited model carries them.
+struct ModelValues {
+  std::vector<Real> ks, kd;  // [M] per spring
+  VecX mass;                 // [N]
+  Vec3 gravity = Vec3::Zero();
+  Pins pins;
+};
+
 // What the future of a run depends on besides the model, terrains, integrator and options: a
 // simulator restored from it continues bit for bit (for integrators that keep no state between
 // steps, which all explicit ones do).
@@ -124,6 +134,9 @@ struct SimulatorSnapshot {
   Real next_output = 0;
   // The integrator's internal_state() (warm starts, contact sets; empty for most methods).
   std::vector<Real> integrator_state;
+  // After a live edit of the model: its edited values, which restore() puts back (so that a
+  // restart after an edit continues exactly); empty for a model as it was built.
+  std::optional<ModelValues> model_values;
 };
 
 // Names a force added to a simulator (Simulator::add_force), for removing it.
@@ -218,8 +231,9 @@ class Simulator {
   void set_state(State state);
   SimulatorSnapshot snapshot() const;
   // Continues from a snapshot (taken from a simulator with the same model, terrains, integrator
-  // and options); the next run_until() first emits a frame of the restored state. Throws
-  // InputError for a snapshot that does not fit the model.
+  // and options; a snapshot of an edited model puts its edited values back); the next
+  // run_until() first emits a frame of the restored state. Throws InputError for a snapshot
+  // that does not fit the model.
   void restore(SimulatorSnapshot snapshot);
   const Terrains& terrains() const { return terrains_; }
   const Integrator& integrator() const { return *integrator_; }
@@ -230,6 +244,8 @@ class Simulator {
   const ContactSolver& contacts() const { return contacts_; }
   const BodyContact& body_contact() const { return body_contact_; }
   long total_steps() const { return total_steps_; }
+  // Live edits of the model so far (0: the model as it was built).
+  long model_revision() const { return model_revision_; }
   long force_evaluations() const { return force_evaluations_; }
 
  private:
@@ -256,6 +272,7 @@ class Simulator {
   ForceHandle next_force_handle_ = 1;
   std::vector<std::string> noted_;  // the notes given so far
   long total_steps_ = 0;
+  long model_revision_ = 0;
   long force_evaluations_ = 0;
   long frames_ = 0;
   Real next_output_ = 0;

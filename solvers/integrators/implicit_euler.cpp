@@ -6,6 +6,7 @@
 
 #include <jelly/core/detail/anchor_jacobian.hpp>
 #include <jelly/core/detail/band_system.hpp>
+#include <jelly/core/detail/clock.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
@@ -19,11 +20,6 @@
 namespace jelly {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Below this many unknowns a fresh CHOLMOD factorization every step is cheap and exact; above
 // it block-Jacobi CG was the fastest backend at every size and stiffness of the benchmark

@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <jelly/core/detail/clock.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/contact/detail/position_contact.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>
@@ -12,11 +13,6 @@
 namespace jelly {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Contact penalties in the factor, as multiples of the particle's diagonal entry of A: a
 // sticking contact is (nearly) held in place by the global solve, a sliding one partly. The
