@@ -364,7 +364,14 @@ void LiveSimulation::loop() {
         ahead = true;
         break;
       }
+      const Real dt = sim_->options().dt;
+      const bool before_end = sim_->state().t < sim_scene_.duration - 0.5 * dt;
       if (!step()) break;
+      // The run pauses where the scene ends (as `jelly run` stops there); Play goes on past it.
+      if (before_end && sim_->state().t >= sim_scene_.duration - 0.5 * dt) {
+        sim_playing_ = false;
+        break;
+      }
     }
     publish();
     const double now = now_seconds();

@@ -56,7 +56,8 @@ struct LiveFrame {
 
 class LiveSimulation {
  public:
-  // threaded: steps on its own thread while playing; otherwise only advance_to() steps.
+  // threaded: steps on its own thread while playing, pausing when the time reaches the scene's
+  // duration (Play then goes on past it); otherwise only advance_to() steps.
   // on_publish (may be empty) is called on the simulating thread after each published frame
   // (the window wakes up with it). Throws InputError for an invalid scene.
   LiveSimulation(Scene scene, bool threaded, std::function<void()> on_publish = {});

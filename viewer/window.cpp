@@ -205,7 +205,7 @@ struct ViewerWindow::Impl {
   std::vector<std::string> clipped_items;  // panel items cut off by its edge, last frame
   std::optional<PanelRect> banner_rect;    // the divergence banner, last frame
   PanelRect panel_rect;                    // the panel, last frame (empty when hidden)
-  bool follow = false;                     // the camera's target follows the bodies
+  bool follow = false;  // the camera's target follows the bodies (default without --camera)
 
   // Mouse.
   enum class Drag { kNone, kOrbit, kPan, kParticle } drag = Drag::kNone;
@@ -356,6 +356,7 @@ struct ViewerWindow::Impl {
       bounds_of(positions, lo, hi);
       camera = framing_camera(lo, hi, builder->terrains(), 0, aspect());
     }
+    follow = options.camera.empty();  // a camera of the user's own stays where it was put
     if (!options.paused && !options.lockstep) live->set_playing(true);
   }
 
@@ -409,6 +410,7 @@ struct ViewerWindow::Impl {
     positions = replay->recording().position[replay_frame];
     camera = replay->default_camera(aspect());
     if (!options.camera.empty()) camera.parse(options.camera);
+    follow = options.camera.empty();
     // The recorded observables to plot, one value per frame (the height of the centre of mass).
     const Recording& r = replay->recording();
     for (const char* name : {"kinetic_energy", "elastic_energy", "gravitational_energy",

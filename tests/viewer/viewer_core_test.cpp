@@ -386,6 +386,29 @@ TEST(LiveSimulation, ThreadTakesCommands) {
   ASSERT_TRUE(wait_for([](const viewer::LiveFrame& f) { return f.t == 0 && f.steps == 0; }));
 }
 
+// The live run pauses at the scene's duration (issue 40, item 3: it ran on for ever); Play goes
+// on past it.
+TEST(LiveSimulation, PausesAtTheScenesDuration) {
+  viewer::LiveSimulation live(small_slope(4, {"duration=0.1"}), true);
+  const auto wait_for = [&](auto done) {
+    for (int i = 0; i < 2000; ++i) {
+      live.refresh();
+      if (done(live.front())) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+  };
+  live.set_speed(0);
+  live.set_playing(true);
+  ASSERT_TRUE(wait_for([](const viewer::LiveFrame& f) { return f.t > 0 && !f.playing; }));
+  EXPECT_EQ(live.front().steps, 100);
+  EXPECT_NEAR(live.front().t, 0.1, 1e-9);
+  EXPECT_FALSE(live.playing());
+  live.set_playing(true);
+  ASSERT_TRUE(wait_for([](const viewer::LiveFrame& f) { return f.t > 0.15; }));
+  live.set_playing(false);
+}
+
 // A stiff cube and a soft one on a floor: each body keeps its own springs whatever the panel
 // changes (issue 40, item 1: every body took the first body's).
 constexpr const char* kStiffAndSoft = R"({

@@ -132,6 +132,25 @@ TEST(Window, PanelShowsThePresetsAndTheBannerClearsIt) {
       << ", panel to " << window->panel_rect().x1;
 }
 
+// Without --camera the camera follows the bodies: the seed jelly, sliding down the slope, is
+// still in the picture after 4 s (issue 40, item 3: it left it).
+TEST(Window, CameraFollowsTheBodiesByDefault) {
+  viewer::ViewOptions options;
+  options.width = kWidth;
+  options.height = kHeight;
+  options.hide_panel = true;
+  options.lockstep = true;
+  options.samples = 1;
+  auto window = viewer::ViewerWindow::live(load_scene(kSlope), kSlope, options);
+  for (int frame = 0; frame <= 240; ++frame) ASSERT_TRUE(window->frame());
+  const testing::Box box =
+      testing::projected_box(window->camera(), window->positions(), kWidth, kHeight);
+  EXPECT_GT(box.x0, 0);
+  EXPECT_LT(box.x1, kWidth);
+  EXPECT_GT(box.y0, 0);
+  EXPECT_LT(box.y1, kHeight);
+}
+
 // Left press on the jelly picks the particle under the cursor; dragging pulls it to the cursor,
 // with RK4 at its step and with implicit Euler at 1/60 (its Jacobian in the solve).
 TEST(Window, PickingAndDraggingMovesTheParticle) {
