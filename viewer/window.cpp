@@ -193,6 +193,7 @@ struct ViewerWindow::Impl {
 
   // Replay.
   std::unique_ptr<RecordingView> replay;
+  std::unique_ptr<RecordingView::Follow> replay_follow;  // the replay's camera target
   int replay_frame = 0;
   double replay_time = 0;
   bool replay_playing = false;
@@ -408,7 +409,12 @@ struct ViewerWindow::Impl {
     scene.show_particles = scene.show_particles || options.particles;
     scene.show_springs = options.springs;
     positions = replay->recording().position[replay_frame];
-    camera = replay->default_camera(aspect());
+    // The camera `jelly render` follows the bodies with over the whole recording, so a replay's
+    // frame and the video's are the same picture.
+    std::vector<int> all(static_cast<size_t>(replay->frames()));
+    for (int k = 0; k < replay->frames(); ++k) all[static_cast<size_t>(k)] = k;
+    replay_follow = std::make_unique<RecordingView::Follow>(*replay, all, aspect());
+    camera = replay_follow->at(replay_frame);
     if (!options.camera.empty()) camera.parse(options.camera);
     follow = options.camera.empty();
     // The recorded observables to plot, one value per frame (the height of the centre of mass).
@@ -967,7 +973,9 @@ struct ViewerWindow::Impl {
         options.hide_panel
             ? 0.0f
             : std::clamp(panel_right * pixel_scale() / static_cast<float>(fb_width), 0.0f, 0.5f);
-    if (follow && positions.size() >= 3) {
+    if (follow && replay_follow) {
+      camera.target = replay_follow->at(replay_frame).target;
+    } else if (follow && positions.size() >= 3) {
       Vec3 lo, hi;
       bounds_of(positions, lo, hi);
       camera.target += 0.1f * ((0.5 * (lo + hi)).cast<float>() - camera.target);

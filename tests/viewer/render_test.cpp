@@ -207,6 +207,30 @@ TEST(RenderCli, KeepsTheBodiesColours) {
   EXPECT_GT(red, 200);
 }
 
+// Without --camera, `jelly render` follows the bodies and keeps them large: the seed jelly,
+// 4 s down the slope, fills a good part of the picture at the end of the video (issue 40,
+// item 3: the camera framed the whole motion and the jelly filled under 5 %).
+TEST(RenderCli, FollowsTheBodies) {
+  TempDir dir;
+  const std::string jelly = std::string("'") + JELLY_CLI + "' ";
+  testing::Result r =
+      testing::run(jelly + "run '" JELLY_SCENES_DIR "/seed_slope.json' --duration 4 --quiet -o '" +
+                       dir.file("r.h5") + "'",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(jelly + "render '" + dir.file("r.h5") + "' -o '" + dir.file("f%03d.png") +
+                       "' --width 320 --height 240 --samples 1 --start 2",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  if (r.err.find("no offscreen") != std::string::npos) GTEST_SKIP() << r.err;
+  for (const std::string frame : {"f000.png", "f120.png"}) {
+    const viewer::Image image = viewer::read_png(dir.file(frame));
+    long red = 0;
+    for (size_t i = 0; i + 2 < image.rgb.size(); i += 3) red += testing::is_jelly(&image.rgb[i]);
+    EXPECT_GT(static_cast<double>(red) / (image.width * image.height), 0.05) << frame;
+  }
+}
+
 // `jelly render`: mp4, gif and PNG frames with the frame count and size ffprobe reports.
 TEST(RenderCli, WritesVideosFfprobeConfirms) {
   TempDir dir;
