@@ -158,7 +158,8 @@ int main(int argc, char** argv) {
                    "Camera: yaw,pitch,distance[,tx,ty,tz] (degrees, m); default: framed");
   view->add_option("--screenshot", view_args.screenshot,
                    "Write the window as PNG after --frames N frames and exit (live: each frame "
-                   "is then one output interval of simulated time)");
+                   "is then one output interval of simulated time; replay: the next recorded "
+                   "frame)");
   view->add_option("--frames", view_args.frames, "Exit after this many frames");
   view->add_option("--frame", view_args.frame, "Replay: the frame shown first");
   view->add_option("--speed", view_args.speed,

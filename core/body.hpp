@@ -1,6 +1,7 @@
 #pragma once
 // A body of the model: a named range of particles and springs with its own material and render
 // surface; and BodyPart, what a body builder (geometry/) returns before it joins a model.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct Body {
   Vec3 angular_velocity = Vec3::Zero();  // rad/s
   Surface surface;                       // global particle indices
   std::vector<ParticleGroup> groups;     // global particle indices
+  // Its colour in pictures and exports: sRGB [r, g, b], each in [0, 1]; none = the viewer's
+  // palette by body index.
+  std::optional<Vec3> color;
 
   int end_particle() const { return first_particle + num_particles; }
   int end_spring() const { return first_spring + num_springs; }

@@ -122,6 +122,10 @@ void BodySpec::validate(const std::string& prefix) const {
           "finite components (m/s)");
   require(angular_velocity.allFinite(), prefix + "angular_velocity", angular_velocity.transpose(),
           "finite components (rad/s)");
+  if (color) {
+    require(color->allFinite() && color->minCoeff() >= 0 && color->maxCoeff() <= 1,
+            prefix + "color", color->transpose(), "[r, g, b], each in [0, 1]");
+  }
 }
 
 BodySpec BodySpec::read(JsonFields& f) {
@@ -138,6 +142,7 @@ BodySpec BodySpec::read(JsonFields& f) {
   b.radius = f.number_or("radius", b.radius);
   b.velocity = f.vec3_or("velocity", b.velocity);
   b.angular_velocity = f.vec3_or("angular_velocity", b.angular_velocity);
+  if (const Json* color = f.value("color")) b.color = json_vec3(*color, f.path("color"));
   if (const Json* pins = f.value("pins")) {
     if (!pins->is_array()) throw InputError(f.path("pins"), json_text(*pins), "a list of pins");
     for (std::size_t i = 0; i < pins->size(); ++i) {
@@ -192,6 +197,7 @@ Json BodySpec::to_json() const {
   j["radius"] = radius;
   if (!velocity.isZero()) j["velocity"] = json_of(velocity);
   if (!angular_velocity.isZero()) j["angular_velocity"] = json_of(angular_velocity);
+  if (color) j["color"] = json_of(*color);
   if (!pins.empty()) {
     Json list = Json::array();
     for (const PinSpec& p : pins) {
@@ -233,6 +239,7 @@ void add_body(Model& model, const BodySpec& spec, const std::string& prefix) {
       model.add_body(spec.name, spec.shape->build(spec.material, prefix), spec.radius);
   model.bodies[index].velocity = spec.velocity;
   model.bodies[index].angular_velocity = spec.angular_velocity;
+  model.bodies[index].color = spec.color;
   const Body& body = model.bodies[index];
   // The body's particles are new: no pin holds them yet. Each may be in one of its pins only
   // (two would give it two paths).

@@ -1,6 +1,7 @@
 #pragma once
 // What a scene says of one body: its name, kind-specific shape, material, contact radius,
 // pinned particles and external forces; and how it joins a model (add_body).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,12 +55,13 @@ struct BodySpec {
   Vec3 angular_velocity = Vec3::Zero();  // rad/s at the start, about the centre of mass
   std::vector<PinSpec> pins;
   std::vector<ExternalForceSpec> forces;
+  std::optional<Vec3> color;  // sRGB [r, g, b] in [0, 1]; none = the viewer's palette
 
   std::string_view kind() const { return shape ? shape->kind() : std::string_view(); }
   // Throws InputError naming `prefix`field ("bodies[0].").
   void validate(const std::string& prefix) const;
   // A scene's body object: kind, name, the kind's keys, springs, particle_mass, density, radius,
-  // pins, forces.
+  // pins, forces, color.
   static BodySpec read(JsonFields& fields);
   Json to_json() const;
 };

@@ -335,6 +335,9 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       h5::write_attribute(g.get(), "num_springs", static_cast<long>(b.num_springs));
       h5::write_attribute(g.get(), "radius", b.radius);
       h5::write_attribute(g.get(), "spacing", b.spacing);
+      if (b.color)
+        h5::write_attribute(g.get(), "color",
+                            std::vector<double>{b.color->x(), b.color->y(), b.color->z()});
     }
     h5::write_dataset(g.get(), "mass", {N}, model.mass.data() + body.first);
     h5::write_dataset(g.get(), "rest_position", {N, 3},

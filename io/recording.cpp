@@ -153,6 +153,15 @@ Recording read(hid_t file) {
         body.radius = h5::read_double_attribute(g.get(), "radius");
       if (h5::has_attribute(g.get(), "spacing"))
         body.spacing = h5::read_double_attribute(g.get(), "spacing");
+      if (h5::has_attribute(g.get(), "color")) {
+        // sRGB [r, g, b] in [0, 1], written as space-separated text by the attribute reader.
+        std::istringstream text(attributes_of(g.get())["color"]);
+        Vec3 c = Vec3::Constant(-1);
+        text >> c.x() >> c.y() >> c.z();
+        expect(!text.fail() && c.allFinite() && c.minCoeff() >= 0 && c.maxCoeff() <= 1,
+               groups[bi].group() + " attribute color", "not [r, g, b] in [0, 1]");
+        body.color = c;
+      }
       body.surface = read_surface(file, groups[bi].group(), first, counts[bi]);
       r.model.bodies.push_back(std::move(body));
       first += counts[bi];

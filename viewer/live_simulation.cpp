@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 
 #include <jelly/core/errors.hpp>
@@ -20,6 +21,13 @@ double now_seconds() {
   return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
 }
 
+// A time for a message: 4 significant digits (0.3333, not 0.33333399999999996).
+std::string time_text(Real t) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", t);
+  return text;
+}
+
 // CPU time of the calling thread (what a step costs, whatever else runs on the machine).
 double thread_cpu_seconds() {
   timespec t{};
@@ -33,7 +41,7 @@ LiveSettings LiveSettings::of(const Scene& scene) {
   LiveSettings s;
   s.integrator = scene.integrator.name;
   s.dt = scene.integrator.dt;
-  s.springs = scene.bodies.front().material.springs;
+  for (const BodySpec& body : scene.bodies) s.springs.push_back(body.material.springs);
   s.gravity = scene.gravity;
   for (const auto& t : scene.terrains) s.contacts.push_back(t->contact);
   return s;
@@ -43,7 +51,8 @@ Scene LiveSettings::applied_to(Scene scene) const {
   if (scene.integrator.name != integrator) scene.integrator.options = {};
   scene.integrator.name = integrator;
   scene.integrator.dt = dt;
-  for (BodySpec& body : scene.bodies) body.material.springs = springs;
+  for (size_t i = 0; i < scene.bodies.size() && i < springs.size(); ++i)
+    scene.bodies[i].material.springs = springs[i];
   scene.gravity = gravity;
   for (size_t i = 0; i < scene.terrains.size() && i < contacts.size(); ++i)
     scene.terrains[i]->contact = contacts[i];
@@ -56,6 +65,7 @@ LiveSimulation::LiveSimulation(Scene scene, bool threaded, std::function<void()>
       on_publish_(std::move(on_publish)) {
   scene_.validate();
   sim_scene_ = scene_;
+  sim_settings_ = settings_;
   rebuild(sim_scene_, false);
   rate_wall_ = now_seconds();
   publish();
@@ -148,6 +158,29 @@ void LiveSimulation::rebuild(const Scene& scene, bool keep_state) {
   if (drag_ && drag_->particle < sim_->model().num_particles()) sim_->set_anchors({*drag_});
 }
 
+void LiveSimulation::apply_live(const LiveSettings& settings) {
+  const LiveSettings& old = sim_settings_;
+  if (settings.integrator != old.integrator)
+    sim_->set_integrator(
+        make_integrator(sim_scene_.integrator.name, sim_scene_.integrator.options));
+  if (settings.dt != old.dt) sim_->set_dt(settings.dt);
+  if (settings.gravity != old.gravity) sim_->set_gravity(settings.gravity);
+  const int bodies = static_cast<int>(sim_->model().bodies.size());
+  for (int b = 0; b < bodies && b < static_cast<int>(settings.springs.size()); ++b)
+    for (int type = 0; type < kSpringTypeCount; ++type) {
+      const SpringCoefficients& c = settings.springs[b][type];
+      if (b < static_cast<int>(old.springs.size()) && c.ks == old.springs[b][type].ks &&
+          c.kd == old.springs[b][type].kd)
+        continue;
+      sim_->set_spring_coefficients(b, static_cast<SpringType>(type), c);
+    }
+  // The panel edits a terrain's coefficients, never its contact model; the terrains are the
+  // simulator's own (its list is const, the terrains in it are not).
+  const Terrains& terrains = sim_->terrains();
+  for (size_t i = 0; i < terrains.size() && i < settings.contacts.size(); ++i)
+    terrains[i]->set_contact(settings.contacts[i]);
+}
+
 bool LiveSimulation::take_commands() {
   Commands c;
   {
@@ -159,6 +192,7 @@ bool LiveSimulation::take_commands() {
   if (c.speed) speed_ = *c.speed;
   if (c.scene) {
     sim_scene_ = std::move(*c.scene);
+    sim_settings_ = LiveSettings::of(sim_scene_);
     ++sim_generation_;
     drag_.reset();
     c.reset = true;
@@ -170,10 +204,11 @@ bool LiveSimulation::take_commands() {
     changed = true;
   }
   if (c.settings) {
-    // A simulator of the new settings continues from the current state (the seed contact
-    // model's active set and an implicit method's warm start start afresh).
+    // The running simulator takes the new settings and goes on from the current state; a reset
+    // rebuilds it from the scene with them.
     sim_scene_ = c.settings->applied_to(std::move(sim_scene_));
-    if (!c.reset) rebuild(sim_scene_, true);
+    if (!c.reset) apply_live(*c.settings);
+    sim_settings_ = *c.settings;
     changed = true;
   }
   if (c.reset) {
@@ -202,10 +237,10 @@ bool LiveSimulation::step() {
     const StepResult r = sim_->step();
     if (!r.ok) {
       status_ = RunStatus::kSolverFailed;
-      message_ = "the solver failed at t = " + to_text(sim_->state().t) + ": " + r.message;
+      message_ = "the solver failed at t = " + time_text(sim_->state().t) + " s" + ": " + r.message;
     } else if (auto why = sim_->options().divergence.check(sim_->model(), sim_->state())) {
       status_ = RunStatus::kDiverged;
-      message_ = "diverged at t = " + to_text(sim_->state().t) + " s: " + *why;
+      message_ = "diverged at t = " + time_text(sim_->state().t) + " s: " + *why;
     }
   } catch (const std::exception& e) {
     status_ = RunStatus::kSolverFailed;
@@ -329,7 +364,14 @@ void LiveSimulation::loop() {
         ahead = true;
         break;
       }
+      const Real dt = sim_->options().dt;
+      const bool before_end = sim_->state().t < sim_scene_.duration - 0.5 * dt;
       if (!step()) break;
+      // The run pauses where the scene ends (as `jelly run` stops there); Play goes on past it.
+      if (before_end && sim_->state().t >= sim_scene_.duration - 0.5 * dt) {
+        sim_playing_ = false;
+        break;
+      }
     }
     publish();
     const double now = now_seconds();

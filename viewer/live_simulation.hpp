@@ -21,12 +21,14 @@
 
 namespace jelly::viewer {
 
-// What the panel edits; a change rebuilds the simulator from the current state (the run goes on
-// with the new integrator, step or coefficients).
+// What the panel edits; a change is applied to the running simulator through its live setters
+// (the run goes on from the current state with the new integrator, step or coefficients; pins,
+// forces and everything else are kept).
 struct LiveSettings {
+  using BodySprings = std::array<SpringCoefficients, kSpringTypeCount>;
   std::string integrator;
   Real dt = 0.001;
-  std::array<SpringCoefficients, kSpringTypeCount> springs{};
+  std::vector<BodySprings> springs;  // per body of the scene, in its order
   Vec3 gravity{0, -9.8, 0};
   std::vector<ContactParams> contacts;  // per terrain of the scene
 
@@ -54,7 +56,8 @@ struct LiveFrame {
 
 class LiveSimulation {
  public:
-  // threaded: steps on its own thread while playing; otherwise only advance_to() steps.
+  // threaded: steps on its own thread while playing, pausing when the time reaches the scene's
+  // duration (Play then goes on past it); otherwise only advance_to() steps.
   // on_publish (may be empty) is called on the simulating thread after each published frame
   // (the window wakes up with it). Throws InputError for an invalid scene.
   LiveSimulation(Scene scene, bool threaded, std::function<void()> on_publish = {});
@@ -87,6 +90,8 @@ class LiveSimulation {
   // The scene and settings as last loaded or applied (UI thread).
   const Scene& scene() const { return scene_; }
   const LiveSettings& settings() const { return settings_; }
+  // The simulator (lockstep only: a threaded simulation owns it on its own thread).
+  const Simulator& simulator() const { return *sim_; }
   unsigned long generation() const { return generation_; }
   bool playing() const { return playing_; }
 
@@ -104,6 +109,9 @@ class LiveSimulation {
   // Applies pending commands on the simulation side; true if anything changed.
   bool take_commands();
   void rebuild(const Scene& scene, bool keep_state);
+  // Applies what differs between the simulator's settings and `settings` through the
+  // simulator's setters.
+  void apply_live(const LiveSettings& settings);
   // One step with the divergence check; false when the simulation stopped.
   bool step();
   void publish();
@@ -126,6 +134,7 @@ class LiveSimulation {
   // Simulation side.
   std::unique_ptr<Simulator> sim_;
   Scene sim_scene_;
+  LiveSettings sim_settings_;  // of sim_scene_
   unsigned long sim_generation_ = 1;
   long steps_ = 0;
   bool sim_playing_ = false;

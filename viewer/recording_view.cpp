@@ -57,6 +57,33 @@ Camera RecordingView::default_camera(float aspect) const {
   return framing_camera(lo_, hi_, builder_->terrains(), recording_.time.front(), aspect);
 }
 
+RecordingView::Follow::Follow(const RecordingView& view, const std::vector<int>& frames,
+                              float aspect)
+    : view_(view) {
+  const auto& position = view.recording().position;
+  const int first = frames.empty() ? 0 : frames.front();
+  Vec3 extent = Vec3::Zero();
+  for (const int k : frames) {
+    Vec3 lo, hi;
+    bounds_of(position[static_cast<size_t>(k)], lo, hi);
+    extent = extent.cwiseMax(hi - lo);
+  }
+  Vec3 lo, hi;
+  bounds_of(position[static_cast<size_t>(first)], lo, hi);
+  const Vec3 centre = 0.5 * (lo + hi);
+  base_ = framing_camera(centre - 0.5 * extent, centre + 0.5 * extent, view.builder().terrains(),
+                         view.recording().time[static_cast<size_t>(first)], aspect);
+  offset_ = base_.target - centre.cast<float>();
+}
+
+Camera RecordingView::Follow::at(int k) const {
+  Vec3 lo, hi;
+  bounds_of(view_.recording().position[static_cast<size_t>(k)], lo, hi);
+  Camera camera = base_;
+  camera.target = (0.5 * (lo + hi)).cast<float>() + offset_;
+  return camera;
+}
+
 Camera framing_camera(const Vec3& lo, const Vec3& hi, const Terrains& terrains, Real t,
                       float aspect) {
   Vec3 a = lo, b = hi;

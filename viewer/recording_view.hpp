@@ -35,6 +35,19 @@ class RecordingView {
 
   // The camera that shows the whole motion in an image of this aspect ratio.
   Camera default_camera(float aspect) const;
+  // A camera that follows the bodies over `frames` (a video's): follow_camera(k) frames the
+  // bodies at frame k at the size of their largest extent over `frames`, from the default
+  // direction; its target moves with the centre of their bounds, so they stay large.
+  class Follow {
+   public:
+    Follow(const RecordingView& view, const std::vector<int>& frames, float aspect);
+    Camera at(int k) const;
+
+   private:
+    const RecordingView& view_;
+    Camera base_;
+    Eigen::Vector3f offset_;  // base_.target minus the bodies' centre at the first frame
+  };
 
  private:
   Recording recording_;

@@ -19,7 +19,8 @@ struct SurfaceView {
   std::string name;
   std::vector<std::array<int, 3>> triangles;  // vertex indices, CCW seen from outside
   std::vector<float> positions;               // [3 V] this frame
-  Vec3f color{0.85f, 0.13f, 0.22f};
+  Vec3f color{0.85f, 0.13f, 0.22f};           // sRGB, of its surface and its particles
+  int first_particle = 0, num_particles = 0;  // its range of RenderScene::particles
   int num_vertices() const { return static_cast<int>(positions.size() / 3); }
 };
 

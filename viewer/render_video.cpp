@@ -34,8 +34,10 @@ RenderVideoReport render_video(const std::string& recording_path, const std::str
   const std::vector<int> frames =
       view.video_frames(fps, options.start >= 0 ? options.start : time.front(),
                         options.end >= 0 ? options.end : time.back());
-  Camera camera =
-      view.default_camera(static_cast<float>(options.width) / static_cast<float>(options.height));
+  // Without --camera the camera follows the bodies (RecordingView::Follow).
+  const float aspect = static_cast<float>(options.width) / static_cast<float>(options.height);
+  const RecordingView::Follow follow(view, frames, aspect);
+  Camera camera = follow.at(frames.front());
   if (!options.camera.empty()) camera.parse(options.camera);
 
   VideoWriter writer(output, options.width, options.height, fps, options.crf);
@@ -53,6 +55,7 @@ RenderVideoReport render_video(const std::string& recording_path, const std::str
   for (const int k : frames) {
     auto t = Clock::now();
     view.update(k, scene);
+    if (options.camera.empty()) camera = follow.at(k);
     target.bind();
     renderer.draw(scene, camera, options.width, options.height);
     target.resolve();

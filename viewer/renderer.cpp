@@ -784,10 +784,19 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
     set(g.point.viewport_height, static_cast<float>(height));
     const Vec3f light_view = (view.topLeftCorner<3, 3>() * light).normalized();
     set(g.point.light_view, light_view);
-    Vec3f color = scene.bodies.empty() ? Vec3f(0.85f, 0.13f, 0.22f) : scene.bodies[0].color;
-    set(g.point.color, Vec3f(0.8f * color));
     glBindVertexArray(g.particle_vao);
-    glDrawArrays(GL_POINTS, 0, g.particle_count);
+    // Each body's particles in its colour; without bodies, all of them in the jelly's.
+    if (scene.bodies.empty()) {
+      set(g.point.color, Vec3f(0.8f * Vec3f(0.85f, 0.13f, 0.22f)));
+      glDrawArrays(GL_POINTS, 0, g.particle_count);
+    }
+    for (const SurfaceView& body : scene.bodies) {
+      const int first = std::clamp(body.first_particle, 0, g.particle_count);
+      const int count = std::clamp(body.num_particles, 0, g.particle_count - first);
+      if (count == 0) continue;
+      set(g.point.color, Vec3f(0.8f * body.color));
+      glDrawArrays(GL_POINTS, first, count);
+    }
   }
 
   // The drag: a line to the target and both ends marked, over everything.

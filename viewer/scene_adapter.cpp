@@ -1,6 +1,7 @@
 #include <jelly/viewer/scene_adapter.hpp>
 
 #include <cmath>
+#include <optional>
 
 #include <jelly/geometry/cube.hpp>
 #include <jelly/io/scene.hpp>
@@ -51,22 +52,40 @@ std::vector<BodySurface> body_surfaces(const Model& model) {
     s.name = b.name;
     s.first_particle = b.first_particle;
     s.num_particles = b.num_particles;
+    s.color = b.color;
     out.push_back(std::move(s));
   }
   return out;
 }
 
 std::vector<BodySurface> recording_surfaces(const Recording& recording) {
-  if (!recording.model.bodies.empty()) return body_surfaces(recording.model);
-  if (!recording.scene_json.empty()) {
-    try {
-      const Model model =
-          make_model(parse_scene(recording.scene_json, {}, "the recording's scene_json"));
-      if (model.num_particles() == recording.model.num_particles()) return body_surfaces(model);
-    } catch (const InputError&) {
-      // A scene this version cannot read: fall through to the particles alone.
+  std::optional<Model> scene_model;  // the recording's scene, made once when needed
+  const auto scene = [&]() -> const Model* {
+    if (!scene_model && !recording.scene_json.empty()) {
+      try {
+        scene_model =
+            make_model(parse_scene(recording.scene_json, {}, "the recording's scene_json"));
+      } catch (const InputError&) {
+        // A scene this version cannot read: the particles alone, the palette's colours.
+        scene_model = Model{};
+      }
     }
+    return scene_model ? &*scene_model : nullptr;
+  };
+  if (!recording.model.bodies.empty()) {
+    std::vector<BodySurface> out = body_surfaces(recording.model);
+    // A file written before bodies carried their colour: the scene's.
+    for (BodySurface& body : out) {
+      if (body.color || recording.scene_json.empty()) continue;
+      if (const Model* model = scene())
+        if (const Body* b = model->find_body(body.name)) body.color = b->color;
+    }
+    return out;
   }
+  const Model* model = scene();
+  if (model != nullptr && !model->bodies.empty() &&
+      model->num_particles() == recording.model.num_particles())
+    return body_surfaces(*model);
   return {all_particles(recording.model)};
 }
 

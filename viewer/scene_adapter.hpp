@@ -4,6 +4,7 @@
 // poses (Terrain::render_mesh(), pose(t)), with the viewer's own choices on top: an infinite
 // plane is drawn as a square large enough for the action, and a recording whose file holds no
 // bodies takes them from the scene it was made from.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@ namespace jelly::viewer {
 struct BodySurface : Surface {
   std::string name;  // as in the HDF5 file: /particles/<name>
   int first_particle = 0, num_particles = 0;
+  std::optional<Vec3> color;  // the body's own (sRGB in [0, 1]); none: the viewer's palette
 
   using Surface::vertices;
   // All vertex positions, [3 V] each, no allocation.
@@ -34,7 +36,8 @@ struct BodySurface : Surface {
 std::vector<BodySurface> body_surfaces(const Model& model);
 // The bodies of a recording: its model's; for a file that holds none, those of the scene it was
 // made from (/parameters scene_json: the same particles in the same order), else one body
-// "jelly" of all particles, with the lattice boundary of a cube when there are n^3 of them.
+// "jelly" of all particles, with the lattice boundary of a cube when there are n^3 of them. A
+// body the file gives no colour takes its scene's, if the scene gives one.
 std::vector<BodySurface> recording_surfaces(const Recording& recording);
 
 // A terrain's shape in its own frame (render_mesh()); an infinite plane becomes a square of

@@ -83,7 +83,10 @@ RenderScene SceneBuilder::make_scene(const VecX& x, Real t) const {
     body.name = surfaces_[b].name;
     body.triangles = surfaces_[b].triangles;
     body.positions.assign(static_cast<size_t>(3 * surfaces_[b].num_vertices()), 0.0f);
-    body.color = kBodyColors[b % (sizeof kBodyColors / sizeof kBodyColors[0])];
+    body.color = surfaces_[b].color ? Vec3f(surfaces_[b].color->cast<float>())
+                                    : kBodyColors[b % (sizeof kBodyColors / sizeof kBodyColors[0])];
+    body.first_particle = surfaces_[b].first_particle;
+    body.num_particles = surfaces_[b].num_particles;
     scene.bodies.push_back(std::move(body));
   }
   for (size_t i = 0; i < terrains_.size(); ++i) {

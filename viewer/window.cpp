@@ -182,6 +182,7 @@ struct ViewerWindow::Impl {
   unsigned long builder_generation = 0;
   Real interval = 1.0 / 60;  // lockstep: simulated time per frame
   LiveSettings edit;         // the panel's copy of the settings
+  int spring_body = 0;       // the body whose springs the panel edits
   std::string panel_error;   // a rejected panel input
   char path_buffer[512] = {};
   Real last_t = -1;
@@ -192,6 +193,7 @@ struct ViewerWindow::Impl {
 
   // Replay.
   std::unique_ptr<RecordingView> replay;
+  std::unique_ptr<RecordingView::Follow> replay_follow;  // the replay's camera target
   int replay_frame = 0;
   double replay_time = 0;
   bool replay_playing = false;
@@ -201,7 +203,10 @@ struct ViewerWindow::Impl {
   Clock::time_point last_frame_time = Clock::now();
 
   float panel_right = 0;  // the panel's right edge in pixels, 0 when hidden or collapsed
-  bool follow = false;    // the camera's target follows the bodies
+  std::vector<std::string> clipped_items;  // panel items cut off by its edge, last frame
+  std::optional<PanelRect> banner_rect;    // the divergence banner, last frame
+  PanelRect panel_rect;                    // the panel, last frame (empty when hidden)
+  bool follow = false;  // the camera's target follows the bodies (default without --camera)
 
   // Mouse.
   enum class Drag { kNone, kOrbit, kPan, kParticle } drag = Drag::kNone;
@@ -352,6 +357,7 @@ struct ViewerWindow::Impl {
       bounds_of(positions, lo, hi);
       camera = framing_camera(lo, hi, builder->terrains(), 0, aspect());
     }
+    follow = options.camera.empty();  // a camera of the user's own stays where it was put
     if (!options.paused && !options.lockstep) live->set_playing(true);
   }
 
@@ -387,6 +393,13 @@ struct ViewerWindow::Impl {
 
   // ---- Replay ----------------------------------------------------------------------------
 
+  // A replay with a screenshot (or a frame count) shows one recorded frame per window frame,
+  // unless started paused.
+  bool replay_lockstep() const {
+    return !options.paused &&
+           (options.lockstep || options.frames >= 0 || !options.screenshot.empty());
+  }
+
   void init_replay(const std::string& path) {
     replay = std::make_unique<RecordingView>(path);
     replay_frame = std::clamp(options.start_frame, 0, replay->frames() - 1);
@@ -396,8 +409,14 @@ struct ViewerWindow::Impl {
     scene.show_particles = scene.show_particles || options.particles;
     scene.show_springs = options.springs;
     positions = replay->recording().position[replay_frame];
-    camera = replay->default_camera(aspect());
+    // The camera `jelly render` follows the bodies with over the whole recording, so a replay's
+    // frame and the video's are the same picture.
+    std::vector<int> all(static_cast<size_t>(replay->frames()));
+    for (int k = 0; k < replay->frames(); ++k) all[static_cast<size_t>(k)] = k;
+    replay_follow = std::make_unique<RecordingView::Follow>(*replay, all, aspect());
+    camera = replay_follow->at(replay_frame);
     if (!options.camera.empty()) camera.parse(options.camera);
+    follow = options.camera.empty();
     // The recorded observables to plot, one value per frame (the height of the centre of mass).
     const Recording& r = replay->recording();
     for (const char* name : {"kinetic_energy", "elastic_energy", "gravitational_energy",
@@ -414,7 +433,14 @@ struct ViewerWindow::Impl {
 
   void update_replay(double wall_dt) {
     const auto& time = replay->recording().time;
-    if (replay_playing) {
+    if (replay_lockstep()) {
+      // Window frame k shows recorded frame start + k, so `--frames N --screenshot` captures
+      // recorded frame start + N (the last one when the recording is shorter).
+      replay_frame = static_cast<int>(
+          std::min<long>(options.start_frame + frames_shown, replay->frames() - 1));
+      replay_frame = std::max(replay_frame, 0);
+      replay_time = time[static_cast<size_t>(replay_frame)];
+    } else if (replay_playing) {
       replay_time += wall_dt * replay_speed;
       if (replay_time > time.back()) {
         if (replay_loop) {
@@ -597,6 +623,12 @@ struct ViewerWindow::Impl {
 
   // ---- Panel -----------------------------------------------------------------------------
 
+  // Records the last item's label when it reaches past the panel's right edge (cut off).
+  void note_clipping(const char* label) {
+    const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+    if (ImGui::GetItemRectMax().x > right + 0.5f) clipped_items.emplace_back(label);
+  }
+
   void apply_settings() {
     try {
       live->apply(edit);
@@ -709,10 +741,13 @@ struct ViewerWindow::Impl {
         ImGui::EndCombo();
       }
       double dt = edit.dt;
+      // A fixed-width field and the presets after it: all of them fit the default panel.
+      ImGui::SetNextItemWidth(90);
       if (ImGui::InputDouble("dt (s)", &dt, 0, 0, "%.6g", ImGuiInputTextFlags_EnterReturnsTrue)) {
         edit.dt = dt;
         apply_settings();
       }
+      note_clipping("dt (s)");
       for (const auto& [label, value] :
            {std::pair{"1/1000", 1e-3}, {"1/240", 1.0 / 240}, {"1/60", 1.0 / 60}}) {
         ImGui::SameLine();
@@ -720,31 +755,46 @@ struct ViewerWindow::Impl {
           edit.dt = value;
           apply_settings();
         }
+        note_clipping(label);
       }
       ImGui::TextDisabled("(applied now, from the current state)");
     }
 
     if (ImGui::CollapsingHeader("Springs and gravity", ImGuiTreeNodeFlags_DefaultOpen)) {
       bool changed = false;
-      for (int type = 0; type < kSpringTypeCount; ++type) {
-        ImGui::PushID(type);
-        const std::string name(spring_type_name(static_cast<SpringType>(type)));
-        float ks = static_cast<float>(edit.springs[type].ks);
-        float kd = static_cast<float>(edit.springs[type].kd);
-        ImGui::SetNextItemWidth(110);
-        if (ImGui::DragFloat("##ks", &ks, std::max(1.0f, 0.01f * ks), 0.0f, 1e7f, "ks %.4g")) {
-          edit.springs[type].ks = std::max(0.0f, ks);
-          changed = true;
+      // Each body keeps its own coefficients; the panel edits one body's at a time.
+      const std::vector<BodySpec>& bodies = live->scene().bodies;
+      const int body_count = static_cast<int>(std::min(bodies.size(), edit.springs.size()));
+      spring_body = std::clamp(spring_body, 0, std::max(0, body_count - 1));
+      if (body_count > 0) {
+        if (body_count > 1 &&
+            ImGui::BeginCombo("body", bodies[static_cast<size_t>(spring_body)].name.c_str())) {
+          for (int b = 0; b < body_count; ++b)
+            if (ImGui::Selectable(bodies[static_cast<size_t>(b)].name.c_str(), b == spring_body))
+              spring_body = b;
+          ImGui::EndCombo();
         }
-        ImGui::SameLine();
-        ImGui::SetNextItemWidth(90);
-        if (ImGui::DragFloat("##kd", &kd, std::max(0.1f, 0.01f * kd), 0.0f, 1e6f, "kd %.4g")) {
-          edit.springs[type].kd = std::max(0.0f, kd);
-          changed = true;
+        auto& springs = edit.springs[static_cast<size_t>(spring_body)];
+        for (int type = 0; type < kSpringTypeCount; ++type) {
+          ImGui::PushID(type);
+          const std::string name(spring_type_name(static_cast<SpringType>(type)));
+          float ks = static_cast<float>(springs[type].ks);
+          float kd = static_cast<float>(springs[type].kd);
+          ImGui::SetNextItemWidth(110);
+          if (ImGui::DragFloat("##ks", &ks, std::max(1.0f, 0.01f * ks), 0.0f, 1e7f, "ks %.4g")) {
+            springs[type].ks = std::max(0.0f, ks);
+            changed = true;
+          }
+          ImGui::SameLine();
+          ImGui::SetNextItemWidth(90);
+          if (ImGui::DragFloat("##kd", &kd, std::max(0.1f, 0.01f * kd), 0.0f, 1e6f, "kd %.4g")) {
+            springs[type].kd = std::max(0.0f, kd);
+            changed = true;
+          }
+          ImGui::SameLine();
+          ImGui::TextUnformatted(name.c_str());
+          ImGui::PopID();
         }
-        ImGui::SameLine();
-        ImGui::TextUnformatted(name.c_str());
-        ImGui::PopID();
       }
       float g[3] = {static_cast<float>(edit.gravity.x()), static_cast<float>(edit.gravity.y()),
                     static_cast<float>(edit.gravity.z())};
@@ -845,18 +895,28 @@ struct ViewerWindow::Impl {
 
   void overlays() {
     // The divergence guard's message over the picture, so it is seen with the panel hidden.
+    banner_rect.reset();
     if (live && live->front().status != RunStatus::kCompleted) {
+      // Centred in the part of the picture the panel leaves free, wrapped to its width.
       const ImGuiViewport* viewport = ImGui::GetMainViewport();
-      ImGui::SetNextWindowPos(
-          ImVec2(viewport->WorkPos.x + viewport->WorkSize.x * 0.5f, viewport->WorkPos.y + 20),
-          ImGuiCond_Always, ImVec2(0.5f, 0));
+      const float left = viewport->WorkPos.x + (options.hide_panel ? 0.0f : panel_right) + 8;
+      const float right = viewport->WorkPos.x + viewport->WorkSize.x - 8;
+      const float width = std::max(120.0f, right - left);
+      ImGui::SetNextWindowPos(ImVec2(0.5f * (left + right), viewport->WorkPos.y + 20),
+                              ImGuiCond_Always, ImVec2(0.5f, 0));
+      ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(width, viewport->WorkSize.y));
       ImGui::SetNextWindowBgAlpha(0.8f);
       ImGui::Begin("stopped", nullptr,
                    ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
                        ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings);
+      ImGui::PushTextWrapPos(width - 2 * ImGui::GetStyle().WindowPadding.x);
       ImGui::TextColored(ImVec4(1, 0.4f, 0.35f, 1), "The simulation stopped: %s",
                          live->front().message.c_str());
-      ImGui::Text("Press R or Reset to start again (try a smaller dt or implicit_euler).");
+      ImGui::TextUnformatted(
+          "Press R or Reset to start again (try a smaller dt or implicit_euler).");
+      ImGui::PopTextWrapPos();
+      const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+      banner_rect = PanelRect{pos.x, pos.y, pos.x + size.x, pos.y + size.y};
       ImGui::End();
     }
   }
@@ -873,6 +933,8 @@ struct ViewerWindow::Impl {
         replay_panel();
     }
     panel_right = open ? ImGui::GetWindowPos().x + ImGui::GetWindowSize().x : 0.0f;
+    const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+    panel_rect = PanelRect{pos.x, pos.y, pos.x + (open ? size.x : 0), pos.y + size.y};
     ImGui::End();
   }
 
@@ -911,7 +973,9 @@ struct ViewerWindow::Impl {
         options.hide_panel
             ? 0.0f
             : std::clamp(panel_right * pixel_scale() / static_cast<float>(fb_width), 0.0f, 0.5f);
-    if (follow && positions.size() >= 3) {
+    if (follow && replay_follow) {
+      camera.target = replay_follow->at(replay_frame).target;
+    } else if (follow && positions.size() >= 3) {
       Vec3 lo, hi;
       bounds_of(positions, lo, hi);
       camera.target += 0.1f * ((0.5 * (lo + hi)).cast<float>() - camera.target);
@@ -937,6 +1001,8 @@ struct ViewerWindow::Impl {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
+    clipped_items.clear();
+    panel_rect = PanelRect{};
     if (!options.hide_panel) panel();
     overlays();
     ImGui::Render();
@@ -1038,5 +1104,10 @@ const VecX& ViewerWindow::positions() const { return impl_->positions; }
 int ViewerWindow::dragged_particle() const { return impl_->drag_particle; }
 LiveSimulation* ViewerWindow::simulation() { return impl_->live.get(); }
 void ViewerWindow::save_screenshot(const std::string& path) { impl_->save_screenshot(path); }
+PanelRect ViewerWindow::panel_rect() const { return impl_->panel_rect; }
+std::optional<PanelRect> ViewerWindow::banner_rect() const { return impl_->banner_rect; }
+const std::vector<std::string>& ViewerWindow::clipped_panel_items() const {
+  return impl_->clipped_items;
+}
 
 }  // namespace jelly::viewer

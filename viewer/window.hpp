@@ -6,8 +6,10 @@
 // the wheel zooms. Keys: space play/pause, S step, R reset, H hide the panel, P particles,
 // L springs, Esc close.
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <jelly/io/scene.hpp>
 #include <jelly/viewer/camera.hpp>
@@ -36,6 +38,14 @@ struct ViewOptions {
 class DisplayUnavailable : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// A rectangle of the window (x right, y down), in window coordinates.
+struct PanelRect {
+  float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool overlaps(const PanelRect& o) const {
+    return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1;
+  }
 };
 
 class ViewerWindow {
@@ -71,6 +81,11 @@ class ViewerWindow {
   int dragged_particle() const;
   // Null when replaying.
   LiveSimulation* simulation();
+  // The last frame's panel (empty when hidden) and divergence banner (none when running), in
+  // window coordinates; and the labels of panel items its right edge cut off.
+  PanelRect panel_rect() const;
+  std::optional<PanelRect> banner_rect() const;
+  const std::vector<std::string>& clipped_panel_items() const;
   // Writes the last drawn frame (with the panel, unless hidden) as PNG.
   void save_screenshot(const std::string& path);
 

@@ -13,11 +13,14 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/io/h5_recorder.hpp>
+#include <jelly/io/recording.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "scene_files.hpp"
+#include "support/temp_dir.hpp"
 
 namespace jelly {
 namespace {
@@ -563,6 +566,65 @@ TEST(BodyVelocity, TwoCubesLaunchedAtEachOtherConserveMomentum) {
   ASSERT_TRUE(report.ok()) << report.brief();
   EXPECT_GT(sim.body_contact().stats().pairs, 0);  // they did meet
   EXPECT_LT((linear_momentum(m, sim.state()) - p0).norm(), 1e-9);
+}
+
+// A body's colour: optional, read, written back, given to the model's body, written to a
+// recording's body group and read back from it (issue 40, item 7).
+TEST(BodyColor, ReadWrittenAndRecorded) {
+  const std::string json = R"({
+    "bodies": [
+      {"kind": "cube", "name": "red", "n": 3, "edge_length": 1, "origin": [-2, 0.5, 0]},
+      {"kind": "cube", "name": "green", "n": 3, "edge_length": 1, "origin": [2, 0.5, 0],
+       "color": [0.1, 0.8, 0.2]}
+    ],
+    "terrains": [], "integrator": {"name": "rk4", "dt": 0.001}, "duration": 0.02
+  })";
+  const Scene scene = parse_scene(json);
+  EXPECT_FALSE(scene.bodies[0].color);
+  ASSERT_TRUE(scene.bodies[1].color);
+  EXPECT_EQ(*scene.bodies[1].color, Vec3(0.1, 0.8, 0.2));
+  const Scene again = parse_scene(scene_to_json(scene));
+  EXPECT_FALSE(again.bodies[0].color);
+  EXPECT_EQ(again.bodies[1].color, scene.bodies[1].color);
+
+  testing::TempDir dir;
+  const std::string path = dir.file("colors.h5");
+  {
+    Simulator sim = make_simulator(scene);
+    EXPECT_FALSE(sim.model().bodies[0].color);
+    EXPECT_EQ(sim.model().bodies[1].color, scene.bodies[1].color);
+    RecorderOptions options;
+    options.scene_json = scene_to_json(scene);
+    H5Recorder recorder(path, sim, options);
+    sim.add_observer(recorder);
+    ASSERT_TRUE(sim.run_until(0.02).ok());
+  }
+  const Recording r = read_recording(path);
+  ASSERT_EQ(r.model.bodies.size(), 2u);
+  EXPECT_FALSE(r.model.bodies[0].color);
+  EXPECT_EQ(r.model.bodies[1].color, scene.bodies[1].color);
+}
+
+TEST(BodyColor, BadColorsNameTheField) {
+  for (const std::string color : {"[0.1, 1.5, 0.2]", "[-0.1, 0, 0]", "[0, 0]", "\"green\""}) {
+    SCOPED_TRACE(color);
+    try {
+      load_scene(scene_path("jelly_stack.json"), {"bodies[1].color=" + color});
+      FAIL();
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("bodies[1].color"));
+    }
+  }
+  Scene scene = load_scene(scene_path("jelly_stack.json"));
+  ASSERT_GE(scene.bodies.size(), 2u);
+  scene.bodies[1].color = Vec3(0.5, 2, 0.5);
+  try {
+    make_simulator(scene);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("bodies[1].color"));
+    EXPECT_THAT(e.what(), HasSubstr("[0, 1]"));
+  }
 }
 
 TEST(BodyVelocity, NonFiniteVelocitiesNameTheirField) {

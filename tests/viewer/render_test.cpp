@@ -3,6 +3,7 @@
 // and `jelly render` writes the frames ffprobe counts.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 
@@ -100,6 +101,75 @@ TEST_F(Offscreen, ParticlesSpringsAndDragDrawWithoutErrors) {
   EXPECT_GT(white, 100);
 }
 
+// A red cube (the palette's first colour) and a cube the scene colours green, on a floor.
+constexpr const char* kRedAndGreen = R"({
+  "bodies": [
+    {"kind": "cube", "name": "first", "n": 4, "edge_length": 1, "origin": [-2, 0.1, -0.5]},
+    {"kind": "cube", "name": "green", "n": 4, "edge_length": 1, "origin": [1, 0.1, -0.5],
+     "color": [0.1, 0.8, 0.2]}
+  ],
+  "terrains": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}],
+  "integrator": {"name": "rk4", "dt": 0.001}, "duration": 0.1
+})";
+
+bool is_green(const std::uint8_t* p) { return p[1] > 60 && p[1] > p[0] + 40 && p[1] > p[2] + 30; }
+
+// The share of green and of jelly-red pixels inside each body's projected box.
+struct TwoBodyPixels {
+  double green_in_green = 0, red_in_green = 0, green_in_first = 0, red_in_first = 0;
+};
+TwoBodyPixels two_body_pixels(const std::vector<std::uint8_t>& rgb, const viewer::Camera& camera,
+                              const Model& model, const VecX& x, int w, int h) {
+  TwoBodyPixels out;
+  for (int b = 0; b < 2; ++b) {
+    const Body& body = model.bodies[static_cast<size_t>(b)];
+    const testing::Box box = testing::projected_box(
+        camera, x.segment(3 * body.first_particle, 3 * body.num_particles), w, h);
+    long inside = 0, green = 0, red = 0;
+    for (int py = 0; py < h; ++py)
+      for (int px = 0; px < w; ++px) {
+        if (!box.contains(px + 0.5f, py + 0.5f)) continue;
+        const std::uint8_t* p = rgb.data() + 3 * (static_cast<size_t>(py) * w + px);
+        ++inside;
+        green += is_green(p);
+        red += testing::is_jelly(p);
+      }
+    const double n = inside > 0 ? static_cast<double>(inside) : 1.0;
+    (b == 0 ? out.green_in_first : out.green_in_green) = static_cast<double>(green) / n;
+    (b == 0 ? out.red_in_first : out.red_in_green) = static_cast<double>(red) / n;
+  }
+  return out;
+}
+
+// Each body is drawn in its scene's colour, its surface and its particles alike (issue 40,
+// item 7: the particles of every body took the first body's colour).
+TEST_F(Offscreen, EveryBodyInItsOwnColour) {
+  const Scene scene = parse_scene(kRedAndGreen);
+  const Model model = make_model(scene);
+  Terrains terrains;
+  for (const auto& t : scene.terrains) terrains.push_back(t->make());
+  Vec3 lo, hi;
+  viewer::bounds_of(model.rest_position, lo, hi);
+  const viewer::SceneBuilder builder(model, std::move(terrains), lo, hi);
+  const int w = 320, h = 240;
+  const viewer::Camera camera =
+      viewer::frame_box(lo.cast<float>(), hi.cast<float>(), float(w) / h, 0, 20);
+  viewer::Renderer renderer;
+  viewer::RenderScene view = builder.make_scene(model.rest_position, 0);
+  for (const bool particles : {false, true}) {
+    SCOPED_TRACE(particles ? "particles" : "surfaces");
+    view.show_surfaces = !particles;
+    view.show_particles = particles;
+    const std::vector<std::uint8_t> rgb = draw(renderer, view, camera, w, h);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+    const TwoBodyPixels c = two_body_pixels(rgb, camera, model, model.rest_position, w, h);
+    EXPECT_GT(c.green_in_green, particles ? 0.2 : 0.6);
+    EXPECT_EQ(c.red_in_green, 0);
+    EXPECT_GT(c.red_in_first, particles ? 0.2 : 0.6);
+    EXPECT_EQ(c.green_in_first, 0);
+  }
+}
+
 TEST_F(Offscreen, PngRoundTrip) {
   TempDir dir;
   std::vector<std::uint8_t> rgb(7 * 5 * 3);
@@ -109,6 +179,56 @@ TEST_F(Offscreen, PngRoundTrip) {
   EXPECT_EQ(image.width, 7);
   EXPECT_EQ(image.height, 5);
   EXPECT_EQ(image.rgb, rgb);
+}
+
+// A recording keeps its bodies' colours: `jelly render` draws the green body green.
+TEST(RenderCli, KeepsTheBodiesColours) {
+  TempDir dir;
+  {
+    std::ofstream out(dir.file("two.json"));
+    out << kRedAndGreen;
+  }
+  const std::string jelly = std::string("'") + JELLY_CLI + "' ";
+  testing::Result r = testing::run(
+      jelly + "run '" + dir.file("two.json") + "' --quiet -o '" + dir.file("two.h5") + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(jelly + "render '" + dir.file("two.h5") + "' -o '" + dir.file("f%03d.png") +
+                       "' --width 320 --height 240 --samples 1 --end 0",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  if (r.err.find("no offscreen") != std::string::npos) GTEST_SKIP() << r.err;
+  const viewer::Image image = viewer::read_png(dir.file("f000.png"));
+  long green = 0, red = 0;
+  for (size_t i = 0; i + 2 < image.rgb.size(); i += 3) {
+    green += is_green(&image.rgb[i]);
+    red += testing::is_jelly(&image.rgb[i]);
+  }
+  EXPECT_GT(green, 200);
+  EXPECT_GT(red, 200);
+}
+
+// Without --camera, `jelly render` follows the bodies and keeps them large: the seed jelly,
+// 4 s down the slope, fills a good part of the picture at the end of the video (issue 40,
+// item 3: the camera framed the whole motion and the jelly filled under 5 %).
+TEST(RenderCli, FollowsTheBodies) {
+  TempDir dir;
+  const std::string jelly = std::string("'") + JELLY_CLI + "' ";
+  testing::Result r =
+      testing::run(jelly + "run '" JELLY_SCENES_DIR "/seed_slope.json' --duration 4 --quiet -o '" +
+                       dir.file("r.h5") + "'",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(jelly + "render '" + dir.file("r.h5") + "' -o '" + dir.file("f%03d.png") +
+                       "' --width 320 --height 240 --samples 1 --start 2",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  if (r.err.find("no offscreen") != std::string::npos) GTEST_SKIP() << r.err;
+  for (const std::string frame : {"f000.png", "f120.png"}) {
+    const viewer::Image image = viewer::read_png(dir.file(frame));
+    long red = 0;
+    for (size_t i = 0; i + 2 < image.rgb.size(); i += 3) red += testing::is_jelly(&image.rgb[i]);
+    EXPECT_GT(static_cast<double>(red) / (image.width * image.height), 0.05) << frame;
+  }
 }
 
 // `jelly render`: mp4, gif and PNG frames with the frame count and size ffprobe reports.

@@ -16,6 +16,7 @@
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/io/scene.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/viewer/camera.hpp>
 #include <jelly/viewer/exports.hpp>
 #include <jelly/viewer/live_simulation.hpp>
@@ -385,6 +386,99 @@ TEST(LiveSimulation, ThreadTakesCommands) {
   ASSERT_TRUE(wait_for([](const viewer::LiveFrame& f) { return f.t == 0 && f.steps == 0; }));
 }
 
+// The live run pauses at the scene's duration (issue 40, item 3: it ran on for ever); Play goes
+// on past it.
+TEST(LiveSimulation, PausesAtTheScenesDuration) {
+  viewer::LiveSimulation live(small_slope(4, {"duration=0.1"}), true);
+  const auto wait_for = [&](auto done) {
+    for (int i = 0; i < 2000; ++i) {
+      live.refresh();
+      if (done(live.front())) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+  };
+  live.set_speed(0);
+  live.set_playing(true);
+  ASSERT_TRUE(wait_for([](const viewer::LiveFrame& f) { return f.t > 0 && !f.playing; }));
+  EXPECT_EQ(live.front().steps, 100);
+  EXPECT_NEAR(live.front().t, 0.1, 1e-9);
+  EXPECT_FALSE(live.playing());
+  live.set_playing(true);
+  ASSERT_TRUE(wait_for([](const viewer::LiveFrame& f) { return f.t > 0.15; }));
+  live.set_playing(false);
+}
+
+// A stiff cube and a soft one on a floor: each body keeps its own springs whatever the panel
+// changes (issue 40, item 1: every body took the first body's).
+constexpr const char* kStiffAndSoft = R"({
+  "bodies": [
+    {"kind": "cube", "name": "stiff", "n": 3, "edge_length": 1, "origin": [-2, 0.5, 0],
+     "springs": {"structural": {"ks": 5000, "kd": 5}, "shear": {"ks": 5000, "kd": 5},
+                 "bending": {"ks": 5000, "kd": 5}}},
+    {"kind": "cube", "name": "soft", "n": 3, "edge_length": 1, "origin": [2, 0.5, 0],
+     "springs": {"structural": {"ks": 3, "kd": 0.5}, "shear": {"ks": 3, "kd": 0.5},
+                 "bending": {"ks": 3, "kd": 0.5}}}
+  ],
+  "terrains": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0],
+                "contact": {"model": "coulomb"}}],
+  "integrator": {"name": "rk4", "dt": 0.001},
+  "duration": 1
+})";
+
+// A panel change (integrator, dt, gravity, contact) goes on from the current state with every
+// body's own springs: bit for bit what the simulator does with the same live edits.
+TEST(LiveSimulation, PanelChangesKeepEveryBodysSprings) {
+  const Scene scene = parse_scene(kStiffAndSoft);
+  viewer::LiveSimulation live(scene, false);
+  Simulator reference = make_simulator(scene);
+  live.advance_to(0.05);
+  ASSERT_TRUE(reference.run_until(0.05).ok());
+
+  viewer::LiveSettings settings = live.settings();
+  ASSERT_EQ(settings.springs.size(), 2u);
+  EXPECT_EQ(settings.springs[1][0].ks, 3);
+  settings.integrator = "midpoint";
+  settings.dt = 0.0005;
+  settings.gravity = Vec3(0, -9.0, 0);
+  settings.contacts[0].friction = 0.3;
+  settings.contacts[0].static_friction = std::max(0.3, settings.contacts[0].static_friction);
+  live.apply(settings);
+  live.advance_to(0.3);
+  ASSERT_TRUE(live.refresh());
+
+  reference.set_integrator(make_integrator("midpoint", {}));
+  reference.set_dt(0.0005);
+  reference.set_gravity(Vec3(0, -9.0, 0));
+  reference.terrains()[0]->set_contact(settings.contacts[0]);
+  ASSERT_TRUE(reference.run_until(0.3).ok());
+  EXPECT_TRUE(live.front().x == reference.state().x);
+
+  // Each body's springs are still its own, in the simulator and in the panel's settings.
+  const Model& model = live.simulator().model();
+  for (int b = 0; b < 2; ++b) {
+    const Body& body = model.bodies[static_cast<size_t>(b)];
+    for (int s = body.first_spring; s < body.end_spring(); ++s)
+      EXPECT_EQ(model.springs.ks[static_cast<size_t>(s)], b == 0 ? 5000 : 3) << "spring " << s;
+  }
+  EXPECT_EQ(live.settings().springs[0][0].ks, 5000);
+  EXPECT_EQ(live.settings().springs[1][0].ks, 3);
+
+  // A change of one body's springs leaves the other's alone.
+  settings.springs[1][0].ks = 7;
+  live.apply(settings);
+  live.advance_to(0.31);
+  const Body& soft = model.bodies[1];
+  const Body& stiff = model.bodies[0];
+  for (int s = soft.first_spring; s < soft.end_spring(); ++s) {
+    if (model.springs.type[static_cast<size_t>(s)] == SpringType::kStructural) {
+      EXPECT_EQ(model.springs.ks[static_cast<size_t>(s)], 7);
+    }
+  }
+  for (int s = stiff.first_spring; s < stiff.end_spring(); ++s)
+    EXPECT_EQ(model.springs.ks[static_cast<size_t>(s)], 5000);
+}
+
 // A diverging run stops with the divergence guard's reason instead of crashing.
 TEST(LiveSimulation, DivergenceStopsWithTheReason) {
   viewer::LiveSimulation live(
@@ -395,6 +489,10 @@ TEST(LiveSimulation, DivergenceStopsWithTheReason) {
   EXPECT_NE(live.front().message.find("diverged at t ="), std::string::npos)
       << live.front().message;
   EXPECT_LT(live.front().t, 20);
+  // The time in 4 significant digits, not the accumulated 0.35000000000000003.
+  const std::string& message = live.front().message;
+  const size_t at = message.find("t = ") + 4;
+  EXPECT_LE(message.find(" s", at) - at, 6u) << message;
   live.reset();
   live.advance_to(0.1);
   live.refresh();

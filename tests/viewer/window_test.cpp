@@ -81,14 +81,74 @@ TEST(Window, ReplayShowsTheRecordedFrame) {
       testing::run(jelly() + "run '" + kSlope + "' --duration 1.5 --quiet -o '" + h5 + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   const Recording rec = read_recording(h5);
-  for (const int k : {0, 50, 90}) {
-    SCOPED_TRACE("frame " + std::to_string(k));
-    r = testing::run(jelly() + "view '" + h5 + "' --frame " + std::to_string(k) +
-                         " --frames 0 --screenshot '" + dir.file("s.png") + "'" + view_args(),
+  // --frame shows a recorded frame first; each window frame of a screenshot run is the next
+  // recorded frame, so --frames N captures recorded frame start + N (issue 40, item 8: it
+  // captured the first frame).
+  for (const auto& [start, frames] : {std::pair{0, 0}, {50, 0}, {90, 0}, {0, 90}, {30, 40}}) {
+    const int k = start + frames;
+    SCOPED_TRACE("--frame " + std::to_string(start) + " --frames " + std::to_string(frames));
+    r = testing::run(jelly() + "view '" + h5 + "' --frame " + std::to_string(start) + " --frames " +
+                         std::to_string(frames) + " --screenshot '" + dir.file("s.png") + "'" +
+                         view_args(),
                      dir);
     ASSERT_EQ(r.code, 0) << r.err;
     expect_jelly_at(dir.file("s.png"), rec.position[k]);
   }
+}
+
+// The default panel shows every dt preset whole; when the run diverges, the banner says when
+// in a few digits and stays clear of the panel (issue 40, items 2 and 8).
+TEST(Window, PanelShowsThePresetsAndTheBannerClearsIt) {
+  Scene scene =
+      load_scene(kSlope, {"cube.n=4", "integrator.name=explicit_euler", "integrator.dt=0.05"});
+  viewer::ViewOptions options;
+  options.width = 1024;
+  options.height = 600;
+  options.lockstep = true;
+  auto window = viewer::ViewerWindow::live(scene, kSlope, options);
+  ASSERT_TRUE(window->frame());  // ImGui lays a new window out on its first frame
+  ASSERT_TRUE(window->frame());
+  EXPECT_TRUE(window->clipped_panel_items().empty())
+      << "cut off: " << window->clipped_panel_items().front();
+  const viewer::PanelRect panel = window->panel_rect();
+  EXPECT_GT(panel.x1, panel.x0);
+  EXPECT_FALSE(window->banner_rect());
+  int frames = 0;
+  while (window->simulation()->front().status == RunStatus::kCompleted && frames < 600) {
+    ASSERT_TRUE(window->frame());
+    ++frames;
+  }
+  ASSERT_EQ(window->simulation()->front().status, RunStatus::kDiverged);
+  ASSERT_TRUE(window->frame());  // the banner's first frame sizes it
+  ASSERT_TRUE(window->frame());
+  const std::string& message = window->simulation()->front().message;
+  const size_t at = message.find("t = "), end = message.find(" s", at);
+  ASSERT_NE(at, std::string::npos) << message;
+  const std::string t = message.substr(at + 4, end - at - 4);
+  EXPECT_LE(t.size(), 6u) << message;  // 4 significant digits: "0.3333", "1.25", "12.35"
+  ASSERT_TRUE(window->banner_rect());
+  EXPECT_FALSE(window->banner_rect()->overlaps(window->panel_rect()))
+      << "banner x " << window->banner_rect()->x0 << " to " << window->banner_rect()->x1
+      << ", panel to " << window->panel_rect().x1;
+}
+
+// Without --camera the camera follows the bodies: the seed jelly, sliding down the slope, is
+// still in the picture after 4 s (issue 40, item 3: it left it).
+TEST(Window, CameraFollowsTheBodiesByDefault) {
+  viewer::ViewOptions options;
+  options.width = kWidth;
+  options.height = kHeight;
+  options.hide_panel = true;
+  options.lockstep = true;
+  options.samples = 1;
+  auto window = viewer::ViewerWindow::live(load_scene(kSlope), kSlope, options);
+  for (int frame = 0; frame <= 240; ++frame) ASSERT_TRUE(window->frame());
+  const testing::Box box =
+      testing::projected_box(window->camera(), window->positions(), kWidth, kHeight);
+  EXPECT_GT(box.x0, 0);
+  EXPECT_LT(box.x1, kWidth);
+  EXPECT_GT(box.y0, 0);
+  EXPECT_LT(box.y1, kHeight);
 }
 
 // Left press on the jelly picks the particle under the cursor; dragging pulls it to the cursor,
