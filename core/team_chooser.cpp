@@ -1,0 +1,52 @@
+#include <jelly/core/detail/team_chooser.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace jelly::parallel {
+
+TeamChooser::TeamChooser(int cores) : cores_(std::max(1, cores)) {}
+
+void TeamChooser::start_trial() {
+  in_trial_ = true;
+  trial_steps_ = 0;
+  trial_seconds_ = 0;
+}
+
+void TeamChooser::record(double seconds) {
+  ++steps_;
+  if (threads() > 1) ++steps_on_all_cores_;
+  if (cores_ <= 1 || !(seconds >= 0) || !std::isfinite(seconds)) return;
+  if (!warm_) {
+    warm_ = true;
+    return;
+  }
+  if (in_trial_) {
+    trial_seconds_ += seconds;
+    if (++trial_steps_ < kTrialSteps) return;
+    in_trial_ = false;
+    const double trial_mean = trial_seconds_ / kTrialSteps;
+    if (trial_mean < (1 - kMargin) * chosen_mean_) {
+      chosen_ = other();
+      chosen_mean_ = trial_mean;
+      patience_ = kPatience;
+      wait_seconds_ = 0;
+    } else {
+      // The trial's loss against the chosen size, times the patience.
+      wait_seconds_ = patience_ * std::max(0.0, trial_seconds_ - kTrialSteps * chosen_mean_);
+      const double largest = chosen_ == 1 ? kLargestPatienceOneThread : kLargestPatienceAllCores;
+      patience_ = std::min(largest, 2 * patience_);
+    }
+    chosen_steps_ = 0;
+    chosen_seconds_ = 0;
+    return;
+  }
+  const bool slow = chosen_ > 1 && chosen_mean_ > 0 && seconds > kSlowStep * chosen_mean_;
+  chosen_mean_ = chosen_mean_ > 0 ? chosen_mean_ + 0.25 * (seconds - chosen_mean_) : seconds;
+  ++chosen_steps_;
+  chosen_seconds_ += seconds;
+  if (chosen_steps_ >= kMinStepsBetweenTrials && (slow || chosen_seconds_ >= wait_seconds_))
+    start_trial();
+}
+
+}  // namespace jelly::parallel
