@@ -9,22 +9,28 @@ namespace jelly::parallel {
 
 class TeamChooser {
  public:
-  // Steps of the other size in one trial.
+  // Steps of the other size in one trial, at least, and their time, at least (so that one time
+  // slice lost to another process does not decide a trial of short steps).
   static constexpr int kTrialSteps = 2;
+  static constexpr double kTrialSeconds = 0.01;
   // Steps of the chosen size between two trials, at least (and before the first trial).
   static constexpr int kMinStepsBetweenTrials = 4;
   // The other size must be this much faster (a fraction of the chosen size's step time) to be
   // chosen: equal speeds keep the choice.
   static constexpr double kMargin = 0.03;
   // After a trial, the chosen size runs `patience` times the time the trial lost before the next
-  // one (so trials cost at most about 1 / patience of the run). Each trial that confirms the
-  // choice doubles the patience, up to the largest for that choice; a change of choice resets it.
+  // one (so trials cost at most about 1 / patience of the run). The loss counted is at least
+  // kMargin of the trial, and at most that of a size 5 times slower, so that one trial disturbed
+  // by something else does not stop the trials for long. Each trial that confirms the choice
+  // doubles the patience, up to the largest for that choice; a change of choice resets it.
   static constexpr double kPatience = 50;
   static constexpr double kLargestPatienceAllCores = 800;  // a slow step calls a trial at once
   static constexpr double kLargestPatienceOneThread = 100;
-  // On all cores, a step this many times slower than the recent ones calls a trial at once (a
-  // neighbour that starts on the cores slows the team down several times).
+  // On all cores, kSlowSteps steps in a row each this many times slower than the recent ones
+  // call a trial at once (a neighbour that starts on the cores slows the team down several
+  // times; one slow step is more often a time slice lost once).
   static constexpr double kSlowStep = 1.5;
+  static constexpr int kSlowSteps = 2;
 
   // `cores`: the largest team (parallel::available_cores()); 1 disables the choice.
   explicit TeamChooser(int cores);
@@ -45,11 +51,13 @@ class TeamChooser {
   int cores_;
   int chosen_ = 1;             // the size of the steps between trials (1 until measured)
   bool warm_ = false;          // the first step (allocations, analyses) is not compared
+  bool team_started_ = false;  // nor the first on all cores (OpenMP starts its threads)
   double chosen_mean_ = 0;     // moving average of the chosen size's step times (0: none yet)
   long chosen_steps_ = 0;      // steps of the chosen size since the last trial
   double chosen_seconds_ = 0;  // their time
   double wait_seconds_ = 0;    // the chosen size's time before the next trial
   double patience_ = kPatience;
+  int slow_steps_ = 0;  // slow steps in a row on all cores
   bool in_trial_ = false;
   int trial_steps_ = 0;
   double trial_seconds_ = 0;

@@ -54,8 +54,9 @@ TEST(TeamChooser, BusyNeighbourRunsOnOneThread) {
 TEST(TeamChooser, EqualSpeedsKeepTheChoice) {
   parallel::TeamChooser chooser(2);
   run(chooser, 0, 500, machine(1.0e-3, 1.0e-3));
-  EXPECT_EQ(chooser.steps_on_all_cores() > 0, true);  // tried
-  EXPECT_EQ(chooser.threads(), 1);                    // but not chosen: not faster by the margin
+  // Tried, but not chosen: not faster by the margin.
+  EXPECT_GT(chooser.steps_on_all_cores(), 0);
+  EXPECT_LT(chooser.steps_on_all_cores(), 0.5 * 500);
 }
 
 TEST(TeamChooser, FollowsTheLoad) {
