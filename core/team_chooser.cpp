@@ -2,10 +2,29 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 namespace jelly::parallel {
 
-TeamChooser::TeamChooser(int cores) : cores_(std::max(1, cores)) {}
+TeamChooser::TeamChooser(int cores, OthersRunning others)
+    : cores_(std::max(1, cores)), others_(others) {}
+
+int TeamChooser::others_running() {
+  std::FILE* stat = std::fopen("/proc/stat", "r");
+  if (stat == nullptr) return -1;
+  int running = -1;
+  char line[256];
+  while (std::fgets(line, sizeof line, stat) != nullptr) {
+    if (std::strncmp(line, "procs_running ", 14) == 0) {
+      running = std::atoi(line + 14);
+      break;
+    }
+  }
+  std::fclose(stat);
+  return running > 0 ? running - 1 : -1;
+}
 
 void TeamChooser::start_trial() {
   in_trial_ = true;
@@ -21,13 +40,11 @@ void TeamChooser::record(double seconds) {
     warm_ = true;
     return;
   }
-  if (threads() > 1 && !team_started_) {
-    team_started_ = true;
-    return;
-  }
   if (in_trial_) {
     trial_seconds_ += seconds;
-    if (++trial_steps_ < kTrialSteps || trial_seconds_ < kTrialSeconds) return;
+    ++trial_steps_;
+    const bool lost = trial_seconds_ >= kLostTrial * kTrialSteps * chosen_mean_;
+    if (!lost && (trial_steps_ < kTrialSteps || trial_seconds_ < kTrialSeconds)) return;
     in_trial_ = false;
     const double trial_mean = trial_seconds_ / trial_steps_;
     if (trial_mean < (1 - kMargin) * chosen_mean_) {
@@ -36,10 +53,9 @@ void TeamChooser::record(double seconds) {
       patience_ = kPatience;
       wait_seconds_ = 0;
     } else {
-      // The trial's loss against the chosen size, times the patience.
-      const double loss = std::min(
-          4 * trial_steps_ * chosen_mean_,
-          std::max(kMargin * trial_seconds_, trial_seconds_ - trial_steps_ * chosen_mean_));
+      // The trial's loss against the chosen size (at least kMargin of it), times the patience.
+      const double loss =
+          std::max(kMargin * trial_seconds_, trial_seconds_ - trial_steps_ * chosen_mean_);
       wait_seconds_ = patience_ * loss;
       const double largest = chosen_ == 1 ? kLargestPatienceOneThread : kLargestPatienceAllCores;
       patience_ = std::min(largest, 2 * patience_);
@@ -54,8 +70,14 @@ void TeamChooser::record(double seconds) {
   ++chosen_steps_;
   chosen_seconds_ += seconds;
   if (chosen_steps_ >= kMinStepsBetweenTrials &&
-      (slow_steps_ >= kSlowSteps || chosen_seconds_ >= wait_seconds_))
+      (slow_steps_ >= kSlowSteps || chosen_seconds_ >= wait_seconds_)) {
+    // A team on all cores would share them with the threads already runnable.
+    if (chosen_ == 1 && others_ != nullptr && others_() > 0) {
+      chosen_steps_ = 0;  // asks again after kMinStepsBetweenTrials steps
+      return;
+    }
     start_trial();
+  }
 }
 
 }  // namespace jelly::parallel

@@ -20,8 +20,7 @@ class TeamChooser {
   static constexpr double kMargin = 0.03;
   // After a trial, the chosen size runs `patience` times the time the trial lost before the next
   // one (so trials cost at most about 1 / patience of the run). The loss counted is at least
-  // kMargin of the trial, and at most that of a size 5 times slower, so that one trial disturbed
-  // by something else does not stop the trials for long. Each trial that confirms the choice
+  // kMargin of the trial. Each trial that confirms the choice
   // doubles the patience, up to the largest for that choice; a change of choice resets it.
   static constexpr double kPatience = 50;
   static constexpr double kLargestPatienceAllCores = 800;  // a slow step calls a trial at once
@@ -32,8 +31,21 @@ class TeamChooser {
   static constexpr double kSlowStep = 1.5;
   static constexpr int kSlowSteps = 2;
 
-  // `cores`: the largest team (parallel::available_cores()); 1 disables the choice.
-  explicit TeamChooser(int cores);
+  // A trial that has taken this many times the chosen size's time for kTrialSteps steps has
+  // lost and ends at once (a team on contended cores can be tens of times slower).
+  static constexpr double kLostTrial = 2;
+
+  // The number of threads of other processes (or of this one) that were runnable besides the
+  // caller when asked, or -1 when not known.
+  using OthersRunning = int (*)();
+  // The machine's count (/proc/stat's procs_running, less the caller): one file read per trial
+  // considered, never per step or region.
+  static int others_running();
+
+  // `cores`: the largest team (parallel::available_cores()); 1 disables the choice. No trial on
+  // all cores starts while `others` says another thread is runnable (it would run on the core
+  // the team needs); trials cost time, the check does not.
+  explicit TeamChooser(int cores, OthersRunning others = &TeamChooser::others_running);
 
   // The team size for the next step: 1 or `cores`.
   int threads() const { return in_trial_ ? other() : chosen_; }
@@ -49,9 +61,9 @@ class TeamChooser {
   void start_trial();
 
   int cores_;
+  OthersRunning others_;
   int chosen_ = 1;             // the size of the steps between trials (1 until measured)
   bool warm_ = false;          // the first step (allocations, analyses) is not compared
-  bool team_started_ = false;  // nor the first on all cores (OpenMP starts its threads)
   double chosen_mean_ = 0;     // moving average of the chosen size's step times (0: none yet)
   long chosen_steps_ = 0;      // steps of the chosen size since the last trial
   double chosen_seconds_ = 0;  // their time

@@ -9,6 +9,9 @@
 namespace jelly {
 namespace {
 
+// No other runnable thread on the machine.
+int no_others() { return 0; }
+
 using StepTime = std::function<double(long step, int threads)>;
 
 // Runs `steps` steps whose times step_time gives; returns their total time.
@@ -28,14 +31,14 @@ StepTime machine(double one, double two) {
 }
 
 TEST(TeamChooser, OneCoreIsOneThread) {
-  parallel::TeamChooser chooser(1);
+  parallel::TeamChooser chooser(1, no_others);
   run(chooser, 0, 100, machine(1.0, 0.5));
   EXPECT_EQ(chooser.threads(), 1);
   EXPECT_EQ(chooser.steps_on_all_cores(), 0);
 }
 
 TEST(TeamChooser, QuietMachineRunsOnAllCores) {
-  parallel::TeamChooser chooser(2);
+  parallel::TeamChooser chooser(2, no_others);
   const double total = run(chooser, 0, 2000, machine(1.8e-3, 1.0e-3));
   EXPECT_EQ(chooser.threads(), 2);
   // The trials of one thread cost a few percent at most.
@@ -44,7 +47,7 @@ TEST(TeamChooser, QuietMachineRunsOnAllCores) {
 }
 
 TEST(TeamChooser, BusyNeighbourRunsOnOneThread) {
-  parallel::TeamChooser chooser(2);
+  parallel::TeamChooser chooser(2, no_others);
   // Two threads five times slower than one.
   const double total = run(chooser, 0, 2000, machine(1.0e-3, 5.0e-3));
   EXPECT_EQ(chooser.threads(), 1);
@@ -52,7 +55,7 @@ TEST(TeamChooser, BusyNeighbourRunsOnOneThread) {
 }
 
 TEST(TeamChooser, EqualSpeedsKeepTheChoice) {
-  parallel::TeamChooser chooser(2);
+  parallel::TeamChooser chooser(2, no_others);
   run(chooser, 0, 500, machine(1.0e-3, 1.0e-3));
   // Tried, but not chosen: not faster by the margin.
   EXPECT_GT(chooser.steps_on_all_cores(), 0);
@@ -60,7 +63,7 @@ TEST(TeamChooser, EqualSpeedsKeepTheChoice) {
 }
 
 TEST(TeamChooser, FollowsTheLoad) {
-  parallel::TeamChooser chooser(2);
+  parallel::TeamChooser chooser(2, no_others);
   const StepTime quiet = machine(1.8e-3, 1.0e-3), busy = machine(1.0e-3, 5.0e-3);
   run(chooser, 0, 1000, quiet);
   ASSERT_EQ(chooser.threads(), 2);
@@ -77,12 +80,34 @@ TEST(TeamChooser, FollowsTheLoad) {
   EXPECT_LT(chooser.steps() - before, 1000);
 }
 
+int others_now = 0;
+int others() { return others_now; }
+
+TEST(TeamChooser, NoTrialWhileOthersRun) {
+  parallel::TeamChooser chooser(2, others);
+  others_now = 1;
+  run(chooser, 0, 1000, machine(1.8e-3, 1.0e-3));
+  EXPECT_EQ(chooser.steps_on_all_cores(), 0);
+  // They stop: the next check starts a trial, and all cores win.
+  others_now = 0;
+  run(chooser, 1000, 100, machine(1.8e-3, 1.0e-3));
+  EXPECT_EQ(chooser.threads(), 2);
+}
+
+TEST(TeamChooser, LostTrialEndsAtOnce) {
+  parallel::TeamChooser chooser(2, no_others);
+  // Two threads thirty times slower: a trial is one step.
+  run(chooser, 0, 2000, machine(1.0e-3, 30.0e-3));
+  EXPECT_EQ(chooser.threads(), 1);
+  EXPECT_LT(chooser.steps_on_all_cores(), 10);
+}
+
 TEST(TeamChooser, SameInputsSameChoices) {
   // Step times that vary (a slow step now and then): two choosers choose alike.
   const StepTime varying = [](long k, int threads) {
     return (threads > 1 ? 1.0e-3 : 1.7e-3) * (k % 37 == 0 ? 3.0 : 1.0);
   };
-  parallel::TeamChooser a(2), b(2);
+  parallel::TeamChooser a(2, no_others), b(2, no_others);
   for (long k = 0; k < 3000; ++k) {
     ASSERT_EQ(a.threads(), b.threads()) << k;
     const double seconds = varying(k, a.threads());
