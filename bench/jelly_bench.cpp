@@ -119,7 +119,10 @@ int main(int argc, char** argv) {
   speed_cmd->add_option("--dt", speed.dt, "time step (s)")->capture_default_str();
   speed_cmd->add_option("--steps", speed.steps, "timed steps per configuration")
       ->capture_default_str();
-  speed_cmd->add_option("--threads", speed.threads, "thread counts, one row each (0 = all cores)")
+  speed_cmd
+      ->add_option("--threads", speed.threads,
+                   "thread counts, one row each (0 = the default: all cores or one thread, chosen "
+                   "step by step)")
       ->delimiter(',')
       ->capture_default_str();
   speed_cmd->add_flag("--interleave", speed.interleave,

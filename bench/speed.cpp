@@ -9,6 +9,7 @@
 #include <jelly/bench/stability_region.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
+#include <jelly/core/detail/team_chooser.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
@@ -37,6 +38,8 @@ double seconds_since(Clock::time_point start) {
 struct SpeedRun {
   std::vector<Cell> head;
   int threads = 1;
+  // For --threads 0: the team size of each step, chosen as the Simulator chooses it.
+  std::unique_ptr<parallel::TeamChooser> chooser;
   bool memory_reset = false;
   SceneParts parts;
   std::unique_ptr<Integrator> method;
@@ -54,6 +57,8 @@ struct SpeedRun {
 
   SpeedRun(std::vector<Cell> row_head, const std::string& integrator, int n, int thread_count)
       : head(std::move(row_head)), threads(thread_count) {
+    if (threads == 0)
+      chooser = std::make_unique<parallel::TeamChooser>(parallel::available_cores());
     SceneSpec spec;
     spec.name = "slope";
     spec.n = n;
@@ -82,17 +87,19 @@ struct SpeedRun {
     for (int k = 0; k < count && !finished(o); ++k, ++taken) {
       const bool timing = taken >= o.warmup_steps;
       if (taken == o.warmup_steps) before_timing = method->statistics();
-      parallel::copy(threads, state.x, before.x);
-      parallel::copy(threads, state.v, before.v);
-      const Dynamics dynamics(model, contacts, &parts.terrains, bands.get(), nullptr, threads);
+      const int team = chooser ? chooser->threads() : threads;
+      parallel::copy(team, state.x, before.x);
+      parallel::copy(team, state.v, before.v);
+      const Dynamics dynamics(model, contacts, &parts.terrains, bands.get(), nullptr, team);
       auto start = Clock::now();
       const StepResult result = method->step(dynamics, state, o.dt);
       const double step_time = seconds_since(start);
       start = Clock::now();
       if (result.ok)
         resolve_contact_after_step(*method, contacts, model, parts.terrains, before, state, o.dt,
-                                   threads);
+                                   team);
       const double contact_time = seconds_since(start);
+      if (chooser) chooser->record(step_time + contact_time);
       if (timing) {
         integrator_seconds += step_time;
         contact_seconds += contact_time;
@@ -101,13 +108,13 @@ struct SpeedRun {
         // One force evaluation (model forces and the seed contact terms), timed between the
         // steps so that it sees the same load and caches as the steps around it.
         start = Clock::now();
-        bands->compute_forces(model, state.x, state.v, f, threads);
+        bands->compute_forces(model, state.x, state.v, f, team);
         contacts.add_forces(state.v, f);
         force_probe_seconds += seconds_since(start);
       }
       if (!result.ok) {
         status = "solver_failed";
-      } else if (guard.check(model, state, threads)) {
+      } else if (guard.check(model, state, team)) {
         status = "diverged";
       }
     }
@@ -133,6 +140,12 @@ struct SpeedRun {
       const auto it = before_timing.find(key);
       const double timed_value = value - (it == before_timing.end() ? 0.0 : it->second);
       stats.add_row({head[0], head[1], head[2], head[3], key, timed_value, timed_value * per_step});
+    }
+    if (chooser) {
+      // Over the whole run, the warm-up included.
+      const double all_cores = static_cast<double>(chooser->steps_on_all_cores());
+      stats.add_row({head[0], head[1], head[2], head[3], std::string("steps_on_all_cores"),
+                     all_cores, all_cores / std::max(1L, chooser->steps())});
     }
   }
 };
@@ -163,7 +176,8 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
       for (int requested_threads : o.threads) {
         const long this_item = item++;
         if (!o.shard.owns(this_item)) continue;
-        const int threads = parallel::resolve_threads(requested_threads);
+        // 0: the default, each step's team size chosen as the Simulator chooses it.
+        const int threads = requested_threads;
         std::vector<Cell> head{static_cast<double>(this_item), integrator, static_cast<double>(n),
                                static_cast<double>(threads)};
         if (is_adaptive_integrator(integrator)) {

@@ -6,6 +6,7 @@
 
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
+#include <jelly/core/detail/team_chooser.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly {
@@ -178,6 +179,7 @@ void Simulator::check_no_overlap() { body_contact_.check_no_overlap(model_, stat
 void Simulator::set_threads(int threads) {
   require(threads >= 0, "threads", threads, "an integer >= 0 (0 = all cores)");
   options_.threads = threads;
+  team_.reset();
 }
 
 Observer::~Observer() {
@@ -383,8 +385,15 @@ void warn_of_tolerance_misses(const std::vector<ToleranceMiss>& before,
 }
 }  // namespace
 
+int Simulator::step_threads() {
+  if (options_.threads > 0) return options_.threads;
+  if (!team_) team_ = std::make_unique<parallel::TeamChooser>(parallel::available_cores());
+  return team_->threads();
+}
+
 StepResult Simulator::step() {
-  const int threads = parallel::resolve_threads(options_.threads);
+  const auto start = std::chrono::steady_clock::now();
+  const int threads = step_threads();
   const bool bodies = body_contact_.active(model_);
   const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_, threads,
                           bodies ? &body_contact_ : nullptr, &forces_);
@@ -411,6 +420,8 @@ StepResult Simulator::step() {
                              options_.dt, threads);
   if (!model_.pins.empty()) model_.pins.apply(state_.t, state_.x, state_.v);
   ++total_steps_;
+  if (team_ && options_.threads == 0)
+    team_->record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return result;
 }
 
@@ -466,8 +477,7 @@ RunReport Simulator::run_until(Real t_end) {
       break;
     }
     ++report.steps;
-    if (auto why = options_.divergence.check(model_, state_,
-                                             parallel::resolve_threads(options_.threads))) {
+    if (auto why = options_.divergence.check(model_, state_, step_threads())) {
       report.status = RunStatus::kDiverged;
       report.reason = *why;
       break;

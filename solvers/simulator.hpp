@@ -22,6 +22,9 @@ namespace jelly {
 
 class Simulator;
 class SpringBands;
+namespace parallel {
+class TeamChooser;
+}
 class ObserverList;
 
 // Called with the simulator at the first output time and then every output interval.
@@ -104,7 +107,9 @@ struct SimulatorOptions {
   Real output_interval = 0;  // s between observer frames; 0 = every step
   DivergenceGuard divergence;
   // Threads for the force loop, the integrators' solves and the contact after a step; 0 = all
-  // cores this process may run on. Results are the same bit for bit for any value.
+  // cores this process may run on or one thread, chosen step by step from which ran faster (a
+  // busy neighbour can make a team slower than one thread; docs/threads.md). Results are the
+  // same bit for bit for any value.
   int threads = 0;
   void validate() const;
 };
@@ -255,11 +260,15 @@ class Simulator {
   // The notes of this run (forces an implicit integrator takes explicitly), once per force and
   // integrator.
   void note_forces(RunReport& report);
+  // The team size of the next step: options_.threads, or team_'s choice for 0.
+  int step_threads();
 
   Model model_;
   std::unique_ptr<const SpringBands> bands_;  // the vectorised force loop over model_'s springs
   State state_;
   std::unique_ptr<Integrator> integrator_;
+  // The team size of each step when options_.threads is 0 (created at the first such step).
+  std::unique_ptr<parallel::TeamChooser> team_;
   SimulatorOptions options_;
   Terrains terrains_;
   ContactSolver contacts_;
