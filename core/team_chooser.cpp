@@ -73,7 +73,9 @@ void TeamChooser::record(double seconds) {
       (slow_steps_ >= kSlowSteps || chosen_seconds_ >= wait_seconds_)) {
     // A team on all cores would share them with the threads already runnable.
     if (chosen_ == 1 && others_ != nullptr && others_() > 0) {
-      chosen_steps_ = 0;  // asks again after kMinStepsBetweenTrials steps
+      // Asks again after kMinStepsBetweenTrials steps and kTrialSeconds.
+      chosen_steps_ = 0;
+      wait_seconds_ = chosen_seconds_ + kTrialSeconds;
       return;
     }
     start_trial();

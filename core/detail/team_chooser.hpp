@@ -20,10 +20,10 @@ class TeamChooser {
   static constexpr double kMargin = 0.03;
   // After a trial, the chosen size runs `patience` times the time the trial lost before the next
   // one (so trials cost at most about 1 / patience of the run). The loss counted is at least
-  // kMargin of the trial. Each trial that confirms the choice
-  // doubles the patience, up to the largest for that choice; a change of choice resets it.
+  // kMargin of the trial. Each trial that confirms the choice doubles the patience, up to the
+  // largest for that choice; a change of choice resets it.
   static constexpr double kPatience = 50;
-  static constexpr double kLargestPatienceAllCores = 800;  // a slow step calls a trial at once
+  static constexpr double kLargestPatienceAllCores = 800;  // slow steps call a trial at once
   static constexpr double kLargestPatienceOneThread = 100;
   // On all cores, kSlowSteps steps in a row each this many times slower than the recent ones
   // call a trial at once (a neighbour that starts on the cores slows the team down several
@@ -38,13 +38,13 @@ class TeamChooser {
   // The number of threads of other processes (or of this one) that were runnable besides the
   // caller when asked, or -1 when not known.
   using OthersRunning = int (*)();
-  // The machine's count (/proc/stat's procs_running, less the caller): one file read per trial
-  // considered, never per step or region.
+  // The machine's count (/proc/stat's procs_running, less the caller): read when a trial on all
+  // cores is due (at most every kMinStepsBetweenTrials steps and kTrialSeconds), never per region.
   static int others_running();
 
   // `cores`: the largest team (parallel::available_cores()); 1 disables the choice. No trial on
   // all cores starts while `others` says another thread is runnable (it would run on the core
-  // the team needs); trials cost time, the check does not.
+  // the team needs); a trial costs steps, the check one file read.
   explicit TeamChooser(int cores, OthersRunning others = &TeamChooser::others_running);
 
   // The team size for the next step: 1 or `cores`.
