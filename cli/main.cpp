@@ -88,9 +88,11 @@ int main(int argc, char** argv) {
   run->add_flag("--strict", run_args.strict,
                 "Exit 3 when steps missed the solver's own tolerance (status "
                 "completed_with_warnings; without --strict a warning and exit 0)");
-  run->add_option("--threads", run_args.threads,
-                  "Threads for the force loop, the solves and contact (default: the scene's "
-                  "`threads`, 0 = all cores; the results are the same for any number)")
+  run->add_option(
+         "--threads", run_args.threads,
+         "Threads for the force loop, the solves and contact (default: the scene's "
+         "`threads`; 0 = all cores or one thread, chosen step by step from which runs faster; "
+         "the results are the same for any number)")
       ->type_name("N")
       ->check(kThreadCount);
 

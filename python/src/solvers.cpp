@@ -365,8 +365,9 @@ void bind_solvers(py::module_& m) {
                      "Seconds between observer frames; 0 = every step.")
       .def_readwrite("divergence", &SimulatorOptions::divergence, "The DivergenceGuard.")
       .def_readwrite("threads", &SimulatorOptions::threads,
-                     "Threads for the force loop, the solves and the contact; 0 = all cores "
-                     "(the same results bit for bit for any count).")
+                     "Threads for the force loop, the solves and the contact; 0 = all cores or "
+                     "one thread, chosen step by step from which runs faster (the same "
+                     "results bit for bit for any count).")
       .def("validate", &SimulatorOptions::validate,
            "Raises InputError naming the first invalid option.");
 

@@ -111,7 +111,7 @@ TEST(AddedForces, CancellingGravityKeepsAFreeCubesCentreStillUnderEveryKindOfMet
 // Wind drag (a scene force) on a free cube under implicit_euler's matrix-free CG: the centre
 // follows backward Euler's own recursion for dv/dt = c (w - v) / m. The momentum correction of
 // an iterative solve (which assumes 1^T A = 1^T M) must not act when the drag adds to A's
-// diagonal: it did, and the centre drifted 0.5 % too far.
+// diagonal: it did, and the centre drifted too far.
 TEST(AddedForces, WindUnderMatrixFreeImplicitEulerFollowsBackwardEuler) {
   Simulator sim = deformed_cube(8, implicit(ImplicitLinearSolver::kAuto), 0.01);
   Model model = sim.model();
