@@ -143,12 +143,14 @@ TEST(MeshIo, FaceIndicesOutsideTheVerticesAreRefusedNotFollowed) {
   }
   EXPECT_THAT(error("past.ply", tetrahedron_ply("3 1 2 9")), HasSubstr("out of range"));
   EXPECT_THAT(error("past.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 9\n"), HasSubstr(field));
-  // A vertex count far beyond the file's content (assimp allocated room for all of them before reading one).
+  // A vertex count far beyond the file's content (assimp allocated room for all of them before
+  // reading one).
   EXPECT_THAT(error("count.ply", tetrahedron_ply("3 1 2 3", "2000000000")),
               HasSubstr("counts fit in it (its header says element vertex 2000000000"));
   EXPECT_THAT(error("negative.ply", tetrahedron_ply("3 1 2 3", "-4")),
               HasSubstr("element vertex -4"));
-  // A face's list length far beyond the file (assimp allocated room for it before reading it), ASCII and binary.
+  // A face's list length far beyond the file (assimp allocated room for it before reading it),
+  // ASCII and binary.
   const std::string header =
       "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
       "property list uint int vertex_indices\nend_header\n";
