@@ -291,6 +291,13 @@ class MshParser {
     w_.expect("$EndEntities");
   }
 
+  // A MSH 4 section's blocks must hold as many items as its header says.
+  void require_block_total(const char* what, long long total, long long read) {
+    if (read == total) return;
+    w_.fail(std::string("as many ") + what + " in the blocks as the section's header says (" +
+            std::to_string(total) + "; the blocks have " + std::to_string(read) + ")");
+  }
+
   void add_node(NodeTag tag) {
     Vec3 p;
     for (int k = 0; k < 3; ++k) p[k] = w_.real("a coordinate");
@@ -322,10 +329,7 @@ class MshParser {
         }
         read += n;
       }
-      if (read != total) {
-        w_.fail("as many nodes in the blocks as the section's header says (" +
-                std::to_string(total) + "; the blocks have " + std::to_string(read) + ")");
-      }
+      require_block_total("nodes", total, read);
       w_.set_binary(false);
     }
     w_.expect("$EndNodes");
@@ -392,10 +396,7 @@ class MshParser {
         }
         read += n;
       }
-      if (read != total) {
-        w_.fail("as many elements in the blocks as the section's header says (" +
-                std::to_string(total) + "; the blocks have " + std::to_string(read) + ")");
-      }
+      require_block_total("elements", total, read);
       w_.set_binary(false);
     }
     w_.expect("$EndElements");
