@@ -36,7 +36,7 @@ class CMakeExtension(Extension):
 
 class CMakeBuild(build_ext):
     """Configures, builds and installs (into a staging prefix) the target jelly_python, then
-    copies the extension and libjelly into the package."""
+    copies the extension, libjelly and its Gmsh plugin into the package."""
 
     def build_extension(self, ext: Extension) -> None:
         build_dir = pathlib.Path(self.build_temp).resolve() / "cmake"
@@ -69,13 +69,16 @@ class CMakeBuild(build_ext):
             # The file the extension asks for (its SONAME, libjelly.so.<major>), as a file.
             if re.fullmatch(r"libjelly\.so\.\d+", library.name):
                 shutil.copy2(library.resolve(), target / library.name)
+        # The Gmsh plugin, which libjelly loads from its own folder on first use.
+        for plugin in (stage / "lib").glob("libjelly_gmsh.so"):
+            shutil.copy2(plugin, target / plugin.name)
 
 
 setup(
     version=version(),
     packages=["jelly"],
     package_dir={"jelly": "python/jelly"},
-    package_data={"jelly": ["__init__.pyi", "py.typed", "libjelly.so.*"]},
+    package_data={"jelly": ["__init__.pyi", "py.typed", "libjelly.so.*", "libjelly_gmsh.so"]},
     ext_modules=[CMakeExtension("jelly._jelly")],
     cmdclass={"build_ext": CMakeBuild},
     options={"build": {"build_base": "build-pip"}},  # not CMake's build/

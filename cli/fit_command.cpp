@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/fit/recording_trajectory.hpp>
 #include <jelly/fit/spring_fit.hpp>
 #include <jelly/io/recording.hpp>

@@ -2,6 +2,7 @@
 #include <string>
 
 #include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/tetrahedralize.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/contact_params.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
@@ -31,6 +32,10 @@ int list_command() {
   for (const EnumName<ExternalForceKind>& k : external_force_kinds()) {
     line("force", k.name, k.description);
   }
+  const std::string no_gmsh = tetrahedralize_unavailable_reason();
+  line("mesher", "gmsh",
+       no_gmsh.empty() ? "fills closed surfaces with tetrahedra (jelly mesh); loaded on first use"
+                       : "not available: " + no_gmsh);
   return kExitOk;
 }
 

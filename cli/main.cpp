@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
                 "the time on a large body");
 
   CLI::App* list = app.add_subcommand(
-      "list", "List the integrators, terrain kinds and contact models, one per line");
+      "list", "List the integrators, body and terrain kinds, contact models, forces and optional parts, one per line");
 
   ViewArgs view_args;
   CLI::App* view = app.add_subcommand(

@@ -5,7 +5,7 @@
 #include <string_view>
 #include <vector>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {

@@ -9,12 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {
-
-// Ordered, so that written scenes keep the order of the format (cube, springs, ...).
-using Json = nlohmann::ordered_json;
 
 // "a.b" + "c" -> "a.b.c"; "" + "c" -> "c".
 std::string json_child(const std::string& path, std::string_view key);

@@ -1,4 +1,5 @@
 #include <jelly/core/path.hpp>
+#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <cmath>

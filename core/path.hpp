@@ -7,7 +7,7 @@
 #include <vector>
 
 #include <jelly/core/elevator_motion.hpp>
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {

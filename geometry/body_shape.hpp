@@ -8,7 +8,7 @@
 #include <string_view>
 
 #include <jelly/core/body.hpp>
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/geometry/lattice.hpp>
 
 namespace jelly {

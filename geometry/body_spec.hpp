@@ -6,7 +6,7 @@
 #include <vector>
 
 #include <jelly/core/external_force.hpp>
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/path.hpp>
 #include <jelly/core/polymorphic_value.hpp>

@@ -1,4 +1,5 @@
 #include <jelly/geometry/cloth.hpp>
+#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <cmath>

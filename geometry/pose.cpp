@@ -1,4 +1,5 @@
 #include <jelly/geometry/pose.hpp>
+#include <jelly/core/json.hpp>
 
 #include <cmath>
 #include <string>

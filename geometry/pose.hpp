@@ -3,7 +3,7 @@
 // moved by `position`.
 #include <string>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {

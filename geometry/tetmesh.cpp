@@ -1,4 +1,5 @@
 #include <jelly/geometry/tetmesh.hpp>
+#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <atomic>

@@ -18,4 +18,8 @@ TetMesh tetrahedralize(const TriangleMesh& surface, Real size, const std::string
                        const std::string& name = "the surface",
                        const std::string& size_field = "size");
 
+// "" when this build can tetrahedralize, otherwise why not (built without Gmsh, or its plugin
+// libjelly_gmsh missing). Loads Gmsh to find out, which takes a moment.
+std::string tetrahedralize_unavailable_reason();
+
 }  // namespace jelly

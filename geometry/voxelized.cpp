@@ -1,4 +1,5 @@
 #include <jelly/geometry/voxelized.hpp>
+#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <atomic>

@@ -1,4 +1,5 @@
 #include <jelly/io/detail/scene_override.hpp>
+#include <jelly/core/json.hpp>
 
 #include <cctype>
 #include <vector>

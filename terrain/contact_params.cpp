@@ -1,4 +1,5 @@
 #include <jelly/terrain/contact_params.hpp>
+#include <jelly/core/json.hpp>
 
 #include <cmath>
 

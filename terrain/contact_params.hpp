@@ -5,7 +5,7 @@
 #include <vector>
 
 #include <jelly/core/enum_names.hpp>
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {

@@ -1,4 +1,5 @@
 #include <jelly/terrain/elevator.hpp>
+#include <jelly/core/json.hpp>
 
 #include <cmath>
 #include <limits>

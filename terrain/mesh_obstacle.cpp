@@ -1,4 +1,5 @@
 #include <jelly/terrain/mesh_obstacle.hpp>
+#include <jelly/core/json.hpp>
 
 #include <atomic>
 #include <cmath>

@@ -1,4 +1,5 @@
 #include <jelly/terrain/obstacle.hpp>
+#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,5 @@
 #include <jelly/terrain/plane.hpp>
+#include <jelly/core/json.hpp>
 
 #include <cmath>
 

@@ -1,4 +1,5 @@
 #include <jelly/terrain/terrain_kinds.hpp>
+#include <jelly/core/json.hpp>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/terrain/elevator.hpp>

@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/terrain/contact_params.hpp>
 #include <jelly/terrain/terrain.hpp>
 

@@ -1,4 +1,5 @@
 #include <jelly/io/detail/json_parse.hpp>
+#include <jelly/core/json.hpp>
 
 #include <sys/stat.h>
 

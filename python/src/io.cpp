@@ -1,5 +1,6 @@
 // io/: scenes (JSON in, JSON out, validated by the C++ parser), simulators made from scenes,
 // the HDF5 recorder, recordings read back as NumPy arrays, checkpoints and restarts.
+#include <jelly/core/json.hpp>
 #include <jelly/io/checkpoint.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>

@@ -1,4 +1,5 @@
 #include <jelly/solvers/arkode/arkode_options.hpp>
+#include <jelly/core/json.hpp>
 
 #include <cmath>
 

@@ -1,4 +1,5 @@
 #include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/broad_phase.hpp>

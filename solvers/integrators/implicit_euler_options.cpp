@@ -1,4 +1,5 @@
 #include <jelly/solvers/integrators/implicit_euler_options.hpp>
+#include <jelly/core/json.hpp>
 
 #include <cmath>
 

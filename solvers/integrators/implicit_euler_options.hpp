@@ -7,7 +7,7 @@
 
 #include <jelly/core/definiteness.hpp>
 #include <jelly/core/enum_names.hpp>
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>
 

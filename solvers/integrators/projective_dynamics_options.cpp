@@ -1,4 +1,5 @@
 #include <jelly/solvers/integrators/projective_dynamics_options.hpp>
+#include <jelly/core/json.hpp>
 
 #include <cmath>
 

@@ -1,4 +1,5 @@
 #include <jelly/solvers/integrators/registry.hpp>
+#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <functional>

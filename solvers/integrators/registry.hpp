@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 

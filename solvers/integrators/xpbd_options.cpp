@@ -1,4 +1,5 @@
 #include <jelly/solvers/integrators/xpbd_options.hpp>
+#include <jelly/core/json.hpp>
 
 #include <jelly/core/errors.hpp>
 

@@ -2,7 +2,7 @@
 // Options of the XPBD integrator (docs/realtime.md).
 #include <string>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 #include <jelly/solvers/integrators/projective_dynamics_options.hpp>  // PositionContactMode
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/h5_recorder.hpp>
 
 namespace jelly::fuzz {

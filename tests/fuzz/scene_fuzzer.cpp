@@ -8,6 +8,7 @@
 #include <string>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/run_limits.hpp>
 #include <jelly/io/scene.hpp>
 

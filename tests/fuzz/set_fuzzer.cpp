@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/scene.hpp>
 
 #include "fuzz/fuzz_target.hpp"

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/body_kinds.hpp>
 #include <jelly/geometry/body_spec.hpp>

@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <jelly/core/json.hpp>
 #include <jelly/geometry/tet_mesh_io.hpp>
 #include <jelly/geometry/tetmesh.hpp>
 #include <jelly/geometry/tetrahedralize.hpp>

@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <jelly/core/json.hpp>
 #include <jelly/geometry/box.hpp>
 #include <jelly/geometry/voxelized.hpp>
 #include <jelly/io/scene.hpp>

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/scene.hpp>
 
 namespace jelly {

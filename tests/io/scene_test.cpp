@@ -1,5 +1,6 @@
 // Scene files: the seed scenes load to the seed facts, scenes round-trip through JSON, and every
 // kind of bad scene or --set override is an InputError with a precise message.
+#include <jelly/core/json.hpp>
 #include <jelly/io/scene.hpp>
 
 #include <algorithm>

@@ -7,6 +7,7 @@
 #include <random>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/terrain/obstacle.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 

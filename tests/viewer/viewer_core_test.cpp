@@ -10,6 +10,7 @@
 #include <thread>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
 #include <jelly/io/export.hpp>

@@ -9,6 +9,7 @@
 
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/arkode/arkode_dirk.hpp>

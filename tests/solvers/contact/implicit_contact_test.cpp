@@ -8,6 +8,7 @@
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>

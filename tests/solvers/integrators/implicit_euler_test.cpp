@@ -6,6 +6,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>

@@ -1,7 +1,8 @@
 #pragma once
 // Gmsh's API is one global state: a session holds it, for one thread at a time, from
 // initialize to finalize, with Gmsh's own printing off. Used to mesh geometry given through the
-// API (tetrahedralize), never to open a user's file. Internal to geometry/.
+// API (tetrahedralize), never to open a user's file. Internal to the plugin
+// libjelly_gmsh (geometry/detail/gmsh/).
 #include <mutex>
 #include <string>
 

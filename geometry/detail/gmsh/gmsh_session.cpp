@@ -1,4 +1,4 @@
-#include <jelly/geometry/detail/gmsh_session.hpp>
+#include <jelly/geometry/detail/gmsh/gmsh_session.hpp>
 
 #include <algorithm>
 #include <unordered_map>
