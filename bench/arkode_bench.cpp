@@ -6,6 +6,8 @@
 #include <string>
 
 #include <jelly/jelly.hpp>
+#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/plane.hpp>
 
 int main(int argc, char** argv) {
   const char* const usage =

@@ -12,6 +12,8 @@
 #include <benchmark/benchmark.h>
 
 #include <jelly/jelly.hpp>
+#include <jelly/solvers/contact/broad_phase.hpp>
+#include <jelly/terrain/mesh_obstacle.hpp>
 
 namespace {
 

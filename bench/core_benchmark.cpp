@@ -8,8 +8,10 @@
 #include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
+#include <jelly/core/forces.hpp>
 #include <jelly/jelly.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/terrain/plane.hpp>
 
 namespace {
 

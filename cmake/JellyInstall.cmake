@@ -1,10 +1,11 @@
-# Installs the library, its headers under include/jelly/<module>/ (not the internal detail/
-# folders), the jelly program (cli/CMakeLists.txt), the scenes under share/jelly/scenes, and the
-# CMake package files.
+# Installs the library, its public headers (cmake/public_headers.txt) under include/jelly/,
+# the jelly program (cli/CMakeLists.txt), the scenes under share/jelly/scenes, and the CMake
+# package files.
 include(CMakePackageConfigHelpers)
-foreach(module IN LISTS JELLY_MODULES)
-  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${module}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly/${module}
-          FILES_MATCHING PATTERN "*.hpp" PATTERN "detail" EXCLUDE)
+foreach(header IN LISTS JELLY_PUBLIC_HEADERS)
+  get_filename_component(folder ${header} DIRECTORY)
+  install(FILES ${CMAKE_CURRENT_SOURCE_DIR}/${header}
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly/${folder})
 endforeach()
 install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/scenes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/jelly/scenes
         FILES_MATCHING PATTERN "*.json")

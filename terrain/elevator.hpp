@@ -29,7 +29,9 @@ struct ElevatorSpec final : TerrainSpecOf<ElevatorSpec> {
 
 class Elevator final : public Terrain {
  public:
-  explicit Elevator(ElevatorSpec spec = {}, ContactParams contact = {});
+  // Answers with the spec's own contact model (spec.contact).
+  explicit Elevator(ElevatorSpec spec = {}) : Elevator(spec, spec.contact) {}
+  Elevator(ElevatorSpec spec, ContactParams contact);
 
   std::string_view kind() const override { return "elevator"; }
   Real signed_distance(const Vec3& p, Real t) const override { return p.y() - height(t); }

@@ -62,7 +62,9 @@ struct MeshObstacleSpec final : TerrainSpecOf<MeshObstacleSpec> {
 class MeshObstacle final : public Terrain {
  public:
   // Throws InputError (fields named "obstacle.") for an invalid spec or mesh.
-  explicit MeshObstacle(MeshObstacleSpec spec, ContactParams contact = {});
+  // Answers with the spec's own contact model (spec.contact).
+  explicit MeshObstacle(MeshObstacleSpec spec) : MeshObstacle(spec, spec.contact) {}
+  MeshObstacle(MeshObstacleSpec spec, ContactParams contact);
 
   std::string_view kind() const override { return "mesh"; }
   Real signed_distance(const Vec3& p, Real t) const override;

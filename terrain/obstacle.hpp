@@ -57,7 +57,9 @@ struct ObstacleSpec final : TerrainSpecOf<ObstacleSpec> {
 class Obstacle final : public Terrain {
  public:
   // Throws InputError (fields named "obstacle.") for an invalid spec.
-  explicit Obstacle(ObstacleSpec spec, ContactParams contact = {});
+  // Answers with the spec's own contact model (spec.contact).
+  explicit Obstacle(ObstacleSpec spec) : Obstacle(spec, spec.contact) {}
+  Obstacle(ObstacleSpec spec, ContactParams contact);
 
   std::string_view kind() const override { return obstacle_shape_name(spec_.geometry.shape); }
   Real signed_distance(const Vec3& p, Real t) const override;

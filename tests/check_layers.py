@@ -8,8 +8,8 @@ layers to its left (a detail/ header counts as its module's):
 
     check_layers.py [--root DIR]             every #include of the layer folders under DIR
     check_layers.py [--root DIR] --umbrella  cmake/jelly.hpp.in includes every public header
-                                             of the library and nothing from detail/, and no
-                                             public header includes a detail/ one
+                                             (cmake/public_headers.txt) and no other, and a
+                                             public header includes only public ones
     check_layers.py --self-test              both checks catch violations in a temporary tree
 
 Exit status 0 when clean, 1 with one line per violation on stderr.
@@ -81,35 +81,48 @@ def check_layers(root):
     return violations
 
 
-def public_headers(root):
+def public_list(root):
+    """cmake/public_headers.txt: (header, in the umbrella) pairs, header as jelly/...."""
     out = []
-    for module in LIBRARY:
-        for path in sources(root, module):
-            relative = os.path.relpath(path, root)
-            if path.endswith(".hpp") and "detail" not in relative.split(os.sep):
-                out.append("jelly/" + relative.replace(os.sep, "/"))
+    with open(os.path.join(root, "cmake", "public_headers.txt"), encoding="utf-8") as f:
+        for line in f:
+            words = line.split("#")[0].split()
+            if words:
+                out.append(("jelly/" + words[0], words[1:] != ["extension"]))
     return out
 
 
 def check_umbrella(root):
+    """The umbrella includes exactly the public headers (less the extension ones); a public
+    header exists, is not from a detail/ folder and includes only public headers (an installed
+    header that includes another one would not compile in a consumer)."""
     path = os.path.join(root, "cmake", "jelly.hpp.in")
     with open(path, encoding="utf-8") as f:
         included = [m.group(2) for m in map(INCLUDE.match, f) if m]
+    listed = public_list(root)
+    public = {header for header, _ in listed} | {"jelly/" + g for g in GENERATED}
     violations = []
-    for header in public_headers(root):
-        if header not in included:
+    for header, umbrella in listed:
+        if umbrella and header not in included:
             violations.append(f"cmake/jelly.hpp.in: does not include <{header}>, a public header")
-    for header in included:
         if "detail" in header.split("/"):
-            violations.append(f"cmake/jelly.hpp.in: includes <{header}>, which is not installed")
-    # An installed header that includes a detail/ one would not compile in a consumer.
-    for header in public_headers(root):
-        with open(os.path.join(root, header[len("jelly/"):]), encoding="utf-8") as f:
+            violations.append(f"cmake/public_headers.txt: {header} is from a detail/ folder")
+    for header in included:
+        if header not in public or dict(listed).get(header) is False:
+            violations.append(f"cmake/jelly.hpp.in: includes <{header}>, which is not a public "
+                              f"header of the umbrella (cmake/public_headers.txt)")
+    for header, _ in listed:
+        file = os.path.join(root, header[len("jelly/"):])
+        if not os.path.exists(file):
+            violations.append(f"cmake/public_headers.txt: {header} does not exist")
+            continue
+        with open(file, encoding="utf-8") as f:
             for number, line in enumerate(f, 1):
                 m = INCLUDE.match(line)
-                if m and "detail" in m.group(2).split("/"):
+                if m and m.group(2).startswith("jelly/") and m.group(2) not in public:
                     violations.append(f"{header[len('jelly/'):]}:{number}: a public header "
-                                      f"includes <{m.group(2)}>, which is not installed")
+                                      f"includes <{m.group(2)}>, which is not public "
+                                      f"(cmake/public_headers.txt)")
     return violations
 
 
@@ -139,6 +152,9 @@ def self_test():
         "cli/output.hpp": "#include <jelly/io/scene.hpp>\n",
         "cmake/jelly.hpp.in": "#include <jelly/core/model.hpp>\n#include <jelly/terrain/plane.hpp>\n"
                               "#include <jelly/solvers/simulator.hpp>\n",
+        "cmake/public_headers.txt": "# comment\ncore/model.hpp\nterrain/plane.hpp\n"
+                                    "solvers/simulator.hpp\ncore/json.hpp extension\n",
+        "core/json.hpp": "#include <nlohmann/json.hpp>\n",
     }
     root = tree(clean)
     for name, found in (("layers", check_layers(root)), ("umbrella", check_umbrella(root))):
@@ -164,17 +180,27 @@ def self_test():
             failures.append(f"{name} ({text.strip()}) is not reported: {found}")
 
     files = dict(clean)
+    files["cmake/public_headers.txt"] += "terrain/elevator.hpp\n"
     files["terrain/elevator.hpp"] = "#include <jelly/core/model.hpp>\n"
     if not any("terrain/elevator.hpp" in v for v in check_umbrella(tree(files))):
         failures.append("a public header missing from the umbrella is not reported")
     files = dict(clean)
     files["cmake/jelly.hpp.in"] += "#include <jelly/core/detail/jacobian.hpp>\n"
-    if not any("not installed" in v for v in check_umbrella(tree(files))):
+    if not any("not a public header" in v for v in check_umbrella(tree(files))):
         failures.append("a detail/ header in the umbrella is not reported")
+    files = dict(clean)
+    files["cmake/jelly.hpp.in"] += "#include <jelly/core/json.hpp>\n"
+    if not any("core/json.hpp" in v for v in check_umbrella(tree(files))):
+        failures.append("an extension header in the umbrella is not reported")
     files = dict(clean)
     files["terrain/plane.hpp"] += "#include <jelly/core/detail/jacobian.hpp>\n"
     if not any("terrain/plane.hpp:2" in v for v in check_umbrella(tree(files))):
         failures.append("a public header including a detail/ one is not reported")
+    files = dict(clean)
+    files["solvers/simulator.hpp"] += "#include <jelly/solvers/dynamics.hpp>\n"
+    files["solvers/dynamics.hpp"] = ""
+    if not any("solvers/simulator.hpp:2" in v for v in check_umbrella(tree(files))):
+        failures.append("a public header including an internal one is not reported")
     for root in made:
         shutil.rmtree(root, ignore_errors=True)
     return failures

@@ -7,7 +7,7 @@
 #include <jelly/core/enum_names.hpp>
 #include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
-#include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/cholmod_options.hpp>
 
 namespace jelly {
 

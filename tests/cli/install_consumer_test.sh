@@ -17,9 +17,19 @@ done
 config=$(find "$prefix" -name jellyConfig.cmake)
 [ -n "$config" ] && [ -e "$(dirname "$config")/jellyConfigVersion.cmake" ] ||
   { echo "missing from the install: jellyConfig.cmake / jellyConfigVersion.cmake"; exit 1; }
-if [ -e "$prefix/include/jelly/io/detail" ]; then
-  echo "io/detail (internal, nlohmann-typed headers) must not be installed"; exit 1
+# The installed headers are the public ones (cmake/public_headers.txt) and no other.
+installed=$(cd "$prefix/include/jelly" && find . -type f | sed 's|^\./||' | sort)
+public=$( (sed -n 's/^\([a-z][^ ]*\).*/\1/p' "$source_dir/cmake/public_headers.txt"
+           echo jelly.hpp; echo version.hpp) | sort)
+if [ "$installed" != "$public" ]; then
+  echo "the installed headers differ from cmake/public_headers.txt (< installed, > listed):"
+  diff <(echo "$installed") <(echo "$public") || true
+  exit 1
 fi
+# The Gmsh plugin sits beside libjelly, where libjelly looks for it.
+[ -e "$(dirname "$(find "$prefix" -name 'libjelly.so' | head -1)")/libjelly_gmsh.so" ] ||
+  { echo "missing from the install: libjelly_gmsh.so beside libjelly.so"; exit 1; }
+"$prefix/bin/jelly" list | grep -q '^mesher *gmsh *fills'
 
 "$prefix/bin/jelly" list | grep -q '^integrator rk4 '
 

@@ -1,9 +1,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/obstacle.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly {
@@ -70,6 +72,34 @@ TEST(Plane, BadInput) {
   c.static_friction = 0.1;  // below kinetic friction 0.5
   EXPECT_THROW(Plane(Vec3::Zero(), Vec3::UnitY(), c), InputError);
   EXPECT_THROW(contact_model_from_name("bouncy", "terrains[0].contact"), InputError);
+}
+
+// A terrain built from its spec alone answers with the spec's contact model, as the same spec
+// made by its registry (spec.make()) does.
+TEST(TerrainSpecContact, ConstructorsTakeTheSpecsOwnContact) {
+  ContactParams contact;
+  contact.model = ContactModel::kSeed;
+  contact.restitution = 0.3;
+  contact.friction = 0.2;
+  ObstacleSpec sphere;
+  sphere.geometry.shape = ObstacleShape::kSphere;
+  sphere.geometry.radius = 0.5;
+  sphere.contact = contact;
+  ElevatorSpec platform;
+  platform.contact = contact;
+  const Obstacle obstacle(sphere);
+  const Elevator elevator(platform);
+  const std::unique_ptr<Terrain> made = sphere.make();
+  for (const Terrain* t :
+       {static_cast<const Terrain*>(&obstacle), static_cast<const Terrain*>(&elevator),
+        static_cast<const Terrain*>(made.get())}) {
+    EXPECT_EQ(t->contact().model, ContactModel::kSeed);
+    EXPECT_DOUBLE_EQ(t->contact().restitution, 0.3);
+    EXPECT_DOUBLE_EQ(t->contact().friction, 0.2);
+  }
+  // An explicit contact model still wins over the spec's.
+  const Obstacle other(sphere, ContactParams{});
+  EXPECT_EQ(other.contact().model, ContactModel::kCoulomb);
 }
 
 }  // namespace

@@ -1,0 +1,165 @@
+#!/usr/bin/python3
+"""What linking and including jelly costs (docs/CONTRIBUTING.md, "The public API"), as a
+Markdown table: the installed headers, the umbrella header's preprocessed lines and compile CPU,
+the shared libraries libjelly loads, the start-up of `jelly run` (one step of the seed scene)
+and of `import jelly`.
+
+    library_figures.py [--build DIR] [--source DIR] [--before-build DIR --before-source DIR]
+                       [--repeat 5]
+
+With --before-*, each timing alternates between the two trees, run by run, so that a busy
+machine slows both alike; the table gives the medians and their ratio. The load average while
+measuring is printed with the table. Exit status 1 when a measurement could not be made.
+"""
+import argparse
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+UMBRELLA_SOURCE = "#include <jelly/jelly.hpp>\nint main() { return 0; }\n"
+
+
+class Tree:
+    def __init__(self, build, source):
+        self.build = os.path.abspath(build)
+        self.source = os.path.abspath(source)
+
+    def include_flags(self):
+        return ["-I", os.path.join(self.build, "include"), "-I", "/usr/include/eigen3"]
+
+    def public_headers(self):
+        listed = os.path.join(self.source, "cmake", "public_headers.txt")
+        if os.path.exists(listed):
+            with open(listed, encoding="utf-8") as f:
+                return sum(1 for line in f if re.match(r"[a-z]", line)) + 2  # + jelly, version
+        # Before the list: every header outside detail/ folders of the library's modules.
+        count = 2
+        for module in ("core", "geometry", "terrain", "solvers", "io", "fit"):
+            for folder, dirs, files in os.walk(os.path.join(self.source, module)):
+                dirs[:] = [d for d in dirs if d != "detail"]
+                count += sum(1 for name in files if name.endswith(".hpp"))
+        return count
+
+    def library(self):
+        return os.path.join(self.build, "libjelly.so")
+
+    def jelly(self):
+        return os.path.join(self.build, "cli", "jelly")
+
+
+def run(command, **kwargs):
+    return subprocess.run(command, check=True, capture_output=True, text=True, **kwargs)
+
+
+def umbrella_lines(tree, work):
+    source = os.path.join(work, "umbrella.cpp")
+    with open(source, "w", encoding="utf-8") as f:
+        f.write(UMBRELLA_SOURCE)
+    out = run(["g++", "-std=c++17", "-E", *tree.include_flags(), source]).stdout
+    nlohmann = len(re.findall(r'^# 1 "/usr/include/nlohmann/', out, re.M))
+    return out.count("\n"), nlohmann
+
+
+def umbrella_cpu(tree, work):
+    """CPU seconds (user + system) of `g++ -O2 -c` of a file that includes the umbrella."""
+    source = os.path.join(work, "umbrella.cpp")
+    before = os.times()
+    run(["g++", "-std=c++17", "-O2", "-c", *tree.include_flags(), source, "-o",
+         os.path.join(work, "umbrella.o")])
+    after = os.times()
+    return (after.children_user - before.children_user) + (after.children_system -
+                                                           before.children_system)
+
+
+def linked_libraries(path):
+    out = run(["ldd", path]).stdout
+    return sum(1 for line in out.splitlines() if line.strip())
+
+
+def run_one_step(tree, work):
+    scene = os.path.join(tree.source, "scenes", "seed_slope.json")
+    # The tree's own libjelly, also for a program copied from another build tree.
+    env = dict(os.environ, LD_LIBRARY_PATH=tree.build)
+    start = time.perf_counter()
+    run([tree.jelly(), "run", scene, "--duration", "0.001", "-o",
+         os.path.join(work, "one.h5"), "--overwrite"], env=env)
+    return time.perf_counter() - start
+
+
+def import_jelly(tree, work):
+    env = dict(os.environ, PYTHONPATH=os.path.join(tree.build, "python"),
+               LD_LIBRARY_PATH=tree.build)
+    start = time.perf_counter()
+    run([sys.executable, "-c", "import jelly"], env=env, cwd=work)
+    return time.perf_counter() - start
+
+
+def alternate(measures, trees, work, repeat):
+    """{name: [median per tree]} for each timing, the trees taking turns run by run."""
+    results = {name: [[] for _ in trees] for name, _ in measures}
+    for _ in range(repeat):
+        for name, measure in measures:
+            for index, tree in enumerate(trees):
+                results[name][index].append(measure(tree, work))
+    return {name: [statistics.median(v) for v in values] for name, values in results.items()}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+    parser.add_argument("--build", default=os.path.join(here, "build"))
+    parser.add_argument("--source", default=here)
+    parser.add_argument("--before-build")
+    parser.add_argument("--before-source")
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args()
+    if bool(args.before_build) != bool(args.before_source):
+        parser.error("--before-build and --before-source go together")
+    if args.repeat < 1:
+        parser.error(f"--repeat = {args.repeat} is invalid: at least 1")
+    trees = [Tree(args.build, args.source)]
+    names = ["this tree"]
+    if args.before_build:
+        trees.insert(0, Tree(args.before_build, args.before_source))
+        names.insert(0, "before")
+
+    with tempfile.TemporaryDirectory(prefix="jelly_figures_") as work:
+        try:
+            rows = [("installed headers", [str(t.public_headers()) for t in trees])]
+            lines = [umbrella_lines(t, work) for t in trees]
+            rows.append(("umbrella: preprocessed lines", [str(n) for n, _ in lines]))
+            rows.append(("umbrella: nlohmann headers included", [str(k) for _, k in lines]))
+            rows.append(("libjelly.so: shared libraries loaded (ldd)",
+                         [str(linked_libraries(t.library())) for t in trees]))
+            timings = [("umbrella: compile CPU (g++ -O2), s", umbrella_cpu),
+                       ("jelly run, 1 step of the seed slope: wall, s", run_one_step)]
+            if all(os.path.isdir(os.path.join(t.build, "python", "jelly")) for t in trees):
+                timings.append(("python3 -c 'import jelly': wall, s", import_jelly))
+            medians = alternate(timings, trees, work, args.repeat)
+        except (subprocess.CalledProcessError, OSError) as e:
+            detail = getattr(e, "stderr", "") or ""
+            print(f"library_figures: a measurement failed: {e}\n{detail}", file=sys.stderr)
+            return 1
+    for name, values in medians.items():
+        rows.append((name + f" (median of {args.repeat})", [f"{v:.3f}" for v in values]))
+
+    header = ["", *names] + (["ratio"] if len(trees) == 2 else [])
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for name, values in rows:
+        ratio = []
+        if len(values) == 2:
+            a, b = float(values[0]), float(values[1])
+            ratio = [f"{b / a:.2f}" if a else "-"]
+        print("| " + " | ".join([name, *values, *ratio]) + " |")
+    print(f"\nLoad average while measuring: {os.getloadavg()[0]:.1f} ({os.cpu_count()} cores).")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
