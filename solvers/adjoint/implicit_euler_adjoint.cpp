@@ -255,6 +255,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       if (c.kind == ConstraintKind::kPin) continue;
       ++out.contact_steps;
       if (c.bounces) ++out.bounce_steps;
+      if (c.kind == ConstraintKind::kSlide) ++out.slide_steps;
       auto w = particle(vb, c.particle);
       w -= c.normal * c.normal.dot(w);
     }

@@ -44,8 +44,11 @@ struct GradientResult {
   std::vector<Real> particle_mass;
   std::vector<Vec3> pin_targets;  // [K * P] as GradientProblem::pin_targets
   // What the backward pass held fixed: constrained particle-steps (terrain contacts, pins not
-  // counted), of which bounced (restitution: its velocity change is not differentiated).
+  // counted), of which sliding (the friction viscosity, which the forward step takes from the
+  // previous solve's impulse, is held) and bouncing (restitution's velocity change is not
+  // differentiated).
   long contact_steps = 0;
+  long slide_steps = 0;
   long bounce_steps = 0;
   std::string backward_solver;  // "cholmod", "ldlt" or "cg_jacobi"
   double forward_seconds = 0, backward_seconds = 0;
