@@ -67,22 +67,18 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
             out[path] = raw["gravity"].copy()
         elif what == "pin_targets":
             out[path] = raw["pin_targets"].reshape(steps, len(pins), 3)
-        elif what in ("ks", "kd"):
-            continue
+        elif isinstance(what, tuple):  # (ks or kd, spring type)
+            out[path] = numpy.array(raw[what[0]][3 * body + what[1]])
+        elif what == "mass":
+            out[path] = numpy.array(raw["particle_mass"][body])
         else:
             b = bodies[body]
             rows = slice(b.first_particle, b.first_particle + b.num_particles)
-            if what == "mass":
-                out[path] = numpy.array(raw["particle_mass"][body])
-            elif what in ("velocities", "positions"):
-                out[path] = raw["velocity" if what == "velocities" else "position"][rows].copy()
-            else:  # velocity, position
-                out[path] = raw[what][rows].sum(axis=0)
-    for path, (body, what) in zip(wrt, requests):
-        if isinstance(what, tuple):
-            kind, spring_type = what
-            out[path] = numpy.array(raw[kind][3 * body + spring_type])
-    return raw["loss"], {path: out[path] for path in wrt}
+            per_particle = raw["velocity" if what.startswith("velocit") else "position"][rows]
+            # bodies[i].velocity / position: every particle moved together (the scene's field).
+            out[path] = per_particle.sum(axis=0) if what in ("velocity", "position") \
+                else per_particle.copy()
+    return raw["loss"], out
 
 
 def _parse(path: str, bodies: int):
