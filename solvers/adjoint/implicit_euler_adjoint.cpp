@@ -5,8 +5,12 @@
 #include <memory>
 #include <stdexcept>
 
+#include <optional>
+
+#include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/clock.hpp>
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
@@ -103,6 +107,29 @@ std::unique_ptr<LinearSolver> backward_solver(std::string_view forward,
   name = forward == "cg_lagged_cholmod" ? "cg_lagged_cholmod" : "cg_jacobi";
   return std::make_unique<CgSolver>(cg);
 }
+
+// The filtered diagonal block S D S + C + I - S of a constrained particle (row-major, in place).
+void filter_block(const Constraint& c, Real block[9]) {
+  Mat3 d;
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) d(r, q) = block[3 * r + q];
+  const Mat3 s = adjoint_free_projector(c);
+  const Real viscosity = c.kind == ConstraintKind::kSlide ? c.viscosity : 0.0;
+  const Mat3 f = s * d * s + viscosity * s + Mat3::Identity() - s;
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) block[3 * r + q] = f(r, q);
+}
+
+// The backward solves of a step whose forward solve was the matrix-free block-Jacobi CG: the same
+// system (BandSystem, in the same precision), filtered the same way, and the same preconditioner.
+struct MatrixFreeBackward {
+  SpringBands bands;
+  BandSystem band;
+  MatrixFreeCg cg;
+  std::vector<Real> projectors, viscosities;
+  MatrixFreeBackward(const Model& model, bool single)
+      : bands(model), band(bands, model.num_particles(), single) {}
+};
 
 // What one forward step leaves for the backward pass.
 struct StepRecord {
@@ -205,13 +232,23 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   const ImplicitEulerOptions& options = ie->options();
   JacobianOptions jacobian_options;
   jacobian_options.definiteness = options.definiteness;
-  SpringJacobian jacobian(model);
-  SparseMatrix a = jacobian.make_matrix();
-  SparseMatrix filtered = jacobian.make_matrix();
-  std::unique_ptr<LinearSolver> solver =
-      backward_solver(ie->linear_solver_name(), options, out.backward_solver);
-  if (LinearResult r = solver->analyze(a); !r.ok())
-    throw std::runtime_error("gradient: " + r.message);
+  const int threads = std::max(1, sim.options().threads);
+  // The matrix-free forward path: its own system and preconditioner; else an assembled matrix.
+  std::optional<MatrixFreeBackward> free;
+  std::optional<SpringJacobian> jacobian;
+  SparseMatrix a, filtered;
+  std::unique_ptr<LinearSolver> solver;
+  if (ie->linear_solver_name() == "cg_jacobi_matrix_free") {
+    free.emplace(model, options.cg_tolerance >= 1e-6);
+    out.backward_solver = "cg_jacobi_matrix_free";
+  } else {
+    jacobian.emplace(model);
+    a = jacobian->make_matrix();
+    filtered = jacobian->make_matrix();
+    solver = backward_solver(ie->linear_solver_name(), options, out.backward_solver);
+    if (LinearResult r = solver->analyze(a); !r.ok())
+      throw std::runtime_error("gradient: " + r.message);
+  }
   const int bodies = model.num_bodies();
   out.ks.assign(static_cast<size_t>(kSpringTypeCount) * bodies, 0.0);
   out.kd.assign(out.ks.size(), 0.0);
@@ -264,11 +301,40 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     dvb = vb + h * xb;
     v0b = dvb;
     // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S mu.
-    jacobian.assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
-    std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
-    filter_system(filtered, cons, slot);
-    LinearResult solved = solver->factorize(filtered);
-    if (solved.ok()) solved = solver->solve(dvb, mu);
+    LinearResult solved;
+    if (free) {
+      if (!free->band.assemble(model, r.x, r.v, options.definiteness, h, h * h, r.v, kw, threads))
+        throw std::runtime_error("gradient: a spring collapsed at step " + std::to_string(k));
+      free->projectors.resize(9 * cons.size());
+      free->viscosities.resize(cons.size());
+      for (size_t ci = 0; ci < cons.size(); ++ci) {
+        const Mat3 sc = adjoint_free_projector(cons[ci]);
+        std::copy(sc.data(), sc.data() + 9, free->projectors.data() + 9 * ci);
+        free->viscosities[ci] = cons[ci].kind == ConstraintKind::kSlide ? cons[ci].viscosity : 0.0;
+      }
+      const ProductFilter filter =
+          cons.empty()
+              ? ProductFilter{}
+              : ProductFilter{slot.data(), free->projectors.data(), free->viscosities.data()};
+      solved = free->cg.set_diagonal_blocks(
+          np,
+          [&](int i, Real d[9]) {
+            free->band.diagonal_block(i, d);
+            if (slot[i] >= 0) filter_block(cons[slot[i]], d);
+          },
+          threads);
+      if (solved.ok()) {
+        solved = free->cg.solve(
+            [&](const VecX& in, VecX& y) { free->band.multiply(in, y, threads, filter); }, dvb, mu,
+            options.cg_tolerance, options.cg_max_iterations, threads);
+      }
+    } else {
+      jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
+      std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
+      filter_system(filtered, cons, slot);
+      solved = solver->factorize(filtered);
+      if (solved.ok()) solved = solver->solve(dvb, mu);
+    }
     if (!solved.ok())
       throw std::runtime_error("gradient: the backward solve of step " + std::to_string(k) +
                                " failed: " + solved.message);
@@ -277,7 +343,12 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       particle(lambda, c.particle) = adjoint_free_projector(c) * particle(mu, c.particle);
     // The prescribed velocity changes z (and the sliding friction's C w0): their adjoint is
     // dvb - A lambda at the constrained particles.
-    if (!cons.empty()) a_lambda.noalias() = a * lambda;
+    if (!cons.empty()) {
+      if (free)
+        free->band.multiply(lambda, a_lambda, threads);
+      else
+        a_lambda.noalias() = a * lambda;
+    }
     for (const Constraint& c : cons) {
       const int i = c.particle;
       const Vec3 zb = particle(dvb, i) - particle(a_lambda, i);
