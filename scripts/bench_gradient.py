@@ -10,9 +10,9 @@ ratios of the medians.
     PYTHONPATH=build/python /usr/bin/python3 scripts/bench_gradient.py [n] [steps] [repeats]
 """
 
+import argparse
 import os
 import statistics
-import sys
 import time
 
 import numpy as np
@@ -38,9 +38,12 @@ def scene(n):
 
 
 def main():
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 20
-    steps = int(sys.argv[2]) if len(sys.argv) > 2 else 20
-    repeats = int(sys.argv[3]) if len(sys.argv) > 3 else 3
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("n", type=int, nargs="?", default=20, help="particles per edge")
+    parser.add_argument("steps", type=int, nargs="?", default=20)
+    parser.add_argument("repeats", type=int, nargs="?", default=3)
+    args = parser.parse_args()
+    n, steps, repeats = args.n, args.steps, args.repeats
     s = scene(n)
     dt = 0.01
 
