@@ -59,7 +59,7 @@ void adjoint_write(SparseMatrix& a, const AdjointBlock& b, const Mat3& m) {
 // a -> S a S + C + I - S for the step's constraints, as ImplicitContact::constrain filters the
 // forward system (`slot`: index into `cons` per particle, or -1; C = viscosity S on a sliding
 // contact's diagonal block).
-void filter_system(SparseMatrix& a, const std::vector<Constraint>& cons,
+void adjoint_filter_system(SparseMatrix& a, const std::vector<Constraint>& cons,
                    const std::vector<int>& slot) {
   const int* outer = a.outerIndexPtr();
   const int* rows = a.innerIndexPtr();
@@ -85,7 +85,7 @@ void filter_system(SparseMatrix& a, const std::vector<Constraint>& cons,
 
 // The solver of the backward pass: the forward step's own kind (a direct factorization, or CG
 // with the same preconditioner).
-std::unique_ptr<LinearSolver> backward_solver(std::string_view forward,
+std::unique_ptr<LinearSolver> adjoint_backward_solver(std::string_view forward,
                                               const ImplicitEulerOptions& o, std::string& name) {
   CholmodOptions cholmod;
   cholmod.ordering = o.ordering;
@@ -109,7 +109,7 @@ std::unique_ptr<LinearSolver> backward_solver(std::string_view forward,
 }
 
 // The filtered diagonal block S D S + C + I - S of a constrained particle (row-major, in place).
-void filter_block(const Constraint& c, Real block[9]) {
+void adjoint_filter_block(const Constraint& c, Real block[9]) {
   Mat3 d;
   for (int r = 0; r < 3; ++r)
     for (int q = 0; q < 3; ++q) d(r, q) = block[3 * r + q];
@@ -137,7 +137,7 @@ struct StepRecord {
   std::vector<Constraint> constraints;
 };
 
-void check_supported(const Simulator& sim, const ImplicitEuler& ie) {
+void adjoint_check_supported(const Simulator& sim, const ImplicitEuler& ie) {
   const ImplicitEulerOptions& o = ie.options();
   require(o.newton_iterations == 1, "integrator.newton_iterations", o.newton_iterations,
           "1 for gradients (the adjoint differentiates the linearized step)");
@@ -160,7 +160,7 @@ void check_supported(const Simulator& sim, const ImplicitEuler& ie) {
 GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& problem) {
   auto* ie = dynamic_cast<ImplicitEuler*>(&sim.integrator());
   require(ie != nullptr, "integrator", sim.integrator().name(), "implicit_euler for gradients");
-  check_supported(sim, *ie);
+  adjoint_check_supported(sim, *ie);
   const int steps = problem.steps;
   require(steps >= 1, "steps", steps, "an integer >= 1");
   require(static_cast<bool>(problem.loss), "loss", "none", "a function");
@@ -245,7 +245,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     jacobian.emplace(model);
     a = jacobian->make_matrix();
     filtered = jacobian->make_matrix();
-    solver = backward_solver(ie->linear_solver_name(), options, out.backward_solver);
+    solver = adjoint_backward_solver(ie->linear_solver_name(), options, out.backward_solver);
     if (LinearResult r = solver->analyze(a); !r.ok())
       throw std::runtime_error("gradient: " + r.message);
   }
@@ -320,7 +320,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
           np,
           [&](int i, Real d[9]) {
             free->band.diagonal_block(i, d);
-            if (slot[i] >= 0) filter_block(cons[slot[i]], d);
+            if (slot[i] >= 0) adjoint_filter_block(cons[slot[i]], d);
           },
           threads);
       if (solved.ok()) {
@@ -331,7 +331,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     } else {
       jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
       std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
-      filter_system(filtered, cons, slot);
+      adjoint_filter_system(filtered, cons, slot);
       solved = solver->factorize(filtered);
       if (solved.ok()) solved = solver->solve(dvb, mu);
     }
