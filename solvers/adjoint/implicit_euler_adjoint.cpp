@@ -60,7 +60,7 @@ void adjoint_write(SparseMatrix& a, const AdjointBlock& b, const Mat3& m) {
 // forward system (`slot`: index into `cons` per particle, or -1; C = viscosity S on a sliding
 // contact's diagonal block).
 void adjoint_filter_system(SparseMatrix& a, const std::vector<Constraint>& cons,
-                   const std::vector<int>& slot) {
+                           const std::vector<int>& slot) {
   const int* outer = a.outerIndexPtr();
   const int* rows = a.innerIndexPtr();
   for (const Constraint& c : cons) {
@@ -86,7 +86,8 @@ void adjoint_filter_system(SparseMatrix& a, const std::vector<Constraint>& cons,
 // The solver of the backward pass: the forward step's own kind (a direct factorization, or CG
 // with the same preconditioner).
 std::unique_ptr<LinearSolver> adjoint_backward_solver(std::string_view forward,
-                                              const ImplicitEulerOptions& o, std::string& name) {
+                                                      const ImplicitEulerOptions& o,
+                                                      std::string& name) {
   CholmodOptions cholmod;
   cholmod.ordering = o.ordering;
   if (forward == "cholmod") {
