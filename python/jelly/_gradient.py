@@ -1,6 +1,7 @@
 """jelly.gradient: exact gradients through implicit_euler (the discrete adjoint, docs/gradients.md)."""
 
 import re
+import warnings
 from typing import Any, Callable, Optional, Sequence
 
 import numpy
@@ -35,7 +36,8 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
       "bodies[i].positions" ((N_i, 3): each particle's initial state), "pin_targets" (K, P, 3).
     pins / pin_targets: pinned particles (global indices) driven by a control sequence: before
     step k pin p moves in a straight line to pin_targets[k, p] (K x P x 3), where it ends the step.
-    Returns (value, {path: array}).
+    Returns (value, {path: array}). Warns when sliding or bouncing contacts made the gradient
+    approximate (their friction viscosity and restitution are held fixed).
     """
     sim = _jelly.Simulator(scene)
     steps = _steps(float(duration), sim.options.dt)
@@ -61,6 +63,11 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
 
     raw = _jelly._gradient(sim, steps, frame_loss, list(frames or []), pins,
                            targets.reshape(-1, 3))
+    for count, what in ((raw["slide_steps"], "sliding contact's friction viscosity"),
+                        (raw["bounce_steps"], "bouncing contact's restitution")):
+        if count:
+            warnings.warn(f"jelly.gradient: {count} particle-step(s) held a {what} fixed; the "
+                          "gradient there is approximate (docs/gradients.md)", stacklevel=2)
     out = {}
     for path, (body, what) in zip(wrt, requests):
         if what == "gravity":

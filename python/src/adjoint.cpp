@@ -58,6 +58,7 @@ void bind_adjoint(py::module_& m) {
           for (int d = 0; d < 3; ++d) pt.mutable_data()[3 * k + d] = g.pin_targets[k][d];
         out["pin_targets"] = pt;
         out["contact_steps"] = g.contact_steps;
+        out["slide_steps"] = g.slide_steps;
         out["bounce_steps"] = g.bounce_steps;
         out["backward_solver"] = g.backward_solver;
         out["forward_seconds"] = g.forward_seconds;

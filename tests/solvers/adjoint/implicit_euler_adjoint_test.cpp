@@ -336,6 +336,41 @@ TEST(ImplicitEulerAdjoint, ConjugateGradientsBackwardAgreesWithFiniteDifferences
   EXPECT_NEAR(lagged.kd[1], exact.kd[1], 1e-7 * std::abs(exact.kd[1]));
 }
 
+// Sliding contacts (low friction on the slope) are counted: the gradient through them holds the
+// friction viscosity fixed. A loss at frame 0 adds its own derivatives to the initial state's.
+TEST(ImplicitEulerAdjoint, CountsSlidingContactsAndTakesALossAtFrameZero) {
+  const Model model = build_cube(testing::small_cube(3, 0.6));
+  const State s0 = testing::cube_on_slope(model, 20);
+  const auto make = [&] {
+    Simulator sim = testing::make_sim(model, s0, "implicit_euler", 1.0 / 100);
+    ContactParams contact;
+    contact.friction = 0.05;
+    contact.static_friction = 0.05;
+    contact.restitution = 0;
+    sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), contact)));
+    return sim;
+  };
+  GradientProblem p;
+  p.steps = 10;
+  p.loss_frames = {0, 10};
+  p.loss = [](int frame, const State& s, VecX& dx, VecX&) {
+    const Real w = frame == 0 ? 2.0 : 1.0;
+    dx = VecX::Constant(s.x.size(), w);
+    return w * s.x.sum();
+  };
+  Simulator sim = make();
+  const GradientResult g = implicit_euler_gradient(sim, p);
+  EXPECT_GT(g.slide_steps, 0);
+  EXPECT_EQ(g.bounce_steps, 0);
+  // Frame 0 alone: dL/dx0 = 2, dL/dv0 = 0.
+  p.loss_frames = {0};
+  Simulator again = make();
+  const GradientResult only_start = implicit_euler_gradient(again, p);
+  EXPECT_EQ(only_start.initial_position, VecX::Constant(s0.x.size(), 2.0));
+  EXPECT_EQ(only_start.initial_velocity, VecX::Zero(s0.x.size()));
+  EXPECT_DOUBLE_EQ(only_start.loss, 2 * s0.x.sum());
+}
+
 TEST(ImplicitEulerAdjoint, RefusesWhatItDoesNotDifferentiate) {
   const Model model = build_cube(testing::small_cube(2, 0.5));
   GradientProblem p;
