@@ -39,8 +39,11 @@ void bind_adjoint(py::module_& m) {
           const auto t = r.cast<py::tuple>();
           require(t.size() == 3, "loss(x, v) at frame " + std::to_string(frame),
                   std::to_string(t.size()) + " values", "(value, dL/dx, dL/dv)");
-          dx += flat_n3(t[1].cast<DoubleArray>(), "dL/dx");
-          dv += flat_n3(t[2].cast<DoubleArray>(), "dL/dv");
+          VecX gx = dx, gv = dv;  // (the right size: assign_n3 checks the arrays' shapes)
+          assign_n3(gx, t[1].cast<DoubleArray>(), "dL/dx");
+          assign_n3(gv, t[2].cast<DoubleArray>(), "dL/dv");
+          dx += gx;
+          dv += gv;
           return t[0].cast<Real>();
         };
         const GradientResult g = implicit_euler_gradient(sim, problem);

@@ -95,6 +95,8 @@ def test_bad_paths_and_shapes_are_named():
         jelly.gradient(scene, STEPS * DT, loss, ["bodies[0].springs.twist.ks"])
     with pytest.raises(jelly.InputError, match="pin_targets"):
         jelly.gradient(scene, STEPS * DT, loss, [], pins=[0], pin_targets=np.zeros((2, 1, 3)))
+    with pytest.raises(jelly.InputError, match="dL/dx"):
+        jelly.gradient(scene, STEPS * DT, lambda x, v: (0.0, np.zeros((3, 3)), v), [])
     with pytest.raises(jelly.InputError, match="duration"):
         jelly.gradient(scene, 0.001, loss, [])
     rk4 = cloth_scene({"integrator.name": "rk4", "integrator.dt": 0.001})
