@@ -164,6 +164,8 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   adjoint_check_supported(sim, *ie);
   const int steps = problem.steps;
   require(steps >= 1, "steps", steps, "an integer >= 1");
+  require(problem.checkpoint_every >= 0, "checkpoint_every", problem.checkpoint_every,
+          "0 (store every step) or a number of steps >= 1");
   require(static_cast<bool>(problem.loss), "loss", "none", "a function");
   const int np = sim.model().num_particles();
   const int n = 3 * np;
@@ -190,7 +192,11 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   const Real h = sim.options().dt;
   // Forward: the states, velocity changes, constraint sets and the loss terms' derivatives.
   auto start = Clock::now();
-  std::vector<StepRecord> records(steps);
+  // Stored steps: all of them, or with checkpoints one segment's (recomputed backwards).
+  const int every = problem.checkpoint_every;
+  const int segment = every > 0 ? std::min(every, steps) : steps;
+  std::vector<StepRecord> records(segment);
+  std::vector<SimulatorSnapshot> checkpoints;
   std::vector<VecX> dl_dx(steps + 1), dl_dv(steps + 1);
   const auto evaluate = [&](int frame) {
     if (!at_frame[frame]) return;
@@ -201,9 +207,8 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
             "loss at frame " + std::to_string(frame), value, "finite values and derivatives");
     out.loss += value;
   };
-  evaluate(0);
-  for (int k = 0; k < steps; ++k) {
-    StepRecord& r = records[k];
+  // Step k of the run, recorded into r.
+  const auto forward_step = [&](int k, StepRecord& r) {
     r.x = sim.state().x;
     r.v = sim.state().v;
     for (int p = 0; p < pins; ++p) {
@@ -216,13 +221,21 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     if (!result.ok)
       throw std::runtime_error("gradient: step " + std::to_string(k) +
                                " failed: " + result.message);
-    if (ie->last_step_had_body_contact())
+    const auto* integrator = dynamic_cast<const ImplicitEuler*>(&sim.integrator());
+    if (integrator->last_step_had_body_contact())
       throw InputError("gradient: contact between bodies at step " + std::to_string(k) +
                        " is not differentiated yet");
-    r.dv = ie->last_velocity_change();
-    r.constraints = ie->last_constraints();
+    r.dv = integrator->last_velocity_change();
+    r.constraints = integrator->last_constraints();
+  };
+  evaluate(0);
+  for (int k = 0; k < steps; ++k) {
+    if (every > 0 && k % segment == 0) checkpoints.push_back(sim.snapshot());
+    forward_step(k, records[every > 0 ? 0 : k]);
     evaluate(k + 1);
   }
+  std::optional<SimulatorSnapshot> end_of_run;
+  if (every > 0) end_of_run = sim.snapshot();
   out.forward_seconds = seconds_since(start);
 
   // Backward: per step from the last, the adjoint of
@@ -271,182 +284,192 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   }
   const Springs& springs = model.springs;
   const Real* rest = springs.rest_length.data();
-  for (int k = steps - 1; k >= 0; --k) {
-    const StepRecord& r = records[k];
-    const std::vector<Constraint>& cons = r.constraints;
-    for (size_t ci = 0; ci < cons.size(); ++ci) slot[cons[ci].particle] = static_cast<int>(ci);
-    // The pins' end of step: x1 = target, v1 = (target - x0) / h for a driven pin (a path's,
-    // independent of the state, for the others); vel_bar collects dL/d(v1) of the driven pins.
-    std::vector<Vec3> vel_bar(pins, Vec3::Zero());
-    for (const Constraint& c : cons) {
-      if (c.kind != ConstraintKind::kPin) continue;
-      const int p = driven[c.particle];
-      if (p >= 0) {
-        out.pin_targets[static_cast<size_t>(k) * pins + p] += particle(xb, c.particle);
-        vel_bar[p] += particle(vb, c.particle);
-      }
-      particle(xb, c.particle).setZero();
-      particle(vb, c.particle).setZero();
+  for (int begin = ((steps - 1) / segment) * segment; begin >= 0; begin -= segment) {
+    const int end = std::min(begin + segment, steps);
+    if (every > 0) {  // the segment's steps again, from its checkpoint
+      sim.restore(checkpoints[begin / segment]);
+      for (int k = begin; k < end; ++k) forward_step(k, records[k - begin]);
     }
-    // The contacts' end of step: (v1 - u).n = 0.
-    for (const Constraint& c : cons) {
-      if (c.kind == ConstraintKind::kPin) continue;
-      ++out.contact_steps;
-      if (c.bounces) ++out.bounce_steps;
-      if (c.kind == ConstraintKind::kSlide) ++out.slide_steps;
-      auto w = particle(vb, c.particle);
-      w -= c.normal * c.normal.dot(w);
-    }
-    // x1 = x0 + h v1, v1 = v0 + dv.
-    x0b = xb;
-    dvb = vb + h * xb;
-    v0b = dvb;
-    // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S mu.
-    LinearResult solved;
-    if (free) {
-      if (!free->band.assemble(model, r.x, r.v, options.definiteness, h, h * h, r.v, kw, threads))
-        throw std::runtime_error("gradient: a spring collapsed at step " + std::to_string(k));
-      free->projectors.resize(9 * cons.size());
-      free->viscosities.resize(cons.size());
-      for (size_t ci = 0; ci < cons.size(); ++ci) {
-        const Mat3 sc = adjoint_free_projector(cons[ci]);
-        std::copy(sc.data(), sc.data() + 9, free->projectors.data() + 9 * ci);
-        free->viscosities[ci] = cons[ci].kind == ConstraintKind::kSlide ? cons[ci].viscosity : 0.0;
-      }
-      const ProductFilter filter =
-          cons.empty()
-              ? ProductFilter{}
-              : ProductFilter{slot.data(), free->projectors.data(), free->viscosities.data()};
-      solved = free->cg.set_diagonal_blocks(
-          np,
-          [&](int i, Real d[9]) {
-            free->band.diagonal_block(i, d);
-            if (slot[i] >= 0) adjoint_filter_block(cons[slot[i]], d);
-          },
-          threads);
-      if (solved.ok()) {
-        solved = free->cg.solve(
-            [&](const VecX& in, VecX& y) { free->band.multiply(in, y, threads, filter); }, dvb, mu,
-            options.cg_tolerance, options.cg_max_iterations, threads);
-      }
-    } else {
-      jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
-      std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
-      adjoint_filter_system(filtered, cons, slot);
-      solved = solver->factorize(filtered);
-      if (solved.ok()) solved = solver->solve(dvb, mu);
-    }
-    if (!solved.ok())
-      throw std::runtime_error("gradient: the backward solve of step " + std::to_string(k) +
-                               " failed: " + solved.message);
-    lambda = mu;
-    for (const Constraint& c : cons)
-      particle(lambda, c.particle) = adjoint_free_projector(c) * particle(mu, c.particle);
-    // The prescribed velocity changes z (and the sliding friction's C w0): their adjoint is
-    // dvb - A lambda at the constrained particles.
-    if (!cons.empty()) {
-      if (free)
-        free->band.multiply(lambda, a_lambda, threads);
-      else
-        a_lambda.noalias() = a * lambda;
-    }
-    for (const Constraint& c : cons) {
-      const int i = c.particle;
-      const Vec3 zb = particle(dvb, i) - particle(a_lambda, i);
-      const Vec3& nn = c.normal;
-      switch (c.kind) {
-        case ConstraintKind::kPin: {  // z = v_path - v0
-          particle(v0b, i) -= zb;
-          const int p = driven[i];
-          if (p >= 0) vel_bar[p] += zb;
-          break;
+    for (int k = end - 1; k >= begin; --k) {
+      const StepRecord& r = records[k - begin];
+      const std::vector<Constraint>& cons = r.constraints;
+      for (size_t ci = 0; ci < cons.size(); ++ci) slot[cons[ci].particle] = static_cast<int>(ci);
+      // The pins' end of step: x1 = target, v1 = (target - x0) / h for a driven pin (a path's,
+      // independent of the state, for the others); vel_bar collects dL/d(v1) of the driven pins.
+      std::vector<Vec3> vel_bar(pins, Vec3::Zero());
+      for (const Constraint& c : cons) {
+        if (c.kind != ConstraintKind::kPin) continue;
+        const int p = driven[c.particle];
+        if (p >= 0) {
+          out.pin_targets[static_cast<size_t>(k) * pins + p] += particle(xb, c.particle);
+          vel_bar[p] += particle(vb, c.particle);
         }
-        case ConstraintKind::kStick:  // z = u_t + (-d(x0) / h) n - v0
-          particle(v0b, i) -= zb;
-          particle(x0b, i) -= (nn.dot(zb) / h) * nn;
-          break;
-        case ConstraintKind::kSlide: {  // z = (-d(x0) / h - v0.n) n; rhs -= c P_t (v0 - u)
-          particle(v0b, i) -= nn.dot(zb) * nn;
-          particle(x0b, i) -= (nn.dot(zb) / h) * nn;
-          const Vec3 l = particle(lambda, i);
-          particle(v0b, i) -= c.viscosity * (l - l.dot(nn) * nn);
-          break;
+        particle(xb, c.particle).setZero();
+        particle(vb, c.particle).setZero();
+      }
+      // The contacts' end of step: (v1 - u).n = 0.
+      for (const Constraint& c : cons) {
+        if (c.kind == ConstraintKind::kPin) continue;
+        ++out.contact_steps;
+        if (c.bounces) ++out.bounce_steps;
+        if (c.kind == ConstraintKind::kSlide) ++out.slide_steps;
+        auto w = particle(vb, c.particle);
+        w -= c.normal * c.normal.dot(w);
+      }
+      // x1 = x0 + h v1, v1 = v0 + dv.
+      x0b = xb;
+      dvb = vb + h * xb;
+      v0b = dvb;
+      // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
+      // mu.
+      LinearResult solved;
+      if (free) {
+        if (!free->band.assemble(model, r.x, r.v, options.definiteness, h, h * h, r.v, kw, threads))
+          throw std::runtime_error("gradient: a spring collapsed at step " + std::to_string(k));
+        free->projectors.resize(9 * cons.size());
+        free->viscosities.resize(cons.size());
+        for (size_t ci = 0; ci < cons.size(); ++ci) {
+          const Mat3 sc = adjoint_free_projector(cons[ci]);
+          std::copy(sc.data(), sc.data() + 9, free->projectors.data() + 9 * ci);
+          free->viscosities[ci] =
+              cons[ci].kind == ConstraintKind::kSlide ? cons[ci].viscosity : 0.0;
+        }
+        const ProductFilter filter =
+            cons.empty()
+                ? ProductFilter{}
+                : ProductFilter{slot.data(), free->projectors.data(), free->viscosities.data()};
+        solved = free->cg.set_diagonal_blocks(
+            np,
+            [&](int i, Real d[9]) {
+              free->band.diagonal_block(i, d);
+              if (slot[i] >= 0) adjoint_filter_block(cons[slot[i]], d);
+            },
+            threads);
+        if (solved.ok()) {
+          solved = free->cg.solve(
+              [&](const VecX& in, VecX& y) { free->band.multiply(in, y, threads, filter); }, dvb,
+              mu, options.cg_tolerance, options.cg_max_iterations, threads);
+        }
+      } else {
+        jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
+        std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
+        adjoint_filter_system(filtered, cons, slot);
+        solved = solver->factorize(filtered);
+        if (solved.ok()) solved = solver->solve(dvb, mu);
+      }
+      if (!solved.ok())
+        throw std::runtime_error("gradient: the backward solve of step " + std::to_string(k) +
+                                 " failed: " + solved.message);
+      lambda = mu;
+      for (const Constraint& c : cons)
+        particle(lambda, c.particle) = adjoint_free_projector(c) * particle(mu, c.particle);
+      // The prescribed velocity changes z (and the sliding friction's C w0): their adjoint is
+      // dvb - A lambda at the constrained particles.
+      if (!cons.empty()) {
+        if (free)
+          free->band.multiply(lambda, a_lambda, threads);
+        else
+          a_lambda.noalias() = a * lambda;
+      }
+      for (const Constraint& c : cons) {
+        const int i = c.particle;
+        const Vec3 zb = particle(dvb, i) - particle(a_lambda, i);
+        const Vec3& nn = c.normal;
+        switch (c.kind) {
+          case ConstraintKind::kPin: {  // z = v_path - v0
+            particle(v0b, i) -= zb;
+            const int p = driven[i];
+            if (p >= 0) vel_bar[p] += zb;
+            break;
+          }
+          case ConstraintKind::kStick:  // z = u_t + (-d(x0) / h) n - v0
+            particle(v0b, i) -= zb;
+            particle(x0b, i) -= (nn.dot(zb) / h) * nn;
+            break;
+          case ConstraintKind::kSlide: {  // z = (-d(x0) / h - v0.n) n; rhs -= c P_t (v0 - u)
+            particle(v0b, i) -= nn.dot(zb) * nn;
+            particle(x0b, i) -= (nn.dot(zb) / h) * nn;
+            const Vec3 l = particle(lambda, i);
+            particle(v0b, i) -= c.viscosity * (l - l.dot(nn) * nn);
+            break;
+          }
         }
       }
-    }
-    for (int p = 0; p < pins; ++p) {
-      const int i = problem.driven_pins[p];
-      out.pin_targets[static_cast<size_t>(k) * pins + p] += vel_bar[p] / h;
-      particle(x0b, i) -= vel_bar[p] / h;
-    }
-    // phi = lambda^T (b - A dv) with b = h (f + h K v), A = M - h D - h^2 K at (x0, v0), lambda
-    // and dv held: its derivatives with respect to x0, v0 and the parameters.
-    // Masses and gravity: phi_i = m_i lambda_i . (h g - dv_i).
-    for (int i = 0; i < np; ++i) {
-      const Vec3 l = particle(lambda, i);
-      out.particle_mass[particle_body[i]] += l.dot(h * model.gravity - particle(r.dv, i));
-      out.gravity += (h * model.mass[i]) * l;
-    }
-    // Springs, per spring with d = xa - xb, L = |d|, u = d / L, w = va - vb, and the differences
-    // l, e of lambda and dv at its ends (q = w + e):
-    //   phi / h = -ks (L - l0) a - kd a (c + be) - h ks a g + h s E,
-    //   a = l.u, be = e.u, g = q.u, c = w.u, E = a g - l.q,
-    //   s = ks (1 - l0/L) + kd c / L, each term as the definiteness fix clamps it.
-    for (int sp = 0; sp < springs.size(); ++sp) {
-      const int ia = springs.a[sp], ib = springs.b[sp];
-      const Vec3 d = particle(r.x, ia) - particle(r.x, ib);
-      const Real length = d.norm();
-      const Real l0 = rest[sp];
-      if (!(length > kDegenerateLength * l0)) continue;  // collapsed: not differentiated
-      const Real ks = springs.ks[sp], kd = springs.kd[sp];
-      const Real inv = 1 / length;
-      const Vec3 u = d * inv;
-      const Vec3 l = particle(lambda, ia) - particle(lambda, ib);
-      const Vec3 e = particle(r.dv, ia) - particle(r.dv, ib);
-      const Vec3 w = particle(r.v, ia) - particle(r.v, ib);
-      const Vec3 q = w + e;
-      const Real al = l.dot(u), be = e.dot(u), ga = q.dot(u), c = w.dot(u), lq = l.dot(q);
-      const Real s1 = ks * (1 - l0 * inv), s2 = kd * c * inv;
-      bool on1 = true, on2 = true;
-      if (options.definiteness == DefinitenessFix::kClampCompressed) {
-        on1 = s1 > 0;
-        on2 = s2 > 0;
-      } else if (options.definiteness == DefinitenessFix::kProjectPsd) {
-        on1 = on2 = s1 + s2 > 0;
+      for (int p = 0; p < pins; ++p) {
+        const int i = problem.driven_pins[p];
+        out.pin_targets[static_cast<size_t>(k) * pins + p] += vel_bar[p] / h;
+        particle(x0b, i) -= vel_bar[p] / h;
       }
-      const Real s = (on1 ? s1 : 0) + (on2 ? s2 : 0);
-      const Real big_e = al * ga - lq;
-      const Vec3 pl = (l - al * u) * inv, pe = (e - be * u) * inv, pw = (w - c * u) * inv,
-                 pq = (q - ga * u) * inv;
-      Vec3 ds = Vec3::Zero();
-      if (on1) ds += (ks * l0 * inv * inv) * u;
-      if (on2) ds += (kd * inv) * (pw - c * inv * u);
-      const Vec3 de = ga * pl + al * pq;
-      const Vec3 grad_d = -ks * (al * u + (length - l0) * pl) -
-                          kd * ((c + be) * pl + al * (pw + pe)) - h * ks * de +
-                          h * (s * de + big_e * ds);
-      Vec3 grad_w = -kd * al * u - h * ks * al * u + h * s * (al * u - l);
-      if (on2) grad_w += (h * big_e * kd * inv) * u;
-      const Real grad_ks =
-          -(length - l0) * al - h * al * ga + (on1 ? h * big_e * (1 - l0 * inv) : 0);
-      const Real grad_kd = -al * (c + be) + (on2 ? h * big_e * c * inv : 0);
-      particle(x0b, ia) += h * grad_d;
-      particle(x0b, ib) -= h * grad_d;
-      particle(v0b, ia) += h * grad_w;
-      particle(v0b, ib) -= h * grad_w;
-      const size_t at = static_cast<size_t>(kSpringTypeCount) * spring_body[sp] +
-                        static_cast<size_t>(springs.type[sp]);
-      out.ks[at] += h * grad_ks;
-      out.kd[at] += h * grad_kd;
-    }
-    for (const Constraint& c : cons) slot[c.particle] = -1;
-    xb.swap(x0b);
-    vb.swap(v0b);
-    if (at_frame[k]) {
-      xb += dl_dx[k];
-      vb += dl_dv[k];
+      // phi = lambda^T (b - A dv) with b = h (f + h K v), A = M - h D - h^2 K at (x0, v0), lambda
+      // and dv held: its derivatives with respect to x0, v0 and the parameters.
+      // Masses and gravity: phi_i = m_i lambda_i . (h g - dv_i).
+      for (int i = 0; i < np; ++i) {
+        const Vec3 l = particle(lambda, i);
+        out.particle_mass[particle_body[i]] += l.dot(h * model.gravity - particle(r.dv, i));
+        out.gravity += (h * model.mass[i]) * l;
+      }
+      // Springs, per spring with d = xa - xb, L = |d|, u = d / L, w = va - vb, and the differences
+      // l, e of lambda and dv at its ends (q = w + e):
+      //   phi / h = -ks (L - l0) a - kd a (c + be) - h ks a g + h s E,
+      //   a = l.u, be = e.u, g = q.u, c = w.u, E = a g - l.q,
+      //   s = ks (1 - l0/L) + kd c / L, each term as the definiteness fix clamps it.
+      for (int sp = 0; sp < springs.size(); ++sp) {
+        const int ia = springs.a[sp], ib = springs.b[sp];
+        const Vec3 d = particle(r.x, ia) - particle(r.x, ib);
+        const Real length = d.norm();
+        const Real l0 = rest[sp];
+        if (!(length > kDegenerateLength * l0)) continue;  // collapsed: not differentiated
+        const Real ks = springs.ks[sp], kd = springs.kd[sp];
+        const Real inv = 1 / length;
+        const Vec3 u = d * inv;
+        const Vec3 l = particle(lambda, ia) - particle(lambda, ib);
+        const Vec3 e = particle(r.dv, ia) - particle(r.dv, ib);
+        const Vec3 w = particle(r.v, ia) - particle(r.v, ib);
+        const Vec3 q = w + e;
+        const Real al = l.dot(u), be = e.dot(u), ga = q.dot(u), c = w.dot(u), lq = l.dot(q);
+        const Real s1 = ks * (1 - l0 * inv), s2 = kd * c * inv;
+        bool on1 = true, on2 = true;
+        if (options.definiteness == DefinitenessFix::kClampCompressed) {
+          on1 = s1 > 0;
+          on2 = s2 > 0;
+        } else if (options.definiteness == DefinitenessFix::kProjectPsd) {
+          on1 = on2 = s1 + s2 > 0;
+        }
+        const Real s = (on1 ? s1 : 0) + (on2 ? s2 : 0);
+        const Real big_e = al * ga - lq;
+        const Vec3 pl = (l - al * u) * inv, pe = (e - be * u) * inv, pw = (w - c * u) * inv,
+                   pq = (q - ga * u) * inv;
+        Vec3 ds = Vec3::Zero();
+        if (on1) ds += (ks * l0 * inv * inv) * u;
+        if (on2) ds += (kd * inv) * (pw - c * inv * u);
+        const Vec3 de = ga * pl + al * pq;
+        const Vec3 grad_d = -ks * (al * u + (length - l0) * pl) -
+                            kd * ((c + be) * pl + al * (pw + pe)) - h * ks * de +
+                            h * (s * de + big_e * ds);
+        Vec3 grad_w = -kd * al * u - h * ks * al * u + h * s * (al * u - l);
+        if (on2) grad_w += (h * big_e * kd * inv) * u;
+        const Real grad_ks =
+            -(length - l0) * al - h * al * ga + (on1 ? h * big_e * (1 - l0 * inv) : 0);
+        const Real grad_kd = -al * (c + be) + (on2 ? h * big_e * c * inv : 0);
+        particle(x0b, ia) += h * grad_d;
+        particle(x0b, ib) -= h * grad_d;
+        particle(v0b, ia) += h * grad_w;
+        particle(v0b, ib) -= h * grad_w;
+        const size_t at = static_cast<size_t>(kSpringTypeCount) * spring_body[sp] +
+                          static_cast<size_t>(springs.type[sp]);
+        out.ks[at] += h * grad_ks;
+        out.kd[at] += h * grad_kd;
+      }
+      for (const Constraint& c : cons) slot[c.particle] = -1;
+      xb.swap(x0b);
+      vb.swap(v0b);
+      if (at_frame[k]) {
+        xb += dl_dx[k];
+        vb += dl_dv[k];
+      }
     }
   }
+  if (end_of_run) sim.restore(std::move(*end_of_run));
   out.initial_position = xb;
   out.initial_velocity = vb;
   out.backward_seconds = seconds_since(start);

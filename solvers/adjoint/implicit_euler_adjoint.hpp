@@ -30,6 +30,11 @@ struct GradientProblem {
   // set_pin_target with velocity (target - x) / dt), so that it ends step k at its target.
   std::vector<int> driven_pins;
   std::vector<Vec3> pin_targets;  // [K * P]
+  // 0: every step's record is kept (x, v, dv: 9N doubles per step). S > 0: a snapshot of the
+  // simulator every S steps; the backward pass runs each segment again from its snapshot and
+  // keeps S steps' records at a time (one more forward run; the same result for the backends
+  // that restart bit for bit: CHOLMOD, LDLT, block-Jacobi CG).
+  int checkpoint_every = 0;
 };
 
 struct GradientResult {
@@ -56,7 +61,8 @@ struct GradientResult {
 
 // Runs `simulator` (implicit_euler with newton_iterations = 1, from its current state) for
 // problem.steps steps and returns the loss and its gradient; the simulator is left at the end
-// of the run. The forward states are kept in memory (6N + 3N doubles per step: x, v, dv).
+// of the run. The forward states are kept in memory (9N doubles per step: x, v, dv), or
+// recomputed from checkpoints (GradientProblem::checkpoint_every).
 // Throws InputError for what the adjoint does not differentiate: another integrator, Newton
 // iterations, contact models other than coulomb inside the solve, contact between bodies, wind,
 // added forces, anchor springs, or a malformed problem; std::runtime_error when a step or a
