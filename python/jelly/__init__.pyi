@@ -639,5 +639,5 @@ def sweep(scene: Scene, parameters: Mapping[str, Sequence[Any]], client: Any = N
 def gradient(scene: Scene, duration: float,
              loss: Callable[[_FloatArray, _FloatArray], tuple[float, _FloatArray, _FloatArray]],
              wrt: Sequence[str], *, frames: Optional[Sequence[int]] = None,
-             pins: Sequence[int] = (), pin_targets: Optional[npt.ArrayLike] = None
-             ) -> tuple[float, dict[str, _FloatArray]]: ...
+             pins: Sequence[int] = (), pin_targets: Optional[npt.ArrayLike] = None,
+             checkpoint_every: int = 0) -> tuple[float, dict[str, _FloatArray]]: ...

@@ -23,7 +23,7 @@ def _steps(duration: float, dt: float) -> int:
 
 def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
              frames: Optional[Sequence[int]] = None, pins: Sequence[int] = (),
-             pin_targets: Any = None) -> tuple:
+             pin_targets: Any = None, checkpoint_every: int = 0) -> tuple:
     """The loss of a run of ``scene`` (implicit_euler) over ``duration`` seconds and its exact
     gradient (docs/gradients.md).
 
@@ -36,6 +36,9 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
       "bodies[i].positions" ((N_i, 3): each particle's initial state), "pin_targets" (K, P, 3).
     pins / pin_targets: pinned particles (global indices) driven by a control sequence: before
     step k pin p moves in a straight line to pin_targets[k, p] (K x P x 3), where it ends the step.
+    checkpoint_every: 0 keeps every step's state (9N doubles per step); S > 0 keeps a snapshot
+    every S steps and runs each segment again during the backward pass (one more forward run,
+    memory for S steps).
     Returns (value, {path: array}). Warns when sliding or bouncing contacts made the gradient
     approximate (their friction viscosity and restitution are held fixed).
     """
@@ -62,7 +65,7 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
         return loss(x, v)
 
     raw = _jelly._gradient(sim, steps, frame_loss, list(frames or []), pins,
-                           targets.reshape(-1, 3))
+                           targets.reshape(-1, 3), int(checkpoint_every))
     for count, what in ((raw["slide_steps"], "sliding contact's friction viscosity"),
                         (raw["bounce_steps"], "bouncing contact's restitution")):
         if count:

@@ -22,11 +22,12 @@ void bind_adjoint(py::module_& m) {
   m.def(
       "_gradient",
       [](Simulator& sim, int steps, py::function loss, std::vector<int> frames,
-         std::vector<int> pins, DoubleArray targets) {
+         std::vector<int> pins, DoubleArray targets, int checkpoint_every) {
         GradientProblem problem;
         problem.steps = steps;
         problem.loss_frames = std::move(frames);
         problem.driven_pins = std::move(pins);
+        problem.checkpoint_every = checkpoint_every;
         const size_t count = static_cast<size_t>(targets.size() / 3);
         require(targets.size() % 3 == 0, "pin_targets", targets.size(),
                 "an array of shape (steps, pins, 3)");
@@ -69,7 +70,7 @@ void bind_adjoint(py::module_& m) {
         return out;
       },
       py::arg("simulator"), py::arg("steps"), py::arg("loss"), py::arg("frames"), py::arg("pins"),
-      py::arg("pin_targets"),
+      py::arg("pin_targets"), py::arg("checkpoint_every") = 0,
       "Internal (jelly.gradient): runs `simulator` for `steps` steps and returns the loss and "
       "its gradient as a dict of arrays.");
 }

@@ -64,6 +64,9 @@ def test_every_kind_agrees_with_finite_differences():
     base = targets(scene)
     L, grads = jelly.gradient(scene, STEPS * DT, loss, wrt, pins=[pin], pin_targets=base)
     assert np.isclose(L, value(scene, base), rtol=1e-14)
+    L2, again = jelly.gradient(scene, STEPS * DT, loss, wrt, pins=[pin], pin_targets=base,
+                               checkpoint_every=3)
+    assert L2 == L and all(np.array_equal(again[p], grads[p]) for p in wrt)
     assert grads["gravity"].shape == (3,)
     assert grads["pin_targets"].shape == (STEPS, 1, 3)
     fixed = lambda e: base  # noqa: E731
