@@ -276,6 +276,14 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
               particle_body.begin() + body.end_particle(), b);
   }
   std::vector<int> slot(np, -1);
+  // The sliding contacts of the step after the current one: dL/d(their viscosity), to be traced
+  // to the current step's solve.
+  struct PendingViscosity {
+    int particle;
+    Real cbar, value;
+  };
+  std::vector<PendingViscosity> pending;
+  VecX e_vec = VecX::Zero(n), a_e(n);
   VecX xb = VecX::Zero(n), vb = VecX::Zero(n), x0b(n), v0b(n), dvb(n), mu = VecX::Zero(n),
        lambda(n), a_lambda(n), kw(n);
   if (at_frame[steps]) {
@@ -312,7 +320,6 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         if (c.kind == ConstraintKind::kPin) continue;
         ++out.contact_steps;
         if (c.bounces) ++out.bounce_steps;
-        if (c.kind == ConstraintKind::kSlide) ++out.slide_steps;
         auto w = particle(vb, c.particle);
         w -= c.normal * c.normal.dot(w);
       }
@@ -322,10 +329,71 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       v0b = dvb;
       // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
       // mu.
-      LinearResult solved;
       if (free) {
         if (!free->band.assemble(model, r.x, r.v, options.definiteness, h, h * h, r.v, kw, threads))
           throw std::runtime_error("gradient: a spring collapsed at step " + std::to_string(k));
+      } else {
+        jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
+      }
+      // The next step's friction viscosities that this step's final solve set (ImplicitContact::
+      // update): a sliding contact's c = mu p_n / |(v1 - u)_t|, a sticking one's switch to sliding
+      // c = mu m p_n / (|p_t| - mu p_n), with p = (A dv - b)_i. Their adjoints: v1 through the
+      // speed, and p through e: e^T (A dv - b) adds A e to dvb, and -e to lambda in phi below.
+      e_vec.setZero();
+      bool traced_any = false;
+      for (const PendingViscosity& pv : pending) {
+        const int ci = slot[pv.particle];
+        const Constraint* c = ci >= 0 ? &cons[ci] : nullptr;
+        bool traced = false;
+        if (c != nullptr && c->kind != ConstraintKind::kPin) {
+          const Vec3& nn = c->normal;
+          const Vec3 p = c->impulse;
+          const Real pn = p.dot(nn);
+          const Real m = model.mass[pv.particle];
+          if (c->kind == ConstraintKind::kSlide) {
+            const Vec3 w =
+                particle(r.v, pv.particle) + particle(r.dv, pv.particle) - c->surface_velocity;
+            const Vec3 wt = w - w.dot(nn) * nn;
+            const Real speed = wt.norm();
+            const Real value = c->friction * pn / std::max(speed, 1e-300);
+            if (value == pv.value && speed > 0) {
+              traced = true;
+              const Vec3 speed_bar = (-pv.cbar * value / speed / speed) * wt;
+              particle(dvb, pv.particle) += speed_bar;
+              particle(v0b, pv.particle) += speed_bar;
+              particle(e_vec, pv.particle) += (pv.cbar * c->friction / speed) * nn;
+            }
+          } else {
+            const Vec3 pt = p - pn * nn;
+            const Real pt_norm = pt.norm();
+            const Real force = c->friction * pn;
+            if (pt_norm > c->static_friction * pn && pt_norm > force) {
+              const Real value = force * m / (pt_norm - force);
+              if (value == pv.value) {
+                traced = true;
+                const Real d = pt_norm - force;
+                const Real d_pn = (c->friction * m / d) * (1 + force / d);
+                const Real d_pt = -value / d;
+                particle(e_vec, pv.particle) += pv.cbar * (d_pn * nn + d_pt * pt / pt_norm);
+                out.particle_mass[particle_body[pv.particle]] += pv.cbar * value / m;
+              }
+            }
+          }
+        }
+        traced_any = traced_any || traced;
+        if (!traced && pv.value != 0) ++out.slide_steps;
+      }
+      if (traced_any) {
+        if (free)
+          free->band.multiply(e_vec, a_e, threads);
+        else
+          a_e.noalias() = a * e_vec;
+        dvb += a_e;
+      }
+      // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
+      // mu.
+      LinearResult solved;
+      if (free) {
         free->projectors.resize(9 * cons.size());
         free->viscosities.resize(cons.size());
         for (size_t ci = 0; ci < cons.size(); ++ci) {
@@ -351,7 +419,6 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
               mu, options.cg_tolerance, options.cg_max_iterations, threads);
         }
       } else {
-        jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
         std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
         adjoint_filter_system(filtered, cons, slot);
         solved = solver->factorize(filtered);
@@ -400,6 +467,16 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         out.pin_targets[static_cast<size_t>(k) * pins + p] += vel_bar[p] / h;
         particle(x0b, i) -= vel_bar[p] / h;
       }
+      // The sliding contacts' viscosity c: Af's C = c P_t and rhs's -c P_t (v0 - u) give
+      // dL/dc = -lambda_i . (v1 - u)_t, sent to the step whose solve set c (the previous one).
+      pending.clear();
+      for (const Constraint& c : cons) {
+        if (c.kind != ConstraintKind::kSlide) continue;
+        const Vec3 w = particle(r.v, c.particle) + particle(r.dv, c.particle) - c.surface_velocity;
+        const Vec3 wt = w - w.dot(c.normal) * c.normal;
+        pending.push_back({c.particle, -particle(lambda, c.particle).dot(wt), c.viscosity});
+      }
+      if (traced_any) lambda -= e_vec;
       // phi = lambda^T (b - A dv) with b = h (f + h K v), A = M - h D - h^2 K at (x0, v0), lambda
       // and dv held: its derivatives with respect to x0, v0 and the parameters.
       // Masses and gravity: phi_i = m_i lambda_i . (h g - dv_i).
@@ -469,6 +546,8 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       }
     }
   }
+  for (const PendingViscosity& pv : pending)  // the first step's: set before the run
+    if (pv.value != 0) ++out.slide_steps;
   if (end_of_run) sim.restore(std::move(*end_of_run));
   out.initial_position = xb;
   out.initial_velocity = vb;

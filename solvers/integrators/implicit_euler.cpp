@@ -157,6 +157,8 @@ struct ImplicitEuler::Impl {
         r.viscosity = r.kind == Kind::kSlide ? c.viscosity : 0.0;
         const ContactParams& params = terrains[c.terrain]->contact();
         r.bounces = params.restitution > 0 && c.approach > params.resting_speed;
+        r.friction = params.friction;
+        r.static_friction = params.static_friction;
       }
       solved_constraints_.push_back(r);
     }
@@ -714,6 +716,14 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     }
   }
   have_dv_ = true;
+  // The impulses the final solve's update found (same particles in the same order, or the
+  // solved set kept when the set was still changing at the last solve).
+  size_t j = 0;
+  for (const ImplicitContact::Contact& c : contact_.contacts()) {
+    while (j < solved_constraints_.size() && solved_constraints_[j].particle != c.particle) ++j;
+    if (j == solved_constraints_.size()) break;
+    solved_constraints_[j++].impulse = c.impulse;
+  }
   return StepResult::success();
 }
 

@@ -68,6 +68,10 @@ class ImplicitEuler final : public Integrator {
     Vec3 surface_velocity = Vec3::Zero();
     Real viscosity = 0;    // sliding only
     bool bounces = false;  // restitution changes its velocity at the end of the step
+    Real friction = 0, static_friction = 0;  // the terrain's mu and mu_s
+    // The constraint impulse p = (A dv - b) of the particle after the solve (the next step's
+    // friction viscosity comes from it).
+    Vec3 impulse = Vec3::Zero();
   };
   // The constraints of the last step's final solve (empty when it had none).
   const std::vector<SolvedConstraint>& last_constraints() const;
