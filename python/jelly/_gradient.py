@@ -66,7 +66,8 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
 
     raw = _jelly._gradient(sim, steps, frame_loss, list(frames or []), pins,
                            targets.reshape(-1, 3), int(checkpoint_every))
-    for count, what in ((raw["slide_steps"], "sliding contact's friction viscosity"),
+    for count, what in ((raw["slide_steps"], "sliding contact's friction viscosity (set by its "
+                         "prediction or an earlier solve of the step)"),
                         (raw["bounce_steps"], "bouncing contact's restitution")):
         if count:
             warnings.warn(f"jelly.gradient: {count} particle-step(s) held a {what} fixed; the "
