@@ -23,6 +23,7 @@ from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module f
     write_xdmf_for_recording)
 from ._scene import Scene, load_scene
 from ._sweep import sweep, sweep_points
+from ._gradient import gradient
 
 _FIT_KEYWORDS = ("free", "window", "initial", "max_iterations", "function_tolerance",
                  "gradient_tolerance", "parameter_tolerance", "fit_restart_velocities",

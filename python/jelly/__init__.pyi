@@ -636,3 +636,8 @@ def sweep(scene: Scene, parameters: Mapping[str, Sequence[Any]], client: Any = N
           out_dir: Optional[_PathLike] = "sweep", duration: Optional[float] = None,
           recorder_options: Optional[dict[str, Any]] = None,
           n_workers: Optional[int] = None, overwrite: bool = False) -> pandas.DataFrame: ...
+def gradient(scene: Scene, duration: float,
+             loss: Callable[[_FloatArray, _FloatArray], tuple[float, _FloatArray, _FloatArray]],
+             wrt: Sequence[str], *, frames: Optional[Sequence[int]] = None,
+             pins: Sequence[int] = (), pin_targets: Optional[npt.ArrayLike] = None,
+             checkpoint_every: int = 0) -> tuple[float, dict[str, _FloatArray]]: ...

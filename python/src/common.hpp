@@ -122,5 +122,6 @@ void bind_terrain(py::module_& m);
 void bind_solvers(py::module_& m);
 void bind_io(py::module_& m);
 void bind_fit(py::module_& m);
+void bind_adjoint(py::module_& m);
 
 }  // namespace jelly::python

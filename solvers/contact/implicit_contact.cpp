@@ -444,6 +444,7 @@ bool ImplicitContact::update_impl(const Terrains& terrains, const VecX& dv, bool
     const Vec3& n = c.normal;
     const Real pn = p.dot(n);
     c.normal_impulse = pn;
+    c.impulse = p;
     c.release = false;  // decided again by this solve
     if (pn < 0) {       // the surface would have to pull: let go
       // A particle that does not move towards its surface (n.v1 >= 0 prescribed) is pulled

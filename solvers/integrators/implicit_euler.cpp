@@ -140,6 +140,29 @@ struct ImplicitEuler::Impl {
   // with `resume` (matrix-free only) from the last solve's system and preconditioner.
   StepResult factorize_and_solve(const Model& model, const VecX& b, VecX& y, bool constrained,
                                  Real t, Real cg_tolerance = 0, bool resume = false);
+  // solved_constraints_ = the contact set about to be solved (empty when unconstrained).
+  void record_constraints(bool constrained, const Terrains& terrains) {
+    solved_constraints_.clear();
+    if (!constrained) return;
+    using Kind = ImplicitEuler::SolvedConstraint::Kind;
+    for (const ImplicitContact::Contact& c : contact_.contacts()) {
+      ImplicitEuler::SolvedConstraint r;
+      r.particle = c.particle;
+      if (c.pinned) {
+        r.kind = Kind::kPin;
+      } else {
+        r.kind = c.mode == ImplicitContact::Mode::kSlide ? Kind::kSlide : Kind::kStick;
+        r.normal = c.normal;
+        r.surface_velocity = c.surface_velocity;
+        r.viscosity = r.kind == Kind::kSlide ? c.viscosity : 0.0;
+        const ContactParams& params = terrains[c.terrain]->contact();
+        r.bounces = params.restitution > 0 && c.approach > params.resting_speed;
+        r.friction = params.friction;
+        r.static_friction = params.static_friction;
+      }
+      solved_constraints_.push_back(r);
+    }
+  }
   // Newton corrections on the nonlinear backward-Euler equations from v1_.
   StepResult newton(const Dynamics& dynamics, const State& s, Real h);
   // Wind drag at time t: d(f)/d(v) = -drag on its particles, so A gains h drag on the diagonal
@@ -199,6 +222,8 @@ struct ImplicitEuler::Impl {
   Real last_h_ = 0;
   bool have_dv_ = false;
   std::vector<Real> residuals_;
+  // The constraints of the last solve of the step (for the adjoint).
+  std::vector<ImplicitEuler::SolvedConstraint> solved_constraints_;
   bool converged_ = true;
   long newton_iterations_ = 0;
   long newton_not_converged_ = 0;
@@ -227,6 +252,14 @@ const ImplicitEulerOptions& ImplicitEuler::options() const { return impl_->optio
 const std::vector<Real>& ImplicitEuler::last_residuals() const { return impl_->residuals_; }
 
 bool ImplicitEuler::last_converged() const { return impl_->converged_; }
+
+const std::vector<ImplicitEuler::SolvedConstraint>& ImplicitEuler::last_constraints() const {
+  return impl_->solved_constraints_;
+}
+
+const VecX& ImplicitEuler::last_velocity_change() const { return impl_->dv_; }
+
+bool ImplicitEuler::last_step_had_body_contact() const { return impl_->bodies_active_; }
 
 std::string_view ImplicitEuler::linear_solver_name() const {
   if (impl_->matrix_free_) return "cg_jacobi_matrix_free";
@@ -644,6 +677,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   // CG iteration this one continues (rhs_, z_ and the block inverses stay).
   const auto solve = [&](Real tolerance, bool resume) -> StepResult {
     const bool constrained = contact_active_ && contact_.has_constraints();
+    if (!resume) record_constraints(constrained, *terrains);
     if (constrained && !resume) constrain(b_, true, dv_);
     StepResult r = factorize_and_solve(model, constrained ? rhs_ : b_, dv_, constrained, s.t,
                                        tolerance, resume);
@@ -682,6 +716,14 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     }
   }
   have_dv_ = true;
+  // The impulses the final solve's update found (same particles in the same order, or the
+  // solved set kept when the set was still changing at the last solve).
+  size_t j = 0;
+  for (const ImplicitContact::Contact& c : contact_.contacts()) {
+    while (j < solved_constraints_.size() && solved_constraints_[j].particle != c.particle) ++j;
+    if (j == solved_constraints_.size()) break;
+    solved_constraints_[j++].impulse = c.impulse;
+  }
   return StepResult::success();
 }
 

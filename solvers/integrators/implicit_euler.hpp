@@ -56,6 +56,31 @@ class ImplicitEuler final : public Integrator {
   const std::vector<Real>& last_residuals() const;
   bool last_converged() const;
 
+  // A velocity constraint of the last step's final linear solve (docs/gradients.md), as the
+  // discrete adjoint (solvers/adjoint/) holds it fixed: a pin (v1 prescribed), a sticking contact
+  // (v1 prescribed: the surface's tangential velocity, the normal velocity that lands it) or a
+  // sliding one (normal velocity prescribed, friction viscosity on the tangent plane).
+  struct SolvedConstraint {
+    enum class Kind { kPin, kStick, kSlide };
+    int particle = 0;
+    Kind kind = Kind::kPin;
+    Vec3 normal = Vec3::UnitY();
+    Vec3 surface_velocity = Vec3::Zero();
+    Real viscosity = 0;    // sliding only
+    bool bounces = false;  // restitution changes its velocity at the end of the step
+    Real friction = 0, static_friction = 0;  // the terrain's mu and mu_s
+    // The constraint impulse p = (A dv - b) of the particle after the solve (the next step's
+    // friction viscosity comes from it).
+    Vec3 impulse = Vec3::Zero();
+  };
+  // The constraints of the last step's final solve (empty when it had none).
+  const std::vector<SolvedConstraint>& last_constraints() const;
+  // The last step's velocity change dv (v1 = v0 + dv before the contacts' end of step and the
+  // pins); with newton_iterations > 1, v1 - v0 of the last Newton iterate.
+  const VecX& last_velocity_change() const;
+  // Whether the last step's solve held contact pairs between bodies.
+  bool last_step_had_body_contact() const;
+
  protected:
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;
 

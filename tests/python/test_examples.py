@@ -52,3 +52,13 @@ def test_stable_dt_sweep(tmp_path):
               cwd=tmp_path)
     assert "largest stable dt" in out
     assert (tmp_path / "stable_dt.png").exists() and (tmp_path / "stable_dt.csv").exists()
+
+
+def test_throw_with_pin(tmp_path):
+    out = run("throw_with_pin.py", "--iterations", "40", cwd=tmp_path)
+    line = next(l for l in out.splitlines() if l.startswith("miss distance"))
+    held = float(line.split("held still ")[1].split()[0])
+    optimised = float(line.split("optimised ")[1].split()[0])
+    # The exact gradients take L-BFGS-B to a swing that lands the jelly three times closer.
+    assert optimised < held / 2.5, line
+    assert "allowed 0.15 m" in out

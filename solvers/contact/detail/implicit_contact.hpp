@@ -58,10 +58,11 @@ class ImplicitContact {
     // Sliding: friction impulse -viscosity (v1 - u)_t, implicit in the solve, with
     // viscosity = mu p_n / |(v1 - u)_t| iterated; always against the sliding.
     Real viscosity = 0;
-    Real normal_impulse = 0;  // p_n of the last solve
-    bool release = false;     // held for this step (pulled without work), free at the next
-    Real approach = 0;        // -(v0 - u).n at the start of the step
-    bool pinned = false;      // a pinned particle: v1 = target_velocity, terrain -1
+    Real normal_impulse = 0;      // p_n of the last solve
+    Vec3 impulse = Vec3::Zero();  // p of the last solve (the adjoint's friction path)
+    bool release = false;         // held for this step (pulled without work), free at the next
+    Real approach = 0;            // -(v0 - u).n at the start of the step
+    bool pinned = false;          // a pinned particle: v1 = target_velocity, terrain -1
     Vec3 target_velocity = Vec3::Zero();
   };
 

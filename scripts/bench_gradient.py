@@ -1,0 +1,82 @@
+#!/usr/bin/python3
+"""The cost of one exact gradient (jelly.gradient, docs/gradients.md) against the forward run
+alone: a cube of n^3 particles dropped onto a coulomb floor (implicit_euler, dt = 10 ms),
+`steps` steps, loss on the final state. Three runs alternate in one process, `repeats` times:
+the forward run (jelly.Simulator(scene) and sim.step() `steps` times), the gradient with respect
+to 10 parameters (ks and kd of the 3 spring types, gravity, the particle mass) and with respect to
+every particle's initial velocity (3 n^3 parameters). Prints best and median seconds and the
+ratios of the medians.
+
+    PYTHONPATH=build/python /usr/bin/python3 scripts/bench_gradient.py [n] [steps] [repeats]
+"""
+
+import argparse
+import os
+import statistics
+import time
+
+import numpy as np
+
+import jelly
+
+
+def scene(n):
+    return jelly.Scene({
+        "bodies": [{"kind": "cube", "name": "jelly", "n": n, "edge_length": 1.0,
+                    "origin": [-0.5, 0.05, -0.5], "particle_mass": 0.05,
+                    "velocity": [0.5, -1.0, 0.0],
+                    "springs": {t: {"ks": 2000, "kd": 2} for t in
+                                ("structural", "shear", "bending")}}],
+        "gravity": [0, -9.8, 0],
+        "terrains": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0],
+                      "contact": {"model": "coulomb", "restitution": 0, "friction": 1,
+                                  "static_friction": 1}}],
+        "integrator": {"name": "implicit_euler", "dt": 0.01},
+        "threads": 1,
+        "duration": 1,
+    })
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("n", type=int, nargs="?", default=20, help="particles per edge")
+    parser.add_argument("steps", type=int, nargs="?", default=20)
+    parser.add_argument("repeats", type=int, nargs="?", default=3)
+    args = parser.parse_args()
+    n, steps, repeats = args.n, args.steps, args.repeats
+    s = scene(n)
+    dt = 0.01
+
+    def loss(x, v):
+        return float(x[:, 0].sum() + 0.5 * (v * v).sum()), np.tile([1.0, 0, 0], (len(x), 1)), v
+
+    def forward():
+        sim = jelly.Simulator(s)
+        sim.set_threads(1)
+        for _ in range(steps):
+            sim.step()
+
+    ten = ["bodies[0].springs.%s.%s" % (t, k) for t in ("structural", "shear", "bending")
+           for k in ("ks", "kd")] + ["gravity", "bodies[0].mass"]
+    runs = {
+        "forward": forward,
+        "gradient, 10 parameters": lambda: jelly.gradient(s, steps * dt, loss, ten),
+        "gradient, %d parameters" % (3 * n ** 3):
+            lambda: jelly.gradient(s, steps * dt, loss, ["bodies[0].velocities"]),
+    }
+    times = {name: [] for name in runs}
+    for _ in range(repeats):
+        for name, run in runs.items():
+            start = time.perf_counter()
+            run()
+            times[name].append(time.perf_counter() - start)
+    print(f"n = {n} ({n ** 3} particles), {steps} steps, load average "
+          f"{os.getloadavg()[0]:.2f}")
+    base = statistics.median(times["forward"])
+    for name, t in times.items():
+        print(f"{name:32s} best {min(t):8.3f} s  median {statistics.median(t):8.3f} s  "
+              f"ratio {statistics.median(t) / base:5.2f}")
+
+
+if __name__ == "__main__":
+    main()

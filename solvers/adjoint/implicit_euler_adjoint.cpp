@@ -1,0 +1,558 @@
+#include <jelly/solvers/adjoint/implicit_euler_adjoint.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include <optional>
+
+#include <jelly/core/detail/band_system.hpp>
+#include <jelly/core/detail/clock.hpp>
+#include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/detail/spring_bands.hpp>
+#include <jelly/core/errors.hpp>
+#include <jelly/core/forces.hpp>
+#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/ldlt_solver.hpp>
+#include <jelly/solvers/simulator.hpp>
+
+namespace jelly {
+
+namespace {
+
+using Mat3 = Eigen::Matrix3d;
+using Constraint = ImplicitEuler::SolvedConstraint;
+using ConstraintKind = ImplicitEuler::SolvedConstraint::Kind;
+
+// The projector S_c onto the free directions of a constrained particle (zero for a pin or a
+// sticking contact, the tangent plane for a sliding one).
+Mat3 adjoint_free_projector(const Constraint& c) {
+  if (c.kind != ConstraintKind::kSlide) return Mat3::Zero();
+  return Mat3::Identity() - c.normal * c.normal.transpose();
+}
+
+// Block (i, j) of a full-storage matrix of dense 3x3 blocks with sorted rows: the value index of
+// its entry (3 i, 3 j) and the distance between its columns.
+struct AdjointBlock {
+  int at, stride;
+};
+AdjointBlock adjoint_block(const SparseMatrix& a, int i, int j) {
+  const int* outer = a.outerIndexPtr();
+  const int* rows = a.innerIndexPtr();
+  const int* found = std::lower_bound(rows + outer[3 * j], rows + outer[3 * j + 1], 3 * i);
+  return {static_cast<int>(found - rows), outer[3 * j + 1] - outer[3 * j]};
+}
+Mat3 adjoint_read(const SparseMatrix& a, const AdjointBlock& b) {
+  Mat3 m;
+  for (int q = 0; q < 3; ++q)
+    for (int r = 0; r < 3; ++r) m(r, q) = a.valuePtr()[b.at + q * b.stride + r];
+  return m;
+}
+void adjoint_write(SparseMatrix& a, const AdjointBlock& b, const Mat3& m) {
+  for (int q = 0; q < 3; ++q)
+    for (int r = 0; r < 3; ++r) a.valuePtr()[b.at + q * b.stride + r] = m(r, q);
+}
+
+// a -> S a S + C + I - S for the step's constraints, as ImplicitContact::constrain filters the
+// forward system (`slot`: index into `cons` per particle, or -1; C = viscosity S on a sliding
+// contact's diagonal block).
+void adjoint_filter_system(SparseMatrix& a, const std::vector<Constraint>& cons,
+                           const std::vector<int>& slot) {
+  const int* outer = a.outerIndexPtr();
+  const int* rows = a.innerIndexPtr();
+  for (const Constraint& c : cons) {
+    const int j = c.particle;
+    const Mat3 sj = adjoint_free_projector(c);
+    for (int at = outer[3 * j]; at < outer[3 * j + 1]; at += 3) {
+      const int i = rows[at] / 3;
+      const AdjointBlock bij = adjoint_block(a, i, j);
+      const Mat3 block = adjoint_read(a, bij);
+      if (i == j) {
+        const Real viscosity = c.kind == ConstraintKind::kSlide ? c.viscosity : 0.0;
+        adjoint_write(a, bij, sj * block * sj + viscosity * sj + Mat3::Identity() - sj);
+        continue;
+      }
+      const Mat3 si = slot[i] >= 0 ? adjoint_free_projector(cons[slot[i]]) : Mat3::Identity();
+      const Mat3 filtered = si * block * sj;
+      adjoint_write(a, bij, filtered);
+      adjoint_write(a, adjoint_block(a, j, i), filtered.transpose());
+    }
+  }
+}
+
+// The solver of the backward pass: the forward step's own kind (a direct factorization, or CG
+// with the same preconditioner).
+std::unique_ptr<LinearSolver> adjoint_backward_solver(std::string_view forward,
+                                                      const ImplicitEulerOptions& o,
+                                                      std::string& name) {
+  CholmodOptions cholmod;
+  cholmod.ordering = o.ordering;
+  if (forward == "cholmod") {
+    name = "cholmod";
+    return std::make_unique<CholmodSolver>(cholmod);
+  }
+  if (forward == "ldlt") {
+    name = "ldlt";
+    return std::make_unique<LdltSolver>();
+  }
+  CgOptions cg;
+  cg.preconditioner = forward == "cg_lagged_cholmod" ? CgPreconditioner::kLaggedCholesky
+                                                     : CgPreconditioner::kJacobi;
+  cg.tolerance = o.cg_tolerance;
+  cg.max_iterations = o.cg_max_iterations;
+  cg.refactor_iterations = o.refactor_iterations;
+  cg.cholmod = cholmod;
+  name = forward == "cg_lagged_cholmod" ? "cg_lagged_cholmod" : "cg_jacobi";
+  return std::make_unique<CgSolver>(cg);
+}
+
+// The filtered diagonal block S D S + C + I - S of a constrained particle (row-major, in place).
+void adjoint_filter_block(const Constraint& c, Real block[9]) {
+  Mat3 d;
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) d(r, q) = block[3 * r + q];
+  const Mat3 s = adjoint_free_projector(c);
+  const Real viscosity = c.kind == ConstraintKind::kSlide ? c.viscosity : 0.0;
+  const Mat3 f = s * d * s + viscosity * s + Mat3::Identity() - s;
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) block[3 * r + q] = f(r, q);
+}
+
+// The backward solves of a step whose forward solve was the matrix-free block-Jacobi CG: the same
+// system (BandSystem, in the same precision), filtered the same way, and the same preconditioner.
+struct MatrixFreeBackward {
+  SpringBands bands;
+  BandSystem band;
+  MatrixFreeCg cg;
+  std::vector<Real> projectors, viscosities;
+  MatrixFreeBackward(const Model& model, bool single)
+      : bands(model), band(bands, model.num_particles(), single) {}
+};
+
+// What one forward step leaves for the backward pass.
+struct StepRecord {
+  VecX x, v, dv;  // the state at the start of the step, and its velocity change
+  std::vector<Constraint> constraints;
+};
+
+void adjoint_check_supported(const Simulator& sim, const ImplicitEuler& ie) {
+  const ImplicitEulerOptions& o = ie.options();
+  require(o.newton_iterations == 1, "integrator.newton_iterations", o.newton_iterations,
+          "1 for gradients (the adjoint differentiates the linearized step)");
+  const Model& model = sim.model();
+  require(model.external_forces.empty(), "external_forces", model.external_forces.size(),
+          "none for gradients (wind is not differentiated yet)");
+  require(sim.forces().empty(), "added forces", sim.forces().size(),
+          "none for gradients (forces' parameters are not differentiated yet)");
+  require(sim.anchors().empty(), "anchors", sim.anchors().size(), "none for gradients");
+  for (int k = 0; k < static_cast<int>(sim.terrains().size()); ++k) {
+    const ContactParams& c = sim.terrains()[k]->contact();
+    require(c.model == ContactModel::kCoulomb && o.contact == ImplicitContactMode::kImplicit,
+            "terrains[" + std::to_string(k) + "].contact.model", contact_model_name(c.model),
+            "\"coulomb\" with the integrator's contact = \"implicit\" for gradients");
+  }
+}
+
+}  // namespace
+
+GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& problem) {
+  auto* ie = dynamic_cast<ImplicitEuler*>(&sim.integrator());
+  require(ie != nullptr, "integrator", sim.integrator().name(), "implicit_euler for gradients");
+  adjoint_check_supported(sim, *ie);
+  const int steps = problem.steps;
+  require(steps >= 1, "steps", steps, "an integer >= 1");
+  require(problem.checkpoint_every >= 0, "checkpoint_every", problem.checkpoint_every,
+          "0 (store every step) or a number of steps >= 1");
+  require(static_cast<bool>(problem.loss), "loss", "none", "a function");
+  const int np = sim.model().num_particles();
+  const int n = 3 * np;
+  const int pins = static_cast<int>(problem.driven_pins.size());
+  require(problem.pin_targets.size() == static_cast<size_t>(steps) * pins, "pin_targets",
+          problem.pin_targets.size(), "steps x driven pins = " + std::to_string(steps * pins));
+  std::vector<int> driven(np, -1);
+  for (int p = 0; p < pins; ++p) {
+    const int particle = problem.driven_pins[p];
+    require(particle >= 0 && particle < np && sim.model().pins.find(particle) >= 0,
+            "driven_pins[" + std::to_string(p) + "]", particle, "a pinned particle");
+    require(driven[particle] < 0, "driven_pins[" + std::to_string(p) + "]", particle,
+            "each pinned particle once");
+    driven[particle] = p;
+  }
+  std::vector<char> at_frame(steps + 1, 0);
+  if (problem.loss_frames.empty()) at_frame[steps] = 1;
+  for (int f : problem.loss_frames) {
+    require(f >= 0 && f <= steps, "loss_frames", f, "frames 0 to " + std::to_string(steps));
+    at_frame[f] = 1;
+  }
+
+  GradientResult out;
+  const Real h = sim.options().dt;
+  // Forward: the states, velocity changes, constraint sets and the loss terms' derivatives.
+  auto start = Clock::now();
+  // Stored steps: all of them, or with checkpoints one segment's (recomputed backwards).
+  const int every = problem.checkpoint_every;
+  const int segment = every > 0 ? std::min(every, steps) : steps;
+  std::vector<StepRecord> records(segment);
+  std::vector<SimulatorSnapshot> checkpoints;
+  std::vector<VecX> dl_dx(steps + 1), dl_dv(steps + 1);
+  const auto evaluate = [&](int frame) {
+    if (!at_frame[frame]) return;
+    dl_dx[frame].setZero(n);
+    dl_dv[frame].setZero(n);
+    const Real value = problem.loss(frame, sim.state(), dl_dx[frame], dl_dv[frame]);
+    require(std::isfinite(value) && dl_dx[frame].allFinite() && dl_dv[frame].allFinite(),
+            "loss at frame " + std::to_string(frame), value, "finite values and derivatives");
+    out.loss += value;
+  };
+  // Step k of the run, recorded into r.
+  const auto forward_step = [&](int k, StepRecord& r) {
+    r.x = sim.state().x;
+    r.v = sim.state().v;
+    for (int p = 0; p < pins; ++p) {
+      const int i = problem.driven_pins[p];
+      const Vec3 now = particle(r.x, i);
+      const Vec3& target = problem.pin_targets[static_cast<size_t>(k) * pins + p];
+      sim.set_pin_target(i, now, (target - now) / h);
+    }
+    const StepResult result = sim.step();
+    if (!result.ok)
+      throw std::runtime_error("gradient: step " + std::to_string(k) +
+                               " failed: " + result.message);
+    const auto* integrator = dynamic_cast<const ImplicitEuler*>(&sim.integrator());
+    if (integrator->last_step_had_body_contact())
+      throw InputError("gradient: contact between bodies at step " + std::to_string(k) +
+                       " is not differentiated yet");
+    r.dv = integrator->last_velocity_change();
+    r.constraints = integrator->last_constraints();
+  };
+  evaluate(0);
+  for (int k = 0; k < steps; ++k) {
+    if (every > 0 && k % segment == 0) checkpoints.push_back(sim.snapshot());
+    forward_step(k, records[every > 0 ? 0 : k]);
+    evaluate(k + 1);
+  }
+  std::optional<SimulatorSnapshot> end_of_run;
+  if (every > 0) end_of_run = sim.snapshot();
+  out.forward_seconds = seconds_since(start);
+
+  // Backward: per step from the last, the adjoint of
+  //   dv = y + z,  (S A S + C + I - S) y = S (b - A z - C w0),  v1 = v0 + dv,  x1 = x0 + h v1,
+  // then the contacts' normal velocity zeroed and the pins set on their paths.
+  start = Clock::now();
+  const Model& model = sim.model();
+  const ImplicitEulerOptions& options = ie->options();
+  JacobianOptions jacobian_options;
+  jacobian_options.definiteness = options.definiteness;
+  const int threads = std::max(1, sim.options().threads);
+  // The matrix-free forward path: its own system and preconditioner; else an assembled matrix.
+  std::optional<MatrixFreeBackward> free;
+  std::optional<SpringJacobian> jacobian;
+  SparseMatrix a, filtered;
+  std::unique_ptr<LinearSolver> solver;
+  if (ie->linear_solver_name() == "cg_jacobi_matrix_free") {
+    free.emplace(model, options.cg_tolerance >= 1e-6);
+    out.backward_solver = "cg_jacobi_matrix_free";
+  } else {
+    jacobian.emplace(model);
+    a = jacobian->make_matrix();
+    filtered = jacobian->make_matrix();
+    solver = adjoint_backward_solver(ie->linear_solver_name(), options, out.backward_solver);
+    if (LinearResult r = solver->analyze(a); !r.ok())
+      throw std::runtime_error("gradient: " + r.message);
+  }
+  const int bodies = model.num_bodies();
+  out.ks.assign(static_cast<size_t>(kSpringTypeCount) * bodies, 0.0);
+  out.kd.assign(out.ks.size(), 0.0);
+  out.particle_mass.assign(bodies, 0.0);
+  out.pin_targets.assign(problem.pin_targets.size(), Vec3::Zero());
+  std::vector<int> spring_body(model.springs.size(), 0), particle_body(np, 0);
+  for (int b = 0; b < bodies; ++b) {
+    const Body& body = model.bodies[b];
+    std::fill(spring_body.begin() + body.first_spring, spring_body.begin() + body.end_spring(), b);
+    std::fill(particle_body.begin() + body.first_particle,
+              particle_body.begin() + body.end_particle(), b);
+  }
+  std::vector<int> slot(np, -1);
+  // The sliding contacts of the step after the current one: dL/d(their viscosity), to be traced
+  // to the current step's solve.
+  struct PendingViscosity {
+    int particle;
+    Real cbar, value;
+  };
+  std::vector<PendingViscosity> pending;
+  VecX e_vec = VecX::Zero(n), a_e(n);
+  VecX xb = VecX::Zero(n), vb = VecX::Zero(n), x0b(n), v0b(n), dvb(n), mu = VecX::Zero(n),
+       lambda(n), a_lambda(n), kw(n);
+  if (at_frame[steps]) {
+    xb = dl_dx[steps];
+    vb = dl_dv[steps];
+  }
+  const Springs& springs = model.springs;
+  const Real* rest = springs.rest_length.data();
+  for (int begin = ((steps - 1) / segment) * segment; begin >= 0; begin -= segment) {
+    const int end = std::min(begin + segment, steps);
+    if (every > 0) {  // the segment's steps again, from its checkpoint
+      sim.restore(checkpoints[begin / segment]);
+      for (int k = begin; k < end; ++k) forward_step(k, records[k - begin]);
+    }
+    for (int k = end - 1; k >= begin; --k) {
+      const StepRecord& r = records[k - begin];
+      const std::vector<Constraint>& cons = r.constraints;
+      for (size_t ci = 0; ci < cons.size(); ++ci) slot[cons[ci].particle] = static_cast<int>(ci);
+      // The pins' end of step: x1 = target, v1 = (target - x0) / h for a driven pin (a path's,
+      // independent of the state, for the others); vel_bar collects dL/d(v1) of the driven pins.
+      std::vector<Vec3> vel_bar(pins, Vec3::Zero());
+      for (const Constraint& c : cons) {
+        if (c.kind != ConstraintKind::kPin) continue;
+        const int p = driven[c.particle];
+        if (p >= 0) {
+          out.pin_targets[static_cast<size_t>(k) * pins + p] += particle(xb, c.particle);
+          vel_bar[p] += particle(vb, c.particle);
+        }
+        particle(xb, c.particle).setZero();
+        particle(vb, c.particle).setZero();
+      }
+      // The contacts' end of step: (v1 - u).n = 0.
+      for (const Constraint& c : cons) {
+        if (c.kind == ConstraintKind::kPin) continue;
+        ++out.contact_steps;
+        if (c.bounces) ++out.bounce_steps;
+        auto w = particle(vb, c.particle);
+        w -= c.normal * c.normal.dot(w);
+      }
+      // x1 = x0 + h v1, v1 = v0 + dv.
+      x0b = xb;
+      dvb = vb + h * xb;
+      v0b = dvb;
+      // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
+      // mu.
+      if (free) {
+        if (!free->band.assemble(model, r.x, r.v, options.definiteness, h, h * h, r.v, kw, threads))
+          throw std::runtime_error("gradient: a spring collapsed at step " + std::to_string(k));
+      } else {
+        jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
+      }
+      // The next step's friction viscosities that this step's final solve set (ImplicitContact::
+      // update): a sliding contact's c = mu p_n / |(v1 - u)_t|, a sticking one's switch to sliding
+      // c = mu m p_n / (|p_t| - mu p_n), with p = (A dv - b)_i. Their adjoints: v1 through the
+      // speed, and p through e: e^T (A dv - b) adds A e to dvb, and -e to lambda in phi below.
+      e_vec.setZero();
+      bool traced_any = false;
+      for (const PendingViscosity& pv : pending) {
+        const int ci = slot[pv.particle];
+        const Constraint* c = ci >= 0 ? &cons[ci] : nullptr;
+        bool traced = false;
+        if (c != nullptr && c->kind != ConstraintKind::kPin) {
+          const Vec3& nn = c->normal;
+          const Vec3 p = c->impulse;
+          const Real pn = p.dot(nn);
+          const Real m = model.mass[pv.particle];
+          if (c->kind == ConstraintKind::kSlide) {
+            const Vec3 w =
+                particle(r.v, pv.particle) + particle(r.dv, pv.particle) - c->surface_velocity;
+            const Vec3 wt = w - w.dot(nn) * nn;
+            const Real speed = wt.norm();
+            const Real value = c->friction * pn / std::max(speed, 1e-300);
+            if (value == pv.value && speed > 0) {
+              traced = true;
+              const Vec3 speed_bar = (-pv.cbar * value / speed / speed) * wt;
+              particle(dvb, pv.particle) += speed_bar;
+              particle(v0b, pv.particle) += speed_bar;
+              particle(e_vec, pv.particle) += (pv.cbar * c->friction / speed) * nn;
+            }
+          } else {
+            const Vec3 pt = p - pn * nn;
+            const Real pt_norm = pt.norm();
+            const Real force = c->friction * pn;
+            if (pt_norm > c->static_friction * pn && pt_norm > force) {
+              const Real value = force * m / (pt_norm - force);
+              if (value == pv.value) {
+                traced = true;
+                const Real d = pt_norm - force;
+                const Real d_pn = (c->friction * m / d) * (1 + force / d);
+                const Real d_pt = -value / d;
+                particle(e_vec, pv.particle) += pv.cbar * (d_pn * nn + d_pt * pt / pt_norm);
+                out.particle_mass[particle_body[pv.particle]] += pv.cbar * value / m;
+              }
+            }
+          }
+        }
+        traced_any = traced_any || traced;
+        if (!traced && pv.value != 0) ++out.slide_steps;
+      }
+      if (traced_any) {
+        if (free)
+          free->band.multiply(e_vec, a_e, threads);
+        else
+          a_e.noalias() = a * e_vec;
+        dvb += a_e;
+      }
+      // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
+      // mu.
+      LinearResult solved;
+      if (free) {
+        free->projectors.resize(9 * cons.size());
+        free->viscosities.resize(cons.size());
+        for (size_t ci = 0; ci < cons.size(); ++ci) {
+          const Mat3 sc = adjoint_free_projector(cons[ci]);
+          std::copy(sc.data(), sc.data() + 9, free->projectors.data() + 9 * ci);
+          free->viscosities[ci] =
+              cons[ci].kind == ConstraintKind::kSlide ? cons[ci].viscosity : 0.0;
+        }
+        const ProductFilter filter =
+            cons.empty()
+                ? ProductFilter{}
+                : ProductFilter{slot.data(), free->projectors.data(), free->viscosities.data()};
+        solved = free->cg.set_diagonal_blocks(
+            np,
+            [&](int i, Real d[9]) {
+              free->band.diagonal_block(i, d);
+              if (slot[i] >= 0) adjoint_filter_block(cons[slot[i]], d);
+            },
+            threads);
+        if (solved.ok()) {
+          solved = free->cg.solve(
+              [&](const VecX& in, VecX& y) { free->band.multiply(in, y, threads, filter); }, dvb,
+              mu, options.cg_tolerance, options.cg_max_iterations, threads);
+        }
+      } else {
+        std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
+        adjoint_filter_system(filtered, cons, slot);
+        solved = solver->factorize(filtered);
+        if (solved.ok()) solved = solver->solve(dvb, mu);
+      }
+      if (!solved.ok())
+        throw std::runtime_error("gradient: the backward solve of step " + std::to_string(k) +
+                                 " failed: " + solved.message);
+      lambda = mu;
+      for (const Constraint& c : cons)
+        particle(lambda, c.particle) = adjoint_free_projector(c) * particle(mu, c.particle);
+      // The prescribed velocity changes z (and the sliding friction's C w0): their adjoint is
+      // dvb - A lambda at the constrained particles.
+      if (!cons.empty()) {
+        if (free)
+          free->band.multiply(lambda, a_lambda, threads);
+        else
+          a_lambda.noalias() = a * lambda;
+      }
+      for (const Constraint& c : cons) {
+        const int i = c.particle;
+        const Vec3 zb = particle(dvb, i) - particle(a_lambda, i);
+        const Vec3& nn = c.normal;
+        switch (c.kind) {
+          case ConstraintKind::kPin: {  // z = v_path - v0
+            particle(v0b, i) -= zb;
+            const int p = driven[i];
+            if (p >= 0) vel_bar[p] += zb;
+            break;
+          }
+          case ConstraintKind::kStick:  // z = u_t + (-d(x0) / h) n - v0
+            particle(v0b, i) -= zb;
+            particle(x0b, i) -= (nn.dot(zb) / h) * nn;
+            break;
+          case ConstraintKind::kSlide: {  // z = (-d(x0) / h - v0.n) n; rhs -= c P_t (v0 - u)
+            particle(v0b, i) -= nn.dot(zb) * nn;
+            particle(x0b, i) -= (nn.dot(zb) / h) * nn;
+            const Vec3 l = particle(lambda, i);
+            particle(v0b, i) -= c.viscosity * (l - l.dot(nn) * nn);
+            break;
+          }
+        }
+      }
+      for (int p = 0; p < pins; ++p) {
+        const int i = problem.driven_pins[p];
+        out.pin_targets[static_cast<size_t>(k) * pins + p] += vel_bar[p] / h;
+        particle(x0b, i) -= vel_bar[p] / h;
+      }
+      // The sliding contacts' viscosity c: Af's C = c P_t and rhs's -c P_t (v0 - u) give
+      // dL/dc = -lambda_i . (v1 - u)_t, sent to the step whose solve set c (the previous one).
+      pending.clear();
+      for (const Constraint& c : cons) {
+        if (c.kind != ConstraintKind::kSlide) continue;
+        const Vec3 w = particle(r.v, c.particle) + particle(r.dv, c.particle) - c.surface_velocity;
+        const Vec3 wt = w - w.dot(c.normal) * c.normal;
+        pending.push_back({c.particle, -particle(lambda, c.particle).dot(wt), c.viscosity});
+      }
+      if (traced_any) lambda -= e_vec;
+      // phi = lambda^T (b - A dv) with b = h (f + h K v), A = M - h D - h^2 K at (x0, v0), lambda
+      // and dv held: its derivatives with respect to x0, v0 and the parameters.
+      // Masses and gravity: phi_i = m_i lambda_i . (h g - dv_i).
+      for (int i = 0; i < np; ++i) {
+        const Vec3 l = particle(lambda, i);
+        out.particle_mass[particle_body[i]] += l.dot(h * model.gravity - particle(r.dv, i));
+        out.gravity += (h * model.mass[i]) * l;
+      }
+      // Springs, per spring with d = xa - xb, L = |d|, u = d / L, w = va - vb, and the differences
+      // l, e of lambda and dv at its ends (q = w + e):
+      //   phi / h = -ks (L - l0) a - kd a (c + be) - h ks a g + h s E,
+      //   a = l.u, be = e.u, g = q.u, c = w.u, E = a g - l.q,
+      //   s = ks (1 - l0/L) + kd c / L, each term as the definiteness fix clamps it.
+      for (int sp = 0; sp < springs.size(); ++sp) {
+        const int ia = springs.a[sp], ib = springs.b[sp];
+        const Vec3 d = particle(r.x, ia) - particle(r.x, ib);
+        const Real length = d.norm();
+        const Real l0 = rest[sp];
+        if (!(length > kDegenerateLength * l0)) continue;  // collapsed: not differentiated
+        const Real ks = springs.ks[sp], kd = springs.kd[sp];
+        const Real inv = 1 / length;
+        const Vec3 u = d * inv;
+        const Vec3 l = particle(lambda, ia) - particle(lambda, ib);
+        const Vec3 e = particle(r.dv, ia) - particle(r.dv, ib);
+        const Vec3 w = particle(r.v, ia) - particle(r.v, ib);
+        const Vec3 q = w + e;
+        const Real al = l.dot(u), be = e.dot(u), ga = q.dot(u), c = w.dot(u), lq = l.dot(q);
+        const Real s1 = ks * (1 - l0 * inv), s2 = kd * c * inv;
+        bool on1 = true, on2 = true;
+        if (options.definiteness == DefinitenessFix::kClampCompressed) {
+          on1 = s1 > 0;
+          on2 = s2 > 0;
+        } else if (options.definiteness == DefinitenessFix::kProjectPsd) {
+          on1 = on2 = s1 + s2 > 0;
+        }
+        const Real s = (on1 ? s1 : 0) + (on2 ? s2 : 0);
+        const Real big_e = al * ga - lq;
+        const Vec3 pl = (l - al * u) * inv, pe = (e - be * u) * inv, pw = (w - c * u) * inv,
+                   pq = (q - ga * u) * inv;
+        Vec3 ds = Vec3::Zero();
+        if (on1) ds += (ks * l0 * inv * inv) * u;
+        if (on2) ds += (kd * inv) * (pw - c * inv * u);
+        const Vec3 de = ga * pl + al * pq;
+        const Vec3 grad_d = -ks * (al * u + (length - l0) * pl) -
+                            kd * ((c + be) * pl + al * (pw + pe)) - h * ks * de +
+                            h * (s * de + big_e * ds);
+        Vec3 grad_w = -kd * al * u - h * ks * al * u + h * s * (al * u - l);
+        if (on2) grad_w += (h * big_e * kd * inv) * u;
+        const Real grad_ks =
+            -(length - l0) * al - h * al * ga + (on1 ? h * big_e * (1 - l0 * inv) : 0);
+        const Real grad_kd = -al * (c + be) + (on2 ? h * big_e * c * inv : 0);
+        particle(x0b, ia) += h * grad_d;
+        particle(x0b, ib) -= h * grad_d;
+        particle(v0b, ia) += h * grad_w;
+        particle(v0b, ib) -= h * grad_w;
+        const size_t at = static_cast<size_t>(kSpringTypeCount) * spring_body[sp] +
+                          static_cast<size_t>(springs.type[sp]);
+        out.ks[at] += h * grad_ks;
+        out.kd[at] += h * grad_kd;
+      }
+      for (const Constraint& c : cons) slot[c.particle] = -1;
+      xb.swap(x0b);
+      vb.swap(v0b);
+      if (at_frame[k]) {
+        xb += dl_dx[k];
+        vb += dl_dv[k];
+      }
+    }
+  }
+  for (const PendingViscosity& pv : pending)  // the first step's: set before the run
+    if (pv.value != 0) ++out.slide_steps;
+  if (end_of_run) sim.restore(std::move(*end_of_run));
+  out.initial_position = xb;
+  out.initial_velocity = vb;
+  out.backward_seconds = seconds_since(start);
+  return out;
+}
+
+}  // namespace jelly

@@ -1,0 +1,72 @@
+#pragma once
+// Exact gradients through implicit_euler (docs/gradients.md): the discrete adjoint of the
+// linearized backward-Euler step, contact and pins included with each step's active set held
+// fixed. One forward run stores every step's state, velocity change and constraint set; one
+// backward pass solves each step's (filtered) system again, transposed, and gathers the gradient
+// of a loss on the states with respect to the springs' coefficients, the particle masses,
+// gravity, the initial state and the targets of driven pins.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <jelly/core/state.hpp>
+#include <jelly/core/types.hpp>
+
+namespace jelly {
+
+class Simulator;
+
+// A loss term at frame k (the state after k steps; 0 = the start): returns its value and adds
+// dL/dx and dL/dv (3N each, zero on entry) for that state.
+using FrameLoss = std::function<Real(int frame, const State& state, VecX& dl_dx, VecX& dl_dv)>;
+
+struct GradientProblem {
+  int steps = 0;  // K >= 1 steps of the simulator's dt
+  // The frames (0..K) at which `loss` is evaluated; empty: frame K only.
+  std::vector<int> loss_frames;
+  FrameLoss loss;
+  // Pins driven by a control sequence: before step k, pinned particle driven_pins[p] is set
+  // moving from where it is to pin_targets[k * P + p] within the step (Simulator::
+  // set_pin_target with velocity (target - x) / dt), so that it ends step k at its target.
+  std::vector<int> driven_pins;
+  std::vector<Vec3> pin_targets;  // [K * P]
+  // 0: every step's record is kept (x, v, dv: 9N doubles per step). S > 0: a snapshot of the
+  // simulator every S steps; the backward pass runs each segment again from its snapshot and
+  // keeps S steps' records at a time (one more forward run; the same result for the backends
+  // that restart bit for bit: CHOLMOD, LDLT, block-Jacobi CG).
+  int checkpoint_every = 0;
+};
+
+struct GradientResult {
+  Real loss = 0;
+  VecX initial_position;  // dL/dx0 [3N]
+  VecX initial_velocity;  // dL/dv0 [3N]
+  Vec3 gravity = Vec3::Zero();
+  // Per body b and spring type t (SpringType), at [kSpringTypeCount * b + t]: dL/dks, dL/dkd of
+  // the coefficients the body's springs of that type share (zero where it has none).
+  std::vector<Real> ks, kd;
+  // Per body: dL/d(the mass of each of its particles), all changed together.
+  std::vector<Real> particle_mass;
+  std::vector<Vec3> pin_targets;  // [K * P] as GradientProblem::pin_targets
+  // What the backward pass held fixed: constrained particle-steps (terrain contacts, pins not
+  // counted), of which sliding (the friction viscosity, which the forward step takes from the
+  // previous solve's impulse, is held) and bouncing (restitution's velocity change is not
+  // differentiated).
+  long contact_steps = 0;
+  long slide_steps = 0;
+  long bounce_steps = 0;
+  std::string backward_solver;  // "cholmod", "ldlt" or "cg_jacobi"
+  double forward_seconds = 0, backward_seconds = 0;
+};
+
+// Runs `simulator` (implicit_euler with newton_iterations = 1, from its current state) for
+// problem.steps steps and returns the loss and its gradient; the simulator is left at the end
+// of the run. The forward states are kept in memory (9N doubles per step: x, v, dv), or
+// recomputed from checkpoints (GradientProblem::checkpoint_every).
+// Throws InputError for what the adjoint does not differentiate: another integrator, Newton
+// iterations, contact models other than coulomb inside the solve, contact between bodies, wind,
+// added forces, anchor springs, or a malformed problem; std::runtime_error when a step or a
+// backward solve fails.
+GradientResult implicit_euler_gradient(Simulator& simulator, const GradientProblem& problem);
+
+}  // namespace jelly

@@ -1,0 +1,107 @@
+"""jelly.gradient (the discrete adjoint of implicit_euler, docs/gradients.md) against central
+finite differences of the loss, and its messages for bad paths and shapes."""
+
+import numpy as np
+import pytest
+
+import jelly
+
+STEPS = 10
+DT = 1 / 60
+
+
+def cloth_scene(overrides=None):
+    scene = {
+        "bodies": [{
+            "kind": "cloth", "name": "cloth", "nu": 5, "nv": 5, "size_u": 1, "size_v": 1,
+            "position": [0, 2, 0], "particle_mass": 0.05,
+            "springs": {"structural": {"ks": 300, "kd": 2}, "shear": {"ks": 150, "kd": 1},
+                        "bending": {"ks": 40, "kd": 0.5}},
+            "velocity": [0.3, 0, -0.2],
+            "pins": [{"group": "corner_00"}, {"group": "corner_10"}]}],
+        "gravity": [0, -9.8, 0],
+        "terrains": [],
+        "integrator": {"name": "implicit_euler", "dt": DT},
+        "duration": STEPS * DT,
+    }
+    return jelly.Scene(scene, overrides or {})
+
+
+WEIGHTS = np.random.default_rng(3).uniform(-1, 1, (25, 3))
+
+
+def loss(x, v):
+    return float((WEIGHTS * x).sum() + 0.05 * (v * v).sum()), WEIGHTS.copy(), 0.1 * v
+
+
+def driven_pin(scene):
+    sim = jelly.Simulator(scene)
+    return int(sim.model.pins.particles[1])
+
+
+def targets(scene):
+    sim = jelly.Simulator(scene)
+    start = np.array(sim.state.x)[driven_pin(scene)]
+    k = np.arange(1, STEPS + 1)[:, None]
+    return (start + 0.05 * np.hstack([np.sin(0.3 * k), 1 - np.cos(0.3 * k), 0.1 * k]))[:, None, :]
+
+
+def value(scene, pin_targets):
+    pin = driven_pin(scene)
+    return jelly.gradient(scene, STEPS * DT, loss, [], pins=[pin], pin_targets=pin_targets)[0]
+
+
+def central(scene_of, pin_targets_of, eps):
+    return (value(scene_of(eps), pin_targets_of(eps)) -
+            value(scene_of(-eps), pin_targets_of(-eps))) / (2 * eps)
+
+
+def test_every_kind_agrees_with_finite_differences():
+    scene = cloth_scene()
+    pin = driven_pin(scene)
+    wrt = ["bodies[0].springs.structural.ks", "bodies[0].springs.shear.kd", "gravity",
+           "bodies[0].mass", "bodies[0].velocity", "pin_targets"]
+    base = targets(scene)
+    L, grads = jelly.gradient(scene, STEPS * DT, loss, wrt, pins=[pin], pin_targets=base)
+    assert np.isclose(L, value(scene, base), rtol=1e-14)
+    L2, again = jelly.gradient(scene, STEPS * DT, loss, wrt, pins=[pin], pin_targets=base,
+                               checkpoint_every=3)
+    assert L2 == L and all(np.array_equal(again[p], grads[p]) for p in wrt)
+    assert grads["gravity"].shape == (3,)
+    assert grads["pin_targets"].shape == (STEPS, 1, 3)
+    fixed = lambda e: base  # noqa: E731
+    checks = {
+        "bodies[0].springs.structural.ks":
+            central(lambda e: cloth_scene({"bodies[0].springs.structural.ks": 300 + e}), fixed,
+                    1e-4),
+        "bodies[0].springs.shear.kd":
+            central(lambda e: cloth_scene({"bodies[0].springs.shear.kd": 1 + e}), fixed, 1e-6),
+        "bodies[0].mass":
+            central(lambda e: cloth_scene({"bodies[0].particle_mass": 0.05 + e}), fixed, 1e-8),
+    }
+    for path, fd in checks.items():
+        assert abs(float(grads[path]) - fd) <= 1e-5 * abs(fd), (path, grads[path], fd)
+    fd_gravity = central(lambda e: cloth_scene({"gravity": [0, -9.8 + e, 0]}), fixed, 1e-6)
+    assert abs(grads["gravity"][1] - fd_gravity) <= 1e-5 * abs(fd_gravity)
+    fd_velocity = central(lambda e: cloth_scene({"bodies[0].velocity": [0.3 + e, 0, -0.2]}),
+                          fixed, 1e-6)
+    assert abs(grads["bodies[0].velocity"][0] - fd_velocity) <= 1e-5 * abs(fd_velocity)
+    direction = np.random.default_rng(5).uniform(-1, 1, base.shape)
+    fd_targets = central(lambda e: scene, lambda e: base + e * direction, 1e-6)
+    adjoint = float((grads["pin_targets"] * direction).sum())
+    assert abs(adjoint - fd_targets) <= 1e-5 * abs(fd_targets)
+
+
+def test_bad_paths_and_shapes_are_named():
+    scene = cloth_scene()
+    with pytest.raises(jelly.InputError, match="wrt: 'bodies\\[0\\].springs.twist.ks'"):
+        jelly.gradient(scene, STEPS * DT, loss, ["bodies[0].springs.twist.ks"])
+    with pytest.raises(jelly.InputError, match="pin_targets"):
+        jelly.gradient(scene, STEPS * DT, loss, [], pins=[0], pin_targets=np.zeros((2, 1, 3)))
+    with pytest.raises(jelly.InputError, match="dL/dx"):
+        jelly.gradient(scene, STEPS * DT, lambda x, v: (0.0, np.zeros((3, 3)), v), [])
+    with pytest.raises(jelly.InputError, match="duration"):
+        jelly.gradient(scene, 0.001, loss, [])
+    rk4 = cloth_scene({"integrator.name": "rk4", "integrator.dt": 0.001})
+    with pytest.raises(jelly.InputError, match="implicit_euler"):
+        jelly.gradient(rk4, 0.01, loss, ["gravity"])

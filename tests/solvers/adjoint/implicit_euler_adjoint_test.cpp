@@ -1,0 +1,480 @@
+// The discrete adjoint of implicit_euler (solvers/adjoint/): every kind of gradient against
+// central finite differences of the simulator's own runs, on a pinned cloth driven by a control
+// sequence, a cube resting on a coulomb slope and two cubes on a floor; CG's backward pass; and
+// the refusals of what it does not differentiate.
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/geometry/body_spec.hpp>
+#include <jelly/geometry/cloth.hpp>
+#include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/adjoint/implicit_euler_adjoint.hpp>
+#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
+#include <jelly/terrain/plane.hpp>
+
+#include "support/systems.hpp"
+
+namespace jelly {
+namespace {
+
+// A scene to differentiate: how to build its simulator, and the problem (steps, driven pins).
+struct AdjointCase {
+  std::function<Simulator()> make;
+  int steps = 12;
+  std::vector<int> driven;
+  std::vector<Vec3> targets;
+};
+
+// L = sum over frames K/2 and K of a.x + 0.05 |v|^2 (a fixed random per particle).
+struct TestLoss {
+  VecX a;
+  Real operator()(int /*frame*/, const State& s, VecX& dx, VecX& dv) const {
+    dx += a;
+    dv += 0.1 * s.v;
+    return a.dot(s.x) + 0.05 * s.v.squaredNorm();
+  }
+};
+
+VecX random_vector(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  VecX r(n);
+  for (int i = 0; i < n; ++i) r[i] = u(rng);
+  return r;
+}
+
+GradientProblem problem_of(const AdjointCase& c, const Simulator& sim) {
+  GradientProblem p;
+  p.steps = c.steps;
+  p.loss_frames = {c.steps / 2, c.steps};
+  p.loss = TestLoss{random_vector(sim.model().num_dofs(), 7)};
+  p.driven_pins = c.driven;
+  p.pin_targets = c.targets;
+  return p;
+}
+
+// The loss of a run after `edit` (the simulator's own steps, the pins driven as the adjoint
+// drives them).
+Real run_loss(const AdjointCase& c, const std::function<void(Simulator&, GradientProblem&)>& edit) {
+  Simulator sim = c.make();
+  GradientProblem p = problem_of(c, sim);
+  edit(sim, p);
+  const Real h = sim.options().dt;
+  const int pins = static_cast<int>(p.driven_pins.size());
+  Real loss = 0;
+  VecX dx(sim.model().num_dofs()), dv(sim.model().num_dofs());
+  for (int k = 0; k < p.steps; ++k) {
+    for (int q = 0; q < pins; ++q) {
+      const int i = p.driven_pins[q];
+      const Vec3 now = particle(sim.state().x, i);
+      sim.set_pin_target(i, now, (p.pin_targets[k * pins + q] - now) / h);
+    }
+    const StepResult r = sim.step();
+    EXPECT_TRUE(r.ok) << r.message;
+    if (k + 1 == p.steps / 2 || k + 1 == p.steps) loss += p.loss(k + 1, sim.state(), dx, dv);
+  }
+  return loss;
+}
+
+// Central difference of the loss along a change `edit(sim, problem, eps)`.
+Real central_difference(const AdjointCase& c, Real eps,
+                        const std::function<void(Simulator&, GradientProblem&, Real)>& edit) {
+  const Real plus = run_loss(c, [&](Simulator& s, GradientProblem& p) { edit(s, p, eps); });
+  const Real minus = run_loss(c, [&](Simulator& s, GradientProblem& p) { edit(s, p, -eps); });
+  return (plus - minus) / (2 * eps);
+}
+
+GradientResult gradient_of(const AdjointCase& c) {
+  Simulator sim = c.make();
+  const GradientProblem p = problem_of(c, sim);
+  return implicit_euler_gradient(sim, p);
+}
+
+void expect_close(Real adjoint, Real fd, Real tolerance, const std::string& what) {
+  EXPECT_LE(std::abs(adjoint - fd), tolerance * std::abs(fd))
+      << what << ": adjoint " << adjoint << " finite differences " << fd;
+  EXPECT_NE(fd, 0) << what;
+}
+
+constexpr Real kTolerance = 1e-5;
+
+// A state moved off rest (positions by up to `dx`, velocities by up to `dv`): at rest every
+// spring sits on the definiteness fix's clamp (s = 0), where the step is not differentiable.
+State jittered(State s, Real dx, Real dv) {
+  s.x += dx * random_vector(static_cast<int>(s.x.size()), 21);
+  s.v += dv * random_vector(static_cast<int>(s.v.size()), 22);
+  return s;
+}
+
+// Checks every parameter kind of body `body` (and the state, gravity, the pins' targets). The
+// steps: 1e-6 relative (1e-4 for kd, whose gradients are small enough for round-off to show at
+// 1e-6), 1e-8 m for the positions (a spring near its rest length, where the definiteness clamp
+// has its kink, must not be crossed).
+void check_every_kind(const AdjointCase& c, int body, const std::vector<SpringType>& types) {
+  const GradientResult g = gradient_of(c);
+  Simulator probe = c.make();
+  const Model& m = probe.model();
+  for (SpringType t : types) {
+    const int at = kSpringTypeCount * body + static_cast<int>(t);
+    const int first = m.bodies[body].first_spring;
+    int sp = first;
+    while (m.springs.type[sp] != t) ++sp;
+    const SpringCoefficients base{m.springs.ks[sp], m.springs.kd[sp]};
+    const std::string name(spring_type_name(t));
+    expect_close(g.ks[at],
+                 central_difference(c, 1e-6 * base.ks,
+                                    [&](Simulator& s, GradientProblem&, Real e) {
+                                      s.set_spring_coefficients(body, t, {base.ks + e, base.kd});
+                                    }),
+                 kTolerance, name + ".ks");
+    expect_close(g.kd[at],
+                 central_difference(c, 1e-4 * base.kd,
+                                    [&](Simulator& s, GradientProblem&, Real e) {
+                                      s.set_spring_coefficients(body, t, {base.ks, base.kd + e});
+                                    }),
+                 kTolerance, name + ".kd");
+  }
+  const Real mass = m.mass[m.bodies[body].first_particle];
+  expect_close(g.particle_mass[body],
+               central_difference(c, 1e-6 * mass,
+                                  [&](Simulator& s, GradientProblem&, Real e) {
+                                    s.set_particle_mass(body, mass + e);
+                                  }),
+               kTolerance, "mass");
+  for (int d = 0; d < 3; ++d) {
+    expect_close(g.gravity[d],
+                 central_difference(c, 1e-6,
+                                    [&](Simulator& s, GradientProblem&, Real e) {
+                                      Vec3 gravity = s.model().gravity;
+                                      gravity[d] += e;
+                                      s.set_gravity(gravity);
+                                    }),
+                 kTolerance, "gravity[" + std::to_string(d) + "]");
+  }
+  // The initial state and the pins' targets along random directions.
+  const VecX dir_x = random_vector(m.num_dofs(), 11), dir_v = random_vector(m.num_dofs(), 12);
+  expect_close(g.initial_position.dot(dir_x),
+               central_difference(c, 1e-8,
+                                  [&](Simulator& s, GradientProblem&, Real e) {
+                                    s.mutable_state().x += e * dir_x;  // (contacts kept)
+                                  }),
+               kTolerance, "initial positions");
+  expect_close(g.initial_velocity.dot(dir_v),
+               central_difference(c, 1e-7,
+                                  [&](Simulator& s, GradientProblem&, Real e) {
+                                    s.mutable_state().v += e * dir_v;
+                                  }),
+               kTolerance, "initial velocities");
+  if (!c.targets.empty()) {
+    const VecX dir = random_vector(3 * static_cast<int>(c.targets.size()), 13);
+    Real adjoint = 0;
+    for (size_t k = 0; k < c.targets.size(); ++k)
+      adjoint += g.pin_targets[k].dot(dir.segment<3>(3 * k));
+    expect_close(adjoint,
+                 central_difference(c, 1e-7,
+                                    [&](Simulator&, GradientProblem& p, Real e) {
+                                      for (size_t k = 0; k < p.pin_targets.size(); ++k)
+                                        p.pin_targets[k] += e * dir.segment<3>(3 * k);
+                                    }),
+                 kTolerance, "pin targets");
+  }
+}
+
+// A 6 x 6 cloth pinned at two corners, one of them driven along a sampled circle.
+AdjointCase pinned_cloth() {
+  AdjointCase c;
+  c.steps = 16;
+  Model model;
+  ClothShape cloth;
+  cloth.nu = 6;
+  cloth.nv = 6;
+  cloth.pose.position = Vec3(0, 1.5, 0);
+  BodySpec sheet;
+  sheet.name = "sheet";
+  sheet.shape = cloth;
+  sheet.material.particle_mass = 0.05;
+  sheet.material.springs[0] = {300, 2};
+  sheet.material.springs[1] = {150, 1};
+  sheet.material.springs[2] = {40, 0.5};
+  sheet.pins = {PinSpec{{{}, false, {}, "corner_00"}, Path()},
+                PinSpec{{{}, false, {}, "corner_10"}, Path()}};
+  add_body(model, sheet, "bodies[0].");
+  const int driven = model.pins.particles[1];
+  const Vec3 start = particle(model.rest_position, driven);
+  c.driven = {driven};
+  for (int k = 0; k < c.steps; ++k) {
+    const Real angle = 0.3 * (k + 1);
+    c.targets.push_back(start + 0.1 * Vec3(std::sin(angle), 1 - std::cos(angle), 0.5 * angle));
+  }
+  c.make = [model] {
+    return testing::make_sim(model, jittered(rest_state(model), 0.01, 0.1), "implicit_euler",
+                             1.0 / 60);
+  };
+  return c;
+}
+
+TEST(ImplicitEulerAdjoint, PinnedClothEveryKindAgreesWithFiniteDifferences) {
+  const AdjointCase c = pinned_cloth();
+  check_every_kind(c, 0, {SpringType::kStructural, SpringType::kShear, SpringType::kBending});
+  const GradientResult g = gradient_of(c);
+  EXPECT_EQ(g.backward_solver, "cholmod");
+  EXPECT_EQ(g.contact_steps, 0);
+}
+
+// A 3 x 3 x 3 cube resting on the 20-degree coulomb slope (friction enough to stick, no bounce).
+AdjointCase cube_on_slope() {
+  AdjointCase c;
+  c.steps = 8;
+  Model model = build_cube(testing::small_cube(3, 0.6));
+  model.mass.setConstant(0.2);
+  for (int t = 0; t < kSpringTypeCount; ++t)
+    model.springs.set_coefficients(static_cast<SpringType>(t), {400.0 + 100 * t, 4.0 + t});
+  const State s0 = jittered(testing::cube_on_slope(model, 20), 1e-4, 0.005);
+  c.make = [model, s0] {
+    Simulator sim = testing::make_sim(model, s0, "implicit_euler", 1.0 / 100);
+    ContactParams contact;
+    contact.friction = 3;
+    contact.static_friction = 3;
+    contact.restitution = 0;
+    sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), contact)));
+    return sim;
+  };
+  return c;
+}
+
+TEST(ImplicitEulerAdjoint, CubeOnACoulombSlopeAgreesWithFiniteDifferences) {
+  const AdjointCase c = cube_on_slope();
+  const GradientResult g = gradient_of(c);
+  EXPECT_GT(g.contact_steps, 9 * c.steps / 2);  // the bottom layer rests on the slope
+  EXPECT_EQ(g.bounce_steps, 0);
+  EXPECT_EQ(g.slide_steps, 0);
+  check_every_kind(c, 0, {SpringType::kStructural, SpringType::kShear, SpringType::kBending});
+}
+
+// The cube sliding down a slope of little friction (mu = 0.2 < tan 20 degrees), from a state
+// 15 steps into the slide: every step's friction viscosity is set by the previous step's solve
+// (traced through it), the first one's before the run (a constant).
+AdjointCase sliding_cube() {
+  AdjointCase c;
+  c.steps = 10;
+  Model model = build_cube(testing::small_cube(3, 0.6));
+  model.mass.setConstant(0.2);
+  for (int t = 0; t < kSpringTypeCount; ++t)
+    model.springs.set_coefficients(static_cast<SpringType>(t), {400.0 + 100 * t, 4.0 + t});
+  const State s0 = jittered(testing::cube_on_slope(model, 20), 1e-4, 0.005);
+  c.make = [model, s0] {
+    Simulator sim = testing::make_sim(model, s0, "implicit_euler", 1.0 / 100);
+    ContactParams contact;
+    contact.friction = 0.2;
+    contact.static_friction = 0.2;
+    contact.restitution = 0;
+    sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), contact)));
+    for (int k = 0; k < 15; ++k) sim.step();
+    return sim;
+  };
+  return c;
+}
+
+TEST(ImplicitEulerAdjoint, CubeSlidingDownASlopeAgreesWithFiniteDifferences) {
+  const AdjointCase c = sliding_cube();
+  const GradientResult g = gradient_of(c);
+  EXPECT_GE(g.contact_steps, 9 * c.steps);  // the bottom layer slides all the way
+  EXPECT_EQ(g.slide_steps, 9);              // held: only the first step's, set before the run
+  check_every_kind(c, 0, {SpringType::kStructural, SpringType::kShear, SpringType::kBending});
+}
+
+// Two cubes of different materials resting side by side on a floor.
+AdjointCase two_cubes_on_a_floor() {
+  AdjointCase c;
+  c.steps = 10;
+  Model model;
+  for (int b = 0; b < 2; ++b) {
+    BodySpec spec;
+    spec.name = b == 0 ? "left" : "right";
+    CubeShape shape;
+    shape.n = 3;
+    shape.edge_length = 0.5;
+    shape.origin = Vec3(b == 0 ? -0.8 : 0.3, 0.002, 0);
+    spec.shape = shape;
+    spec.material.particle_mass = b == 0 ? 0.1 : 0.3;
+    spec.material.springs.fill({b == 0 ? 300.0 : 800.0, b == 0 ? 1.0 : 3.0});
+    spec.velocity = Vec3(b == 0 ? 0.2 : -0.1, -0.3, 0);
+    add_body(model, spec, "bodies[" + std::to_string(b) + "].");
+  }
+  c.make = [model] {
+    Simulator sim = testing::make_sim(model, jittered(initial_state(model), 2e-4, 0.02),
+                                      "implicit_euler", 1.0 / 100);
+    ContactParams contact;
+    contact.friction = 3;
+    contact.static_friction = 3;
+    contact.restitution = 0;
+    sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitY(), contact));
+    return sim;
+  };
+  return c;
+}
+
+TEST(ImplicitEulerAdjoint, TwoCubesOnAFloorAgreeWithFiniteDifferencesPerBody) {
+  const AdjointCase c = two_cubes_on_a_floor();
+  const GradientResult g = gradient_of(c);
+  EXPECT_GT(g.contact_steps, 0);
+  EXPECT_EQ(g.bounce_steps, 0);
+  EXPECT_EQ(g.slide_steps, 0);
+  check_every_kind(c, 1, {SpringType::kStructural, SpringType::kBending});
+}
+
+// CG forward and backward (tight tolerance): the gradient agrees to CG's accuracy.
+TEST(ImplicitEulerAdjoint, ConjugateGradientsBackwardAgreesWithFiniteDifferences) {
+  AdjointCase c = cube_on_slope();
+  const std::function<Simulator()> direct = c.make;
+  c.make = [direct] {
+    Simulator sim = direct();
+    ImplicitEulerOptions o;
+    o.linear_solver = ImplicitLinearSolver::kCg;
+    o.cg_tolerance = 1e-12;
+    sim.set_integrator(std::make_unique<ImplicitEuler>(o));
+    return sim;
+  };
+  const GradientResult g = gradient_of(c);
+  EXPECT_EQ(g.backward_solver, "cg_jacobi_matrix_free");
+  const GradientResult exact = gradient_of(cube_on_slope());
+  for (int t = 0; t < kSpringTypeCount; ++t) {
+    EXPECT_NEAR(g.ks[t], exact.ks[t], 1e-7 * std::abs(exact.ks[t]));
+    EXPECT_NEAR(g.kd[t], exact.kd[t], 1e-7 * std::abs(exact.kd[t]));
+  }
+  EXPECT_LT((g.initial_velocity - exact.initial_velocity).norm(),
+            1e-7 * exact.initial_velocity.norm());
+  check_every_kind(c, 0, {SpringType::kShear});
+  // An assembled CG forward (lagged Cholesky preconditioner): the same in its backward pass.
+  c.make = [direct] {
+    Simulator sim = direct();
+    ImplicitEulerOptions o;
+    o.linear_solver = ImplicitLinearSolver::kCg;
+    o.cg_preconditioner = CgPreconditionerKind::kCholmod;
+    o.cg_tolerance = 1e-12;
+    sim.set_integrator(std::make_unique<ImplicitEuler>(o));
+    return sim;
+  };
+  const GradientResult lagged = gradient_of(c);
+  EXPECT_EQ(lagged.backward_solver, "cg_lagged_cholmod");
+  EXPECT_LT((lagged.initial_velocity - exact.initial_velocity).norm(),
+            1e-7 * exact.initial_velocity.norm());
+  EXPECT_NEAR(lagged.kd[1], exact.kd[1], 1e-7 * std::abs(exact.kd[1]));
+}
+
+// Sliding contacts (low friction on the slope) are counted: the gradient through them holds the
+// friction viscosity fixed. A loss at frame 0 adds its own derivatives to the initial state's.
+TEST(ImplicitEulerAdjoint, CountsSlidingContactsAndTakesALossAtFrameZero) {
+  const Model model = build_cube(testing::small_cube(3, 0.6));
+  const State s0 = testing::cube_on_slope(model, 20);
+  const auto make = [&] {
+    Simulator sim = testing::make_sim(model, s0, "implicit_euler", 1.0 / 100);
+    ContactParams contact;
+    contact.friction = 0.05;
+    contact.static_friction = 0.05;
+    contact.restitution = 0;
+    sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), contact)));
+    return sim;
+  };
+  GradientProblem p;
+  p.steps = 10;
+  p.loss_frames = {0, 10};
+  p.loss = [](int frame, const State& s, VecX& dx, VecX&) {
+    const Real w = frame == 0 ? 2.0 : 1.0;
+    dx = VecX::Constant(s.x.size(), w);
+    return w * s.x.sum();
+  };
+  Simulator sim = make();
+  const GradientResult g = implicit_euler_gradient(sim, p);
+  EXPECT_GT(g.slide_steps, 0);
+  EXPECT_EQ(g.bounce_steps, 0);
+  // Frame 0 alone: dL/dx0 = 2, dL/dv0 = 0.
+  p.loss_frames = {0};
+  Simulator again = make();
+  const GradientResult only_start = implicit_euler_gradient(again, p);
+  EXPECT_EQ(only_start.initial_position, VecX::Constant(s0.x.size(), 2.0));
+  EXPECT_EQ(only_start.initial_velocity, VecX::Zero(s0.x.size()));
+  EXPECT_DOUBLE_EQ(only_start.loss, 2 * s0.x.sum());
+}
+
+// Checkpoints every 5 steps (segments of 5, and a last one of 1): the segments recomputed from
+// their snapshots give the stored run's gradient, and the simulator ends where the run ended.
+TEST(ImplicitEulerAdjoint, CheckpointsGiveTheStoredRunsGradient) {
+  for (const int which : {0, 1, 2}) {
+    const bool matrix_free = which == 1;
+    AdjointCase c = which == 0 ? pinned_cloth() : which == 1 ? cube_on_slope() : sliding_cube();
+    if (matrix_free) {
+      const std::function<Simulator()> direct = c.make;
+      c.make = [direct] {
+        Simulator sim = direct();
+        ImplicitEulerOptions o;
+        o.linear_solver = ImplicitLinearSolver::kCg;
+        o.cg_tolerance = 1e-10;
+        sim.set_integrator(std::make_unique<ImplicitEuler>(o));
+        return sim;
+      };
+    }
+    c.steps = 11;
+    if (!c.targets.empty()) c.targets.resize(c.steps);
+    Simulator stored_sim = c.make();
+    const GradientResult stored = implicit_euler_gradient(stored_sim, problem_of(c, stored_sim));
+    Simulator sim = c.make();
+    GradientProblem p = problem_of(c, sim);
+    p.checkpoint_every = 5;
+    const GradientResult checkpointed = implicit_euler_gradient(sim, p);
+    EXPECT_EQ(checkpointed.loss, stored.loss);
+    EXPECT_EQ(checkpointed.initial_position, stored.initial_position);
+    EXPECT_EQ(checkpointed.initial_velocity, stored.initial_velocity);
+    EXPECT_EQ(checkpointed.ks, stored.ks);
+    EXPECT_EQ(checkpointed.kd, stored.kd);
+    EXPECT_EQ(checkpointed.particle_mass, stored.particle_mass);
+    EXPECT_EQ(checkpointed.gravity, stored.gravity);
+    EXPECT_EQ(checkpointed.pin_targets, stored.pin_targets);
+    EXPECT_EQ(sim.state().x, stored_sim.state().x);
+    EXPECT_EQ(sim.state().t, stored_sim.state().t);
+  }
+}
+
+TEST(ImplicitEulerAdjoint, RefusesWhatItDoesNotDifferentiate) {
+  const Model model = build_cube(testing::small_cube(2, 0.5));
+  GradientProblem p;
+  p.steps = 2;
+  p.loss = [](int, const State& s, VecX& dx, VecX&) {
+    dx.setOnes();
+    return s.x.sum();
+  };
+  {
+    Simulator sim = testing::make_sim(model, rest_state(model), "rk4", 1e-3);
+    EXPECT_THROW(implicit_euler_gradient(sim, p), InputError);
+  }
+  {
+    ImplicitEulerOptions o;
+    o.newton_iterations = 3;
+    SimulatorOptions so;
+    so.dt = 0.01;
+    Simulator sim(model, rest_state(model), std::make_unique<ImplicitEuler>(o), so);
+    EXPECT_THROW(implicit_euler_gradient(sim, p), InputError);
+  }
+  {
+    Simulator sim = testing::make_sim(model, rest_state(model), "implicit_euler", 0.01);
+    ContactParams seed;
+    seed.model = ContactModel::kSeed;
+    sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitY(), seed));
+    EXPECT_THROW(implicit_euler_gradient(sim, p), InputError);
+  }
+  {
+    Simulator sim = testing::make_sim(model, rest_state(model), "implicit_euler", 0.01);
+    GradientProblem wrong = p;
+    wrong.driven_pins = {0};  // not pinned
+    wrong.pin_targets.assign(2, Vec3::Zero());
+    EXPECT_THROW(implicit_euler_gradient(sim, wrong), InputError);
+  }
+}
+
+}  // namespace
+}  // namespace jelly
