@@ -132,4 +132,8 @@ SpringCoefficients.__reduce__ = lambda self: (_options_from_state, (SpringCoeffi
                                                                      {"ks": self.ks,
                                                                       "kd": self.kd}))
 
+# Classes to subclass in Python: their instances print as the subclass's name.
+Force.__repr__ = lambda self: f"<jelly.Force {type(self).__name__}>"
+Observer.__repr__ = lambda self: f"<jelly.Observer {type(self).__name__}>"
+
 __all__ = sorted(name for name in dir() if not name.startswith("_"))

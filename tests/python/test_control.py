@@ -128,3 +128,45 @@ def test_observations_are_views_that_follow_the_simulator():
     assert ref() is not None and np.isfinite(x).all()
     del x, v
     gc.collect()
+
+
+def test_read_only_views_go_to_dlpack_without_a_copy():
+    sim, _ = hanging_cube()
+    x = sim.state.x
+    with pytest.raises(BufferError):  # NumPy 1.24 does not export a read-only array
+        x.__dlpack__()
+    exported = jelly.dlpack(x)
+    assert exported.__dlpack_device__() == (1, 0)
+    taken = np.from_dlpack(exported)
+    assert np.shares_memory(taken, x) and taken.shape == x.shape and taken.dtype == np.float64
+    sim.step(3)
+    assert np.array_equal(taken, sim.state.x)  # the same memory, after steps too
+    # A strided view and the model's arrays.
+    assert np.array_equal(np.from_dlpack(jelly.dlpack(x[:, 1])), x[:, 1])
+    assert np.array_equal(np.from_dlpack(jelly.dlpack(sim.model.springs.a)), sim.model.springs.a)
+    # The tensor keeps the simulator alive.
+    ref = weakref.ref(sim)
+    del sim, x, exported
+    gc.collect()
+    assert ref() is not None and np.isfinite(taken).all()
+    del taken
+    gc.collect()
+    assert ref() is None
+    with pytest.raises(jelly.InputError, match="stream"):
+        jelly.dlpack(np.zeros(3)).__dlpack__(stream=1)
+
+
+def test_the_pin_controller_example_resets_between_episodes():
+    import os
+    import pathlib
+    import subprocess
+    import sys
+    source = pathlib.Path(os.environ.get("JELLY_SOURCE_DIR", pathlib.Path(__file__).parents[2]))
+    done = subprocess.run([sys.executable, str(source / "examples/python/pin_controller.py"),
+                           "--seconds", "2", "--gains", "1,3"], capture_output=True, text=True,
+                          check=True)
+    lines = done.stdout.splitlines()
+    first = lines[-3].split("the centre is ")[1]
+    # Gain 1 from the start again repeats the first episode exactly; gain 3 differs.
+    assert lines[-2] == "gain 1: after 2 s the centre is " + first, done.stdout
+    assert lines[-1].startswith("gain 3: ") and lines[-1].split("is ")[1] != first
