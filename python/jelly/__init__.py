@@ -11,6 +11,7 @@ from typing import Any as _Any, Optional as _Optional, Union as _Union
 from . import _jelly
 from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module folder)
     AnchorSpring, ArkodeOptions, Body, Checkpoint, ContactParams, CubeSpec, DivergenceGuard,
+    DLPackExport, dlpack,
     Elevator, ElevatorSpec, ExternalForce, FitOptions, Force, FitResult, FittedParameter, H5Recorder,
     ImplicitEulerOptions, InputError, Integrator, IntegratorOptions, Model, Observer, Pins, Plane,
     RecorderOptions, Recording, Rollout, RunReport, SimulatorOptions, SimulatorSnapshot, Simulator,

@@ -163,9 +163,9 @@ py::tuple model_state(const Model& md) {
   for (const Body& b : md.bodies) {
     py::list groups;
     for (const ParticleGroup& g : b.groups) groups.append(py::make_tuple(g.name, g.particles));
-    bodies.append(py::make_tuple(b.name, b.kind, b.first_particle, b.num_particles,
-                                 b.first_spring, b.num_springs, b.spacing, b.radius, b.velocity,
-                                 b.angular_velocity, surface_state(b.surface), groups, b.color));
+    bodies.append(py::make_tuple(b.name, b.kind, b.first_particle, b.num_particles, b.first_spring,
+                                 b.num_springs, b.spacing, b.radius, b.velocity, b.angular_velocity,
+                                 surface_state(b.surface), groups, b.color));
   }
   std::vector<std::string> paths;
   for (const Path& p : md.pins.paths) paths.push_back(p.to_json().dump());
@@ -174,11 +174,10 @@ py::tuple model_state(const Model& md) {
     forces.append(py::make_tuple(static_cast<int>(f.kind), f.particles, f.vector, f.drag, f.gust,
                                  f.gust_frequency, f.start, f.end));
   }
-  return py::make_tuple(md.mass, md.rest_position,
-                        py::make_tuple(sp.a, sp.b, sp.rest_length, sp.ks, sp.kd, types),
-                        md.gravity, bodies,
-                        py::make_tuple(md.pins.particles, md.pins.anchors, md.pins.path, paths),
-                        forces);
+  return py::make_tuple(
+      md.mass, md.rest_position, py::make_tuple(sp.a, sp.b, sp.rest_length, sp.ks, sp.kd, types),
+      md.gravity, bodies, py::make_tuple(md.pins.particles, md.pins.anchors, md.pins.path, paths),
+      forces);
 }
 
 Model model_from_state(const py::tuple& t) {
@@ -194,8 +193,7 @@ Model model_from_state(const py::tuple& t) {
   md.springs.ks = sp[3].cast<std::vector<Real>>();
   md.springs.kd = sp[4].cast<std::vector<Real>>();
   for (int type : sp[5].cast<std::vector<int>>()) {
-    require(type >= 0 && type < kSpringTypeCount, "Model state spring type", type,
-            "0, 1 or 2");
+    require(type >= 0 && type < kSpringTypeCount, "Model state spring type", type, "0, 1 or 2");
     md.springs.type.push_back(static_cast<SpringType>(type));
   }
   md.gravity = t[3].cast<Vec3>();

@@ -640,10 +640,12 @@ void bind_solvers(py::module_& m) {
           "snapshot",
           [](const Simulator& s) {
             SimulatorSnapshot snapshot = s.snapshot();
-            if (!snapshot.model_values) {  // the model as built: its values too, so that a
-              const Model& m = s.model();  // reset after live edits puts them back
-              snapshot.model_values =
-                  ModelValues{m.springs.ks, m.springs.kd, m.mass, m.gravity, m.pins};
+            // The model as built: its values too, so that a reset after live edits puts
+            // them back.
+            if (!snapshot.model_values) {
+              const Model& model = s.model();
+              snapshot.model_values = ModelValues{model.springs.ks, model.springs.kd, model.mass,
+                                                  model.gravity, model.pins};
             }
             return snapshot;
           },
