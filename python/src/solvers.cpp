@@ -638,19 +638,23 @@ void bind_solvers(py::module_& m) {
       .def_property_readonly("anchors", &Simulator::anchors, "The anchors in force (copies).")
       .def(
           "snapshot",
-          [](const Simulator& s) {
+          [](const Simulator& s, bool model) {
             SimulatorSnapshot snapshot = s.snapshot();
-            // The model as built: its values too, so that a reset after live edits puts
-            // them back.
-            if (!snapshot.model_values) {
-              const Model& model = s.model();
-              snapshot.model_values = ModelValues{model.springs.ks, model.springs.kd, model.mass,
-                                                  model.gravity, model.pins};
+            // The model as built: its values too, so that a reset after live edits puts them
+            // back.
+            if (model && !snapshot.model_values) {
+              const Model& built = s.model();
+              snapshot.model_values = ModelValues{built.springs.ks, built.springs.kd, built.mass,
+                                                  built.gravity, built.pins};
             }
             return snapshot;
           },
-          "A SimulatorSnapshot to restore later (bit for bit): the state, contacts, clock and the "
-          "model's live values (pins, coefficients, masses, gravity).")
+          py::arg("model") = true,
+          "A SimulatorSnapshot to restore later (bit for bit): the state, contacts, clock and "
+          "the model's live values (pins and their targets, coefficients, masses, gravity), "
+          "which reset/restore put back. model=False leaves the values out unless the model "
+          "was edited (as the C++ Simulator::snapshot), for restoring the state into a "
+          "simulator of another model.")
       .def("restore", &Simulator::restore, py::arg("snapshot"),
            "Continues from a snapshot of a simulator with the same model, terrains, integrator "
            "and options.")
