@@ -92,13 +92,13 @@ def instances(tmp_path):
     import numpy as np
 
     scene = jelly.load_scene(pathlib.Path(__file__).resolve().parents[2] / "scenes"
-                             / "pinned_jelly.json", {"duration": 0.02})
+                             / "pinned_jelly.json", {"duration": 0.02, "output_interval": 0.005})
     sim = jelly.Simulator(scene)
     report = sim.run_until(0.02)
     path = str(tmp_path / "run.h5")
     with jelly.H5Recorder(path, sim, scene) as recorder:
         sim.add_observer(recorder)
-        sim.run_until(0.04)
+        sim.run_until(0.06)
     model = sim.model
 
     class Pull(jelly.Force):
