@@ -49,12 +49,21 @@ void rethrow_first(const std::vector<std::exception_ptr>& errors,
   }
 }
 
+// Thrown by FrameKeeper to leave a run when the rollout is stopped.
+struct RolloutStopped {};
+
 // Keeps the frames of one run in its part of the rollout's arrays.
 class FrameKeeper final : public Observer {
  public:
-  FrameKeeper(long capacity, Real* positions, Real* velocities, Real* times)
-      : capacity_(capacity), positions_(positions), velocities_(velocities), times_(times) {}
+  FrameKeeper(long capacity, Real* positions, Real* velocities, Real* times,
+              const std::atomic<bool>* stop)
+      : capacity_(capacity),
+        positions_(positions),
+        velocities_(velocities),
+        times_(times),
+        stop_(stop) {}
   void on_frame(const Simulator& sim) override {
+    if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) throw RolloutStopped{};
     if (frames_ < capacity_) {
       const VecX& x = sim.state().x;
       std::copy(x.data(), x.data() + x.size(), positions_ + frames_ * x.size());
@@ -71,6 +80,7 @@ class FrameKeeper final : public Observer {
  private:
   long capacity_;
   Real *positions_, *velocities_, *times_;
+  const std::atomic<bool>* stop_;
   long frames_ = 0;
 };
 
@@ -164,7 +174,7 @@ RolloutResult rollout(const std::vector<Scene>& scenes, const RolloutOptions& op
     RolloutRun& out = r.run[k];
     long kept = 0;
     {
-      FrameKeeper keeper(r.frames, x, v, r.times.data() + k * r.frames);
+      FrameKeeper keeper(r.frames, x, v, r.times.data() + k * r.frames, options.stop);
       try {
         sims[k]->add_observer(keeper);
         const RunReport report = sims[k]->run_until(options.duration);
@@ -173,6 +183,11 @@ RolloutResult rollout(const std::vector<Scene>& scenes, const RolloutOptions& op
         out.t = report.t;
         out.steps = report.steps;
         out.wall_seconds = report.wall_seconds;
+      } catch (const RolloutStopped&) {
+        out.status = "stopped";
+        out.t = sims[k]->state().t;
+        out.steps = sims[k]->total_steps();
+        out.reason = "stopped at t = " + to_text(out.t);
       } catch (const std::exception& e) {
         out.status = "failed";
         out.reason = e.what();

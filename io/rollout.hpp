@@ -4,6 +4,7 @@
 // their particle positions (and velocities) kept every `every` seconds in one array
 // [runs][frames][particles][3]. A run that diverges or fails stops alone; the others go on.
 // Each run's frames are the same bits as a Simulator of that scene run alone (any thread count).
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -21,13 +22,16 @@ struct RolloutOptions {
   // Runs at once (0 = the cores this process may run on). Each run steps on one thread, or on
   // threads / runs threads when there are fewer runs than threads; results do not depend on it.
   int threads = 0;
+  // When it becomes true (another thread sets it: a Ctrl-C), each run stops at its next frame
+  // and the runs not started do not start; their status is "stopped". Null: never.
+  const std::atomic<bool>* stop = nullptr;
   // Throws InputError naming the field (duration, every, threads).
   void validate() const;
 };
 
 // How one run of a rollout ended: its status is a RunStatus name ("completed",
-// "completed_with_warnings", "diverged", "solver_failed") or "failed" when the run threw (the
-// exception's message is then the reason).
+// "completed_with_warnings", "diverged", "solver_failed"), "failed" when the run threw (the
+// exception's message is then the reason) or "stopped" (RolloutOptions::stop).
 struct RolloutRun {
   std::string status;
   std::string reason;  // why it stopped early, or its warnings; empty when completed

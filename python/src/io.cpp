@@ -1,5 +1,9 @@
 // io/: scenes (JSON in, JSON out, validated by the C++ parser), simulators made from scenes,
 // the HDF5 recorder, recordings read back as NumPy arrays, checkpoints and restarts.
+#include <atomic>
+#include <chrono>
+#include <future>
+
 #include <jelly/io/checkpoint.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
@@ -169,7 +173,8 @@ void bind_rollout(py::module_& m) {
             return out;
           },
           "Each run's status: \"completed\", \"completed_with_warnings\", \"diverged\", "
-          "\"solver_failed\" or \"failed\" (it raised; the reason is the message).")
+          "\"solver_failed\", \"failed\" (it raised; the reason is the message) or "
+          "\"stopped\".")
       .def_property_readonly(
           "reasons",
           [](const RolloutResult& r) {
@@ -230,19 +235,40 @@ void bind_rollout(py::module_& m) {
       [](const std::string& scene_json, const std::vector<std::vector<std::string>>& overrides,
          const std::string& source, const std::string& base_directory, Real duration, Real every,
          bool velocities, int threads) {
+        std::atomic<bool> stop{false};
         RolloutOptions options;
         options.duration = duration;
         options.every = every;
         options.velocities = velocities;
         options.threads = threads;
-        py::gil_scoped_release release;
-        return rollout(scene_json, overrides, options, source, base_directory);
+        options.stop = &stop;
+        bool interrupted = false;
+        RolloutResult result;
+        {
+          py::gil_scoped_release release;
+          // The runs on their own threads; this one looks at Python's signals every 20 ms (a
+          // Ctrl-C stops every run at its next frame; only the main thread sees signals).
+          auto runs = std::async(std::launch::async, [&] {
+            return rollout(scene_json, overrides, options, source, base_directory);
+          });
+          while (runs.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready) {
+            if (interrupted) continue;
+            py::gil_scoped_acquire gil;
+            if (PyErr_CheckSignals() != 0) {  // the exception stays set until we raise it
+              interrupted = true;
+              stop = true;
+            }
+          }
+          result = runs.get();  // rethrows an InputError of the rollout
+        }
+        if (interrupted) throw py::error_already_set();
+        return result;
       },
       py::arg("scene_json"), py::arg("overrides_per_run"), py::arg("source"),
       py::arg("base_directory"), py::arg("duration"), py::arg("every"), py::arg("velocities"),
       py::arg("threads"),
       "The C++ jelly::rollout (jelly.rollout wraps it): runs on a pool of threads without the "
-      "GIL.");
+      "GIL; Ctrl-C stops the runs at their next frame and raises KeyboardInterrupt.");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // other particle counts or bad overrides are refused by name.
 #include <jelly/io/rollout.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -116,6 +117,20 @@ TEST(Rollout, ADivergedRunStopsAlone) {
   EXPECT_TRUE(std::isnan(diverged[r.run[1].frames * r.particles * 3]));
   EXPECT_TRUE(std::isnan(diverged[per_run - 1]));
   for (std::size_t i = 0; i < per_run; ++i) ASSERT_TRUE(std::isfinite(r.positions[i]));
+}
+
+TEST(Rollout, AStopFlagStopsEveryRun) {
+  const std::atomic<bool> stop{true};
+  RolloutOptions options;
+  options.duration = 0.1;
+  options.stop = &stop;
+  const RolloutResult r = rollout(small_slope(), {{}, {}, {}}, options);
+  for (const RolloutRun& run : r.run) {
+    EXPECT_EQ(run.status, "stopped");
+    EXPECT_EQ(run.frames, 0);
+    EXPECT_FALSE(run.ok());
+  }
+  EXPECT_TRUE(std::isnan(r.positions.front()) && std::isnan(r.positions.back()));
 }
 
 TEST(Rollout, RefusesOtherParticleCountsAndBadOverridesByName) {

@@ -2,7 +2,11 @@
 `jelly run`, bit for bit, for any thread count; a diverged run stops alone; runs of other
 particle counts, bad overrides and overrides of the rollout's own fields are refused by name."""
 
+import os
 import pickle
+import subprocess
+import sys
+import textwrap
 
 import h5py
 import numpy as np
@@ -159,3 +163,25 @@ def test_the_result_pickles_prints_and_owns_its_arrays(small_slope):
     assert np.shares_memory(r.positions, r.positions)
     # Writeable NumPy arrays: DLPack hands them over without a copy.
     assert np.shares_memory(np.from_dlpack(r.positions), r.positions)
+
+
+INTERRUPTED_ROLLOUT = textwrap.dedent("""
+    import os, signal, sys, threading, time
+    import jelly
+    scene = jelly.load_scene(sys.argv[1], {"cube.n": 4, "terrains": [], "gravity": [0, 0, 0]})
+    threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    start = time.perf_counter()
+    try:
+        jelly.rollout(scene, [{}] * 8, 1e4, every=10)  # 8 x 10^7 steps: hours
+        print("not interrupted")
+    except KeyboardInterrupt:
+        print(f"interrupted after {time.perf_counter() - start:.1f} s")
+""")
+
+
+def test_ctrl_c_stops_a_rollout(scenes):
+    result = subprocess.run([sys.executable, "-c", INTERRUPTED_ROLLOUT,
+                             str(scenes / "seed_slope.json")], capture_output=True, text=True,
+                            timeout=120, env=os.environ.copy())
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("interrupted after"), result.stdout
