@@ -41,6 +41,9 @@ def rollout(scene: Union[Scene, str, os.PathLike], overrides_per_run: Sequence[O
     if isinstance(overrides_per_run, (str, bytes, Mapping)):
         raise TypeError("rollout: overrides_per_run is a list with one item (a {path: value} "
                         "mapping or a list of 'path=value' strings) per run")
+    if every is not None and not every >= 0:
+        raise _jelly.InputError(f"every = {every} is invalid: an interval >= 0 (s; 0 = every "
+                                "step, None = the scene's output_interval)")
     runs = [_full_json_paths(scene, assignments(overrides)) for overrides in overrides_per_run]
     return _jelly._rollout(scene.to_json(), runs, scene._name, scene.base_directory,
                            float(duration), -1.0 if every is None else float(every),

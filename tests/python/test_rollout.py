@@ -131,6 +131,8 @@ def test_bad_overrides_name_the_run_and_the_field(small_slope):
         jelly.rollout(small_slope, [{}, ["output_interval=0.1"]], 0.1)
     with pytest.raises(jelly.InputError, match="duration"):
         jelly.rollout(small_slope, [{}], -1)
+    with pytest.raises(jelly.InputError, match="every = -0.5"):
+        jelly.rollout(small_slope, [{}], 0.1, every=-0.5)
     with pytest.raises(jelly.InputError, match="threads"):
         jelly.rollout(small_slope, [{}], 0.1, threads=-2)
     with pytest.raises(jelly.InputError, match="overrides_per_run"):
