@@ -187,3 +187,15 @@ def test_ctrl_c_stops_a_rollout(scenes):
                             timeout=120, env=os.environ.copy())
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("interrupted after"), result.stdout
+
+
+def test_every_integrator_runs_side_by_side_as_alone(scenes):
+    # Two runs of each registered integrator at once (their solvers, SUNDIALS contexts and
+    # factorizations on two threads), each equal to its simulator alone.
+    scene = jelly.load_scene(scenes / "seed_slope.json", {"cube.n": 3})
+    runs = [{"integrator.name": name, "integrator.dt": 0.002} for name in jelly.integrator_names()]
+    r = jelly.rollout(scene, runs * 2, 0.06, every=0.01, threads=2)
+    assert set(r.status) == {"completed"}, r.reasons
+    for k, overrides in enumerate(runs * 2):
+        x, _, _, _ = alone(scene, overrides, 0.06, 0.01)
+        assert r.positions[k].tobytes() == x.tobytes(), overrides
