@@ -12,8 +12,13 @@
 4. threads: 2 simulators (seed cube, rk4, 1 thread each) run in 2 Python threads against the
    same two runs one after the other, best and median of the repeats (the GIL is released while
    C++ steps, and each simulator has its own lock).
+5. rollout: 64 launches of a 5 x 5 x 5 cube onto the slope (random initial velocities), 500 steps
+   each (rk4, dt 1 ms), positions kept at every step: jelly.rollout (on all cores, and on one
+   thread) against a Python loop of sim.step() copying sim.state.x into the same array,
+   alternating, with the CPU time (user + system) each took; the arrays are checked equal.
 
-    PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python.py [step|view|sweep|threads ...]
+    PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python.py \
+        [step|view|sweep|threads|rollout ...]
 """
 
 import os
@@ -170,8 +175,60 @@ def bench_threads(repeats=7, seconds=1.0):
           f"{statistics.median(serial) / statistics.median(threaded):.2f}")
 
 
+def bench_rollout(repeats=3, runs=64, steps=500):
+    scene = jelly.load_scene(SCENES / "seed_slope.json", {"cube.n": 5})
+    rng = np.random.default_rng(38)
+    launches = [{"bodies[0].velocity": [float(rng.uniform(-2, 2)), float(rng.uniform(0, 3)),
+                                        float(rng.uniform(-2, 2))]} for _ in range(runs)]
+    duration = steps * scene.integrator.dt
+
+    def timed(f):
+        cpu, start = os.times(), time.perf_counter()
+        out = f()
+        wall, after = time.perf_counter() - start, os.times()
+        return out, wall, (after.user - cpu.user) + (after.system - cpu.system)
+
+    def python_loop():
+        positions = np.empty((runs, steps + 1, 125, 3))
+        for k, launch in enumerate(launches):
+            sim = jelly.Simulator(scene.with_overrides(launch))
+            positions[k, 0] = sim.state.x
+            for i in range(steps):
+                sim.step()
+                positions[k, i + 1] = sim.state.x
+        return positions
+
+    cases = {
+        "jelly.rollout, all cores": lambda: jelly.rollout(scene, launches, duration, every=0),
+        "jelly.rollout, threads=1": lambda: jelly.rollout(scene, launches, duration, every=0,
+                                                          threads=1),
+        "Python loop of step()": python_loop,
+    }
+    times = {name: [] for name in cases}
+    loads = []
+    for _ in range(repeats):  # alternating, so that load changes hit every case alike
+        loads.append(os.getloadavg()[0])
+        results = {}
+        for name, f in cases.items():
+            out, wall, cpu = timed(f)
+            times[name].append((wall, cpu))
+            results[name] = out if isinstance(out, np.ndarray) else out.positions
+        first = results["jelly.rollout, all cores"]
+        assert all(r.tobytes() == first.tobytes() for r in results.values())
+    print(f"rollout: {runs} launches of a 5 x 5 x 5 cube, {steps} steps each (rk4, dt 1 ms), "
+          f"positions at every step, {repeats} repeats, {os.cpu_count()} cores, load average "
+          f"{min(loads):.2f}-{max(loads):.2f}; the arrays equal bit for bit")
+    loop = min(w for w, _ in times["Python loop of step()"])
+    for name, values in times.items():
+        best = min(values)
+        print(f"  {name:26s} best {best[0]:6.3f} s wall, {best[1]:6.3f} s CPU "
+              f"({best[1] / best[0]:.2f} cores), median "
+              f"{statistics.median(w for w, _ in values):6.3f} s; Python loop / this: "
+              f"{loop / best[0]:.2f}")
+
+
 if __name__ == "__main__":
-    chosen = sys.argv[1:] or ["step", "view", "sweep", "threads"]
+    chosen = sys.argv[1:] or ["step", "view", "sweep", "threads", "rollout"]
     for name in chosen:
         {"step": bench_step, "view": bench_view, "sweep": bench_sweep,
-         "threads": bench_threads}[name]()
+         "threads": bench_threads, "rollout": bench_rollout}[name]()

@@ -27,6 +27,8 @@ packages=(
   python3-scipy
   # the wheel test (tests/python/wheel_test.sh): python3 -m build
   python3-build python3-venv
+  # jelly.dlpack: arrays handed to torch/JAX without copies (DLPack's header only)
+  libdlpack-dev
 )
 if [ "${1:-}" = "--tests" ]; then
   # The test jelly_paraview (tests/io/paraview_test.py; it skips without them): ParaView and its

@@ -1,7 +1,7 @@
 """jelly: a mass-spring soft-body solver (C++17) in Python.
 
 Scenes (``load_scene``, attributes by JSON path), simulation with NumPy views of the C++ state
-(``Simulator``), recordings (``H5Recorder``, ``read_recording``, checkpoints), fitting
+(``Simulator``), batched rollouts into NumPy arrays (``rollout``), recordings (``H5Recorder``, ``read_recording``, checkpoints), fitting
 (``fit_recording``) and parameter sweeps on Dask (``sweep``). See docs/python.md.
 """
 
@@ -11,9 +11,10 @@ from typing import Any as _Any, Optional as _Optional, Union as _Union
 from . import _jelly
 from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module folder)
     AnchorSpring, ArkodeOptions, Body, Checkpoint, ContactParams, CubeSpec, DivergenceGuard,
+    DLPackExport, dlpack,
     Elevator, ElevatorSpec, ExternalForce, FitOptions, Force, FitResult, FittedParameter, H5Recorder,
     ImplicitEulerOptions, InputError, Integrator, IntegratorOptions, Model, Observer, Pins, Plane,
-    RecorderOptions, Recording, RunReport, SimulatorOptions, SimulatorSnapshot, Simulator,
+    RecorderOptions, Recording, Rollout, RunReport, SimulatorOptions, SimulatorSnapshot, Simulator,
     SpringCoefficients, Springs, SpringType, State, StepResult, Surface, Terrain, __version__,
     angular_momentum, apply_override, body_kinds, build_cube, center_of_mass, check_same_scene,
     contact_models, cube_index, cube_particle_count, cube_spring_count, describe_recording,
@@ -22,6 +23,7 @@ from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module f
     initial_state, rest_state, restore, scene_to_json, spring_type_names, terrain_kinds, total_energy,
     write_xdmf_for_recording)
 from ._scene import Scene, load_scene
+from ._rollout import rollout
 from ._sweep import sweep, sweep_points
 from ._gradient import gradient
 
@@ -131,5 +133,9 @@ AnchorSpring.__reduce__ = lambda self: (
 SpringCoefficients.__reduce__ = lambda self: (_options_from_state, (SpringCoefficients,
                                                                      {"ks": self.ks,
                                                                       "kd": self.kd}))
+
+# Classes to subclass in Python: their instances print as the subclass's name.
+Force.__repr__ = lambda self: f"<jelly.Force {type(self).__name__}>"
+Observer.__repr__ = lambda self: f"<jelly.Observer {type(self).__name__}>"
 
 __all__ = sorted(name for name in dir() if not name.startswith("_"))

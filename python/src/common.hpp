@@ -123,5 +123,7 @@ void bind_solvers(py::module_& m);
 void bind_io(py::module_& m);
 void bind_fit(py::module_& m);
 void bind_adjoint(py::module_& m);
+// DLPack export of arrays (dlpack.cpp).
+void bind_dlpack(py::module_& m);
 
 }  // namespace jelly::python

@@ -1,11 +1,14 @@
 // core/: the model (masses, springs as NumPy arrays, its bodies with their render surfaces,
 // pins and external forces), the state, energies and momenta.
 #include <map>
+#include <optional>
+#include <vector>
 
 #include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/body.hpp>
 #include <jelly/core/external_force.hpp>
 #include <jelly/core/force.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/pins.hpp>
@@ -137,6 +140,109 @@ class PyForce : public Force {
     for (const auto& [at, b] : blocks) jacobian.add(b.i, b.j, b.dfdx, b.dfdv);
   }
 };
+
+// Model's pickled state: every field, as plain values (paths of pins as their scene JSON).
+py::tuple surface_state(const Surface& s) {
+  return py::make_tuple(s.triangles, s.offsets, s.particles, s.weights);
+}
+
+Surface surface_from_state(const py::tuple& t) {
+  Surface s;
+  s.triangles = t[0].cast<std::vector<Triangle>>();
+  s.offsets = t[1].cast<std::vector<int>>();
+  s.particles = t[2].cast<std::vector<int>>();
+  s.weights = t[3].cast<std::vector<Real>>();
+  return s;
+}
+
+py::tuple model_state(const Model& md) {
+  const Springs& sp = md.springs;
+  std::vector<int> types;
+  for (SpringType t : sp.type) types.push_back(static_cast<int>(t));
+  py::list bodies;
+  for (const Body& b : md.bodies) {
+    py::list groups;
+    for (const ParticleGroup& g : b.groups) groups.append(py::make_tuple(g.name, g.particles));
+    bodies.append(py::make_tuple(b.name, b.kind, b.first_particle, b.num_particles, b.first_spring,
+                                 b.num_springs, b.spacing, b.radius, b.velocity, b.angular_velocity,
+                                 surface_state(b.surface), groups, b.color));
+  }
+  std::vector<std::string> paths;
+  for (const Path& p : md.pins.paths) paths.push_back(p.to_json().dump());
+  py::list forces;
+  for (const ExternalForce& f : md.external_forces) {
+    forces.append(py::make_tuple(static_cast<int>(f.kind), f.particles, f.vector, f.drag, f.gust,
+                                 f.gust_frequency, f.start, f.end));
+  }
+  return py::make_tuple(
+      md.mass, md.rest_position, py::make_tuple(sp.a, sp.b, sp.rest_length, sp.ks, sp.kd, types),
+      md.gravity, bodies, py::make_tuple(md.pins.particles, md.pins.anchors, md.pins.path, paths),
+      forces);
+}
+
+Model model_from_state(const py::tuple& t) {
+  require(t.size() == 7, "Model state", std::to_string(t.size()) + " items",
+          "the 7 items of a pickled Model");
+  Model md;
+  md.mass = t[0].cast<VecX>();
+  md.rest_position = t[1].cast<VecX>();
+  const auto sp = t[2].cast<py::tuple>();
+  md.springs.a = sp[0].cast<std::vector<int>>();
+  md.springs.b = sp[1].cast<std::vector<int>>();
+  md.springs.rest_length = sp[2].cast<std::vector<Real>>();
+  md.springs.ks = sp[3].cast<std::vector<Real>>();
+  md.springs.kd = sp[4].cast<std::vector<Real>>();
+  for (int type : sp[5].cast<std::vector<int>>()) {
+    require(type >= 0 && type < kSpringTypeCount, "Model state spring type", type, "0, 1 or 2");
+    md.springs.type.push_back(static_cast<SpringType>(type));
+  }
+  md.gravity = t[3].cast<Vec3>();
+  for (const py::handle item : t[4].cast<py::list>()) {
+    const auto b = item.cast<py::tuple>();
+    Body body;
+    body.name = b[0].cast<std::string>();
+    body.kind = b[1].cast<std::string>();
+    body.first_particle = b[2].cast<int>();
+    body.num_particles = b[3].cast<int>();
+    body.first_spring = b[4].cast<int>();
+    body.num_springs = b[5].cast<int>();
+    body.spacing = b[6].cast<Real>();
+    body.radius = b[7].cast<Real>();
+    body.velocity = b[8].cast<Vec3>();
+    body.angular_velocity = b[9].cast<Vec3>();
+    body.surface = surface_from_state(b[10].cast<py::tuple>());
+    for (const py::handle g : b[11].cast<py::list>()) {
+      const auto group = g.cast<py::tuple>();
+      body.groups.push_back({group[0].cast<std::string>(), group[1].cast<std::vector<int>>()});
+    }
+    body.color = b[12].cast<std::optional<Vec3>>();
+    md.bodies.push_back(std::move(body));
+  }
+  const auto pins = t[5].cast<py::tuple>();
+  md.pins.particles = pins[0].cast<std::vector<int>>();
+  md.pins.anchors = pins[1].cast<std::vector<Vec3>>();
+  md.pins.path = pins[2].cast<std::vector<int>>();
+  for (const std::string& text : pins[3].cast<std::vector<std::string>>())
+    md.pins.paths.push_back(Path::read(Json::parse(text), "Model state pin path"));
+  for (const py::handle item : t[6].cast<py::list>()) {
+    const auto f = item.cast<py::tuple>();
+    ExternalForce force;
+    const int kind = f[0].cast<int>();
+    require(kind >= 0 && kind <= static_cast<int>(ExternalForceKind::kPoint),
+            "Model state external force kind", kind, "0, 1 or 2");
+    force.kind = static_cast<ExternalForceKind>(kind);
+    force.particles = f[1].cast<std::vector<int>>();
+    force.vector = f[2].cast<Vec3>();
+    force.drag = f[3].cast<Real>();
+    force.gust = f[4].cast<Real>();
+    force.gust_frequency = f[5].cast<Real>();
+    force.start = f[6].cast<Real>();
+    force.end = f[7].cast<Real>();
+    md.external_forces.push_back(std::move(force));
+  }
+  md.validate();  // a tampered pickle is an InputError, not a broken model
+  return md;
+}
 
 }  // namespace
 
@@ -484,6 +590,7 @@ void bind_core(py::module_& m) {
           "The number of springs M.")
       .def("validate", &Model::validate,
            "Raises InputError when a mass, index, rest length or coefficient is out of range.")
+      .def(py::pickle(&model_state, &model_from_state))
       .def("__repr__", [](const Model& md) {
         return "<jelly.Model with " + std::to_string(md.num_particles()) + " particles and " +
                std::to_string(md.springs.size()) + " springs>";

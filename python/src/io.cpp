@@ -1,9 +1,14 @@
 // io/: scenes (JSON in, JSON out, validated by the C++ parser), simulators made from scenes,
 // the HDF5 recorder, recordings read back as NumPy arrays, checkpoints and restarts.
+#include <atomic>
+#include <chrono>
+#include <future>
+
 #include <jelly/core/json.hpp>
 #include <jelly/io/checkpoint.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
+#include <jelly/io/rollout.hpp>
 #include <jelly/io/run_limits.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/io/xdmf.hpp>
@@ -62,9 +67,215 @@ py::array stack_frames(const std::vector<VecX>& frames, int n) {
   return out;
 }
 
+// A rollout's [runs][frames][particles][3] vector as a NumPy array over its memory, owned by the
+// Python Rollout object `owner` (writeable: the arrays are the caller's data).
+py::array rollout_array(const std::vector<Real>& values, const RolloutResult& r, py::handle owner) {
+  const auto s = static_cast<py::ssize_t>(sizeof(Real));
+  const py::ssize_t runs = r.runs, frames = r.frames, n = r.particles;
+  return py::array(py::dtype::of<Real>(), {runs, frames, n, py::ssize_t{3}},
+                   {frames * n * 3 * s, n * 3 * s, 3 * s, s}, values.data(), owner);
+}
+
+py::dict rollout_run_dict(const RolloutRun& run) {
+  py::dict d;
+  d["status"] = run.status;
+  d["reason"] = run.reason;
+  d["t"] = run.t;
+  d["steps"] = run.steps;
+  d["frames"] = run.frames;
+  d["wall_seconds"] = run.wall_seconds;
+  return d;
+}
+
+// Rollout's pickled state: the sizes, the arrays (copies) and the runs as tuples.
+py::tuple rollout_state(const RolloutResult& r) {
+  py::list runs;
+  for (const RolloutRun& run : r.run)
+    runs.append(
+        py::make_tuple(run.status, run.reason, run.t, run.steps, run.frames, run.wall_seconds));
+  return py::make_tuple(
+      r.runs, r.frames, r.particles,
+      py::bytes(reinterpret_cast<const char*>(r.positions.data()),
+                r.positions.size() * sizeof(Real)),
+      py::bytes(reinterpret_cast<const char*>(r.velocities.data()),
+                r.velocities.size() * sizeof(Real)),
+      py::bytes(reinterpret_cast<const char*>(r.times.data()), r.times.size() * sizeof(Real)), runs,
+      r.wall_seconds, r.threads);
+}
+
+std::vector<Real> reals_of(const py::bytes& b) {
+  const std::string text = b;
+  std::vector<Real> out(text.size() / sizeof(Real));
+  std::copy(text.data(), text.data() + out.size() * sizeof(Real),
+            reinterpret_cast<char*>(out.data()));
+  return out;
+}
+
+RolloutResult rollout_from_state(const py::tuple& t) {
+  require(t.size() == 9, "Rollout state", std::to_string(t.size()) + " items",
+          "the 9 items of a pickled Rollout");
+  RolloutResult r;
+  r.runs = t[0].cast<long>();
+  r.frames = t[1].cast<long>();
+  r.particles = t[2].cast<long>();
+  r.positions = reals_of(t[3]);
+  r.velocities = reals_of(t[4]);
+  r.times = reals_of(t[5]);
+  for (const py::handle item : t[6].cast<py::list>()) {
+    const auto run = item.cast<py::tuple>();
+    r.run.push_back({run[0].cast<std::string>(), run[1].cast<std::string>(), run[2].cast<Real>(),
+                     run[3].cast<long>(), run[4].cast<long>(), run[5].cast<double>()});
+  }
+  r.wall_seconds = t[7].cast<double>();
+  r.threads = t[8].cast<int>();
+  const auto values = static_cast<std::size_t>(r.runs * r.frames * r.particles * 3);
+  require(r.positions.size() == values && (r.velocities.empty() || r.velocities.size() == values) &&
+              r.times.size() == static_cast<std::size_t>(r.runs * r.frames) &&
+              r.run.size() == static_cast<std::size_t>(r.runs),
+          "Rollout state", "arrays of other sizes", "the sizes of a pickled Rollout");
+  return r;
+}
+
+void bind_rollout(py::module_& m) {
+  py::class_<RolloutResult>(
+      m, "Rollout",
+      "The result of jelly.rollout: positions (and velocities) of every run at every frame as "
+      "NumPy arrays over its own memory, the frame times, and how each run ended.")
+      .def_property_readonly(
+          "positions",
+          [](py::object self) {
+            const auto& r = self.cast<const RolloutResult&>();
+            return rollout_array(r.positions, r, self);
+          },
+          "Positions (m), float64 [runs, frames, particles, 3] (a view of the result's memory, "
+          "no copy); NaN after a run's last frame.")
+      .def_property_readonly(
+          "velocities",
+          [](py::object self) -> py::object {
+            const auto& r = self.cast<const RolloutResult&>();
+            if (r.velocities.empty()) return py::none();
+            return rollout_array(r.velocities, r, self);
+          },
+          "Velocities (m/s) in the layout of positions, or None unless rollout(velocities=True).")
+      .def_property_readonly(
+          "times",
+          [](py::object self) {
+            const auto& r = self.cast<const RolloutResult&>();
+            const auto s = static_cast<py::ssize_t>(sizeof(Real));
+            return py::array(py::dtype::of<Real>(), {py::ssize_t(r.runs), py::ssize_t(r.frames)},
+                             {py::ssize_t(r.frames) * s, s}, r.times.data(), self);
+          },
+          "Time of each frame (s), [runs, frames]; NaN after a run's last frame.")
+      .def_property_readonly(
+          "status",
+          [](const RolloutResult& r) {
+            std::vector<std::string> out;
+            for (const RolloutRun& run : r.run) out.push_back(run.status);
+            return out;
+          },
+          "Each run's status: \"completed\", \"completed_with_warnings\", \"diverged\", "
+          "\"solver_failed\", \"failed\" (it raised; the reason is the message) or "
+          "\"stopped\".")
+      .def_property_readonly(
+          "reasons",
+          [](const RolloutResult& r) {
+            std::vector<std::string> out;
+            for (const RolloutRun& run : r.run) out.push_back(run.reason);
+            return out;
+          },
+          "Why each run stopped early (or its warnings); \"\" for a completed run.")
+      .def_property_readonly(
+          "ok",
+          [](const RolloutResult& r) {
+            py::array_t<bool> out(static_cast<py::ssize_t>(r.runs));
+            for (long k = 0; k < r.runs; ++k) out.mutable_at(k) = r.run[k].ok();
+            return out;
+          },
+          "Whether each run reached the duration, bool [runs].")
+      .def_property_readonly(
+          "frames",
+          [](const RolloutResult& r) {
+            py::array_t<long> out(static_cast<py::ssize_t>(r.runs));
+            for (long k = 0; k < r.runs; ++k) out.mutable_at(k) = r.run[k].frames;
+            return out;
+          },
+          "Frames each run kept, int [runs] (the arrays have max(frames) frames).")
+      .def_property_readonly(
+          "steps",
+          [](const RolloutResult& r) {
+            py::array_t<long> out(static_cast<py::ssize_t>(r.runs));
+            for (long k = 0; k < r.runs; ++k) out.mutable_at(k) = r.run[k].steps;
+            return out;
+          },
+          "Steps each run took, int [runs].")
+      .def_property_readonly(
+          "runs",
+          [](const RolloutResult& r) {
+            py::list out;
+            for (const RolloutRun& run : r.run) out.append(rollout_run_dict(run));
+            return out;
+          },
+          "Each run as a dict: status, reason, t, steps, frames, wall_seconds.")
+      .def_readonly("wall_seconds", &RolloutResult::wall_seconds,
+                    "Wall time of the whole rollout (s).")
+      .def_readonly("threads", &RolloutResult::threads, "Runs that went at once.")
+      .def(
+          "__len__", [](const RolloutResult& r) { return r.runs; }, "The number of runs.")
+      .def(py::pickle([](const RolloutResult& r) { return rollout_state(r); },
+                      [](const py::tuple& t) { return rollout_from_state(t); }))
+      .def("__repr__", [](const RolloutResult& r) {
+        long ok = 0;
+        for (const RolloutRun& run : r.run) ok += run.ok() ? 1 : 0;
+        return "<jelly.Rollout " + std::to_string(r.runs) + " runs (" + std::to_string(ok) +
+               " ok), " + std::to_string(r.frames) + " frames of " + std::to_string(r.particles) +
+               " particles" + (r.velocities.empty() ? "" : ", with velocities") + ">";
+      });
+
+  m.def(
+      "_rollout",
+      [](const std::string& scene_json, const std::vector<std::vector<std::string>>& overrides,
+         const std::string& source, const std::string& base_directory, Real duration, Real every,
+         bool velocities, int threads) {
+        std::atomic<bool> stop{false};
+        RolloutOptions options;
+        options.duration = duration;
+        options.every = every;
+        options.velocities = velocities;
+        options.threads = threads;
+        options.stop = &stop;
+        bool interrupted = false;
+        RolloutResult result;
+        {
+          py::gil_scoped_release release;
+          // The runs on their own threads; this one looks at Python's signals every 20 ms (a
+          // Ctrl-C stops every run at its next frame; only the main thread sees signals).
+          auto runs = std::async(std::launch::async, [&] {
+            return rollout(scene_json, overrides, options, source, base_directory);
+          });
+          while (runs.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready) {
+            if (interrupted) continue;
+            py::gil_scoped_acquire gil;
+            if (PyErr_CheckSignals() != 0) {  // the exception stays set until we raise it
+              interrupted = true;
+              stop = true;
+            }
+          }
+          result = runs.get();  // rethrows an InputError of the rollout
+        }
+        if (interrupted) throw py::error_already_set();
+        return result;
+      },
+      py::arg("scene_json"), py::arg("overrides_per_run"), py::arg("source"),
+      py::arg("base_directory"), py::arg("duration"), py::arg("every"), py::arg("velocities"),
+      py::arg("threads"),
+      "The C++ jelly::rollout (jelly.rollout wraps it): runs on a pool of threads without the "
+      "GIL; Ctrl-C stops the runs at their next frame and raises KeyboardInterrupt.");
+}
+
 }  // namespace
 
 void bind_io(py::module_& m) {
+  bind_rollout(m);
   py::class_<Scene>(m, "_Scene",
                     "The C++ scene (jelly.Scene wraps it: attribute access by JSON path).")
       .def(py::init([](const std::string& json_text, const std::vector<std::string>& overrides,

@@ -22,5 +22,6 @@ PYBIND11_MODULE(_jelly, m) {
   jelly::python::bind_io(m);
   jelly::python::bind_fit(m);
   jelly::python::bind_adjoint(m);
+  jelly::python::bind_dlpack(m);
   jelly::python::serialise_simulator(m);
 }

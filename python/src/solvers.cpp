@@ -546,9 +546,42 @@ void bind_solvers(py::module_& m) {
            "Calls observer.on_frame at every output frame of run_until (and on_finish at its end).")
       .def("remove_observer", &Simulator::remove_observer, py::arg("observer"),
            "Stops calling an observer added before; False when it was not added.")
-      .def("step", &Simulator::step, py::call_guard<py::gil_scoped_release>(),
-           "One step of options.dt, then contact (the GIL is released). Returns a StepResult; "
-           "does not check divergence (run_until does).")
+      .def(
+          "step",
+          [](Simulator& s, long n) {
+            require(n >= 1, "n", n, "a step count >= 1");
+            py::gil_scoped_release release;
+            // Ctrl-C between steps, looked at most every 20 ms (Python runs its handlers in the
+            // main thread only).
+            auto next_check = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
+            StepResult result;
+            for (long k = 0; k < n; ++k) {
+              result = s.step();
+              if (!result.ok) break;
+              if (k + 1 < n && std::chrono::steady_clock::now() >= next_check) {
+                next_check = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
+                py::gil_scoped_acquire gil;
+                if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+              }
+            }
+            return result;
+          },
+          py::arg("n") = 1,
+          "n steps of options.dt (default 1), each followed by contact, with the GIL released; "
+          "stops at the first step the integrator fails and returns that step's StepResult (else "
+          "the last one's). Does not call observers or check divergence (run_until does). "
+          "Ctrl-C stops it between two steps.")
+      .def(
+          "reset", [](Simulator& s, const SimulatorSnapshot& snapshot) { s.restore(snapshot); },
+          py::arg("snapshot"),
+          "Back to a snapshot of this simulator (Simulator.snapshot()): state, contacts, clock, "
+          "step count and the model's live values of then (pins and their targets, spring "
+          "coefficients, masses, gravity), bit for bit. Added forces, terrains and the integrator "
+          "stay as they are. The arrays of sim.state keep their memory (views stay valid).")
+      .def(
+          "reset", [](Simulator& s, const State& state) { s.set_state(state); }, py::arg("state"),
+          "Back to a state (positions, velocities, t): as set_state, the active contacts are "
+          "forgotten and the output clock restarts; the model's live values stay as they are.")
       .def(
           "run_until",
           [](py::object self, Real t_end, py::object callback) {
@@ -603,7 +636,25 @@ void bind_solvers(py::module_& m) {
            "every step until replaced ([] removes them); implicit integrators take them into "
            "their solve. Raises InputError for an invalid anchor. Not part of snapshots.")
       .def_property_readonly("anchors", &Simulator::anchors, "The anchors in force (copies).")
-      .def("snapshot", &Simulator::snapshot, "A SimulatorSnapshot to restore later (bit for bit).")
+      .def(
+          "snapshot",
+          [](const Simulator& s, bool model) {
+            SimulatorSnapshot snapshot = s.snapshot();
+            // The model as built: its values too, so that a reset after live edits puts them
+            // back.
+            if (model && !snapshot.model_values) {
+              const Model& built = s.model();
+              snapshot.model_values = ModelValues{built.springs.ks, built.springs.kd, built.mass,
+                                                  built.gravity, built.pins};
+            }
+            return snapshot;
+          },
+          py::arg("model") = true,
+          "A SimulatorSnapshot to restore later (bit for bit): the state, contacts, clock and "
+          "the model's live values (pins and their targets, coefficients, masses, gravity), "
+          "which reset/restore put back. model=False leaves the values out unless the model "
+          "was edited (as the C++ Simulator::snapshot), for restoring the state into a "
+          "simulator of another model.")
       .def("restore", &Simulator::restore, py::arg("snapshot"),
            "Continues from a snapshot of a simulator with the same model, terrains, integrator "
            "and options.")

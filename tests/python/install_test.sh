@@ -8,7 +8,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 prefix=$work/prefix
 "$cmake" --install "$build_dir" --prefix "$prefix" >"$work/install.log"
-for f in __init__.py __init__.pyi _scene.py _sweep.py py.typed; do
+for f in __init__.py __init__.pyi _rollout.py _scene.py _sweep.py py.typed; do
   [ -e "$prefix/$site/jelly/$f" ] || { echo "missing from the install: $site/jelly/$f"; exit 1; }
 done
 ls "$prefix/$site/jelly/"_jelly*.so >/dev/null

@@ -85,3 +85,96 @@ def test_everything_public_has_a_docstring():
         elif callable(obj) and not has_doc(obj):
             undocumented.append(name)
     assert undocumented == []
+
+
+def instances(tmp_path):
+    """One instance of every public class of the module, by class name."""
+    import numpy as np
+
+    scene = jelly.load_scene(pathlib.Path(__file__).resolve().parents[2] / "scenes"
+                             / "pinned_jelly.json", {"duration": 0.02, "output_interval": 0.005})
+    sim = jelly.Simulator(scene)
+    report = sim.run_until(0.02)
+    path = str(tmp_path / "run.h5")
+    with jelly.H5Recorder(path, sim, scene) as recorder:
+        sim.add_observer(recorder)
+        sim.run_until(0.06)
+    model = sim.model
+
+    class Pull(jelly.Force):
+        def forces(self, t, x, v, f):
+            pass
+
+    class Watch(jelly.Observer):
+        def on_frame(self, simulator):
+            pass
+
+    fit = jelly.fit_recording(path, free="ks", max_iterations=1, window=0.02)
+    out = {
+        "AnchorSpring": jelly.AnchorSpring(0, [0, 1, 0], 10.0),
+        "ArkodeOptions": jelly.ArkodeOptions(), "Body": model.bodies[0],
+        "Checkpoint": jelly.read_checkpoint(path), "ContactParams": jelly.ContactParams(),
+        "CubeSpec": jelly.CubeSpec(), "DLPackExport": jelly.dlpack(np.zeros(3)),
+        "DivergenceGuard": jelly.DivergenceGuard(), "Elevator": jelly.Elevator(),
+        "ElevatorSpec": jelly.ElevatorSpec(), "ExternalForce": None, "FitOptions": jelly.FitOptions(),
+        "FitResult": fit, "FittedParameter": fit.parameters[0], "Force": Pull(),
+        "H5Recorder": recorder, "ImplicitEulerOptions": jelly.ImplicitEulerOptions(),
+        "Integrator": sim.integrator, "IntegratorOptions": jelly.IntegratorOptions(),
+        "Model": model, "Observer": Watch(), "Pins": model.pins, "Plane": jelly.Plane.slope(20),
+        "RecorderOptions": jelly.RecorderOptions(), "Recording": jelly.read_recording(path),
+        "Rollout": jelly.rollout(scene, [{}], 0.01, every=0.005), "RunReport": report,
+        "Scene": scene, "Simulator": sim, "SimulatorOptions": jelly.SimulatorOptions(),
+        "SimulatorSnapshot": sim.snapshot(), "SpringCoefficients": jelly.SpringCoefficients(),
+        "SpringType": jelly.SpringType.shear, "Springs": model.springs,
+        "State": sim.state, "StepResult": sim.step(), "Surface": model.bodies[0].surface,
+        "Terrain": sim.terrains[0],
+    }
+    wind = jelly.Scene({"bodies": [{"kind": "cube", "n": 2, "forces": [
+        {"kind": "wind", "velocity": [1, 0, 0], "drag": 0.1}]}],
+        "integrator": {"name": "rk4"}, "duration": 1})
+    out["ExternalForce"] = jelly.make_model(wind).external_forces[0]
+    return out
+
+
+# What does not pickle, and why: views into a simulator or model (pickle the model or the
+# scene), live objects (a simulator: pickle its scene and a snapshot; a recorder writes a file;
+# a subclass's Python state), and results made to be read, not stored.
+NOT_PICKLED = {"Body", "Checkpoint", "DLPackExport", "Elevator", "ExternalForce", "FitResult",
+               "FittedParameter", "Force", "H5Recorder", "Integrator", "Observer", "Pins",
+               "Plane", "Simulator", "Springs", "StepResult", "Surface", "Terrain"}
+
+
+def test_every_class_prints_and_pickles_or_says_it_does_not(tmp_path):
+    import copy
+    import pickle
+
+    import numpy as np
+
+    objects = instances(tmp_path)
+    classes = {name for name in jelly.__all__ if inspect.isclass(getattr(jelly, name))
+               and not issubclass(getattr(jelly, name), BaseException)}
+    assert classes == set(objects), "a public class without an instance here"
+    for name, obj in sorted(objects.items()):
+        assert isinstance(obj, getattr(jelly, name)), name
+        text = repr(obj)
+        assert " object at 0x" not in text, f"{name} has no repr of its own: {text}"
+        if name in NOT_PICKLED:
+            continue
+        back = pickle.loads(pickle.dumps(obj))
+        assert type(back) is type(obj), name
+        assert repr(back) == text or name in ("Scene",), name
+        if name in ("Model", "State", "Rollout", "SimulatorSnapshot"):
+            copy.deepcopy(obj)
+    model = pickle.loads(pickle.dumps(objects["Model"]))
+    original = objects["Model"]
+    for field in ("mass", "rest_position"):
+        assert getattr(model, field).tobytes() == getattr(original, field).tobytes()
+    for field in ("a", "b", "ks", "kd", "rest_length", "type"):
+        assert np.array_equal(getattr(model.springs, field), getattr(original.springs, field))
+    assert repr(model.pins) == repr(original.pins) and len(model.bodies) == len(original.bodies)
+    assert repr(model.bodies[0]) == repr(original.bodies[0])
+    # A simulator of the unpickled model runs as one of the original.
+    a, b = jelly.Simulator(original), jelly.Simulator(model)
+    a.step(20)
+    b.step(20)
+    assert a.state.x.tobytes() == b.state.x.tobytes()
