@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <optional>
 
 #include <jelly/core/detail/anchor_jacobian.hpp>
@@ -15,6 +16,7 @@
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/lattice_multigrid.hpp>
 #include <jelly/solvers/linear/ldlt_solver.hpp>
 
 namespace jelly {
@@ -172,6 +174,11 @@ struct ImplicitEuler::Impl {
   bool matrix_free_failed_ = false;  // a collapsed spring: the assembled path from then on
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
+  // cg_preconditioner = multigrid on the matrix-free path, when the model has a lattice body:
+  // the V-cycle, and whether its coarse operators are older than the last assembly.
+  LatticeMultigrid multigrid_;
+  bool use_multigrid_ = false;
+  bool coarse_stale_ = true;
   VecX az_;
   VecX cg_x_;                      // a loose matrix-free solve's iterate, for resuming it
   int loose_iterations_ = 0;       // ... and its CG iterations
@@ -229,7 +236,8 @@ const std::vector<Real>& ImplicitEuler::last_residuals() const { return impl_->r
 bool ImplicitEuler::last_converged() const { return impl_->converged_; }
 
 std::string_view ImplicitEuler::linear_solver_name() const {
-  if (impl_->matrix_free_) return "cg_jacobi_matrix_free";
+  if (impl_->matrix_free_)
+    return impl_->use_multigrid_ ? "cg_multigrid_matrix_free" : "cg_jacobi_matrix_free";
   return impl_->solver_ ? impl_->solver_->name() : std::string_view();
 }
 
@@ -267,6 +275,7 @@ void ImplicitEuler::Impl::add_statistics(Statistics& s) const {
   s["assembly_seconds"] = assembly_seconds_;
   s["factorization_seconds"] = factorization_seconds_;
   s["solve_seconds"] = solve_seconds_;
+  if (use_multigrid_) s["multigrid_levels"] = static_cast<double>(multigrid_.levels());
   if (resolves_contact()) {
     const ImplicitContact::Counters& cc = contact_.counters();
     s["contact_extra_solves"] = static_cast<double>(cc.extra_solves);
@@ -338,7 +347,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
   // Block-Jacobi CG needs only products with A: from the bands when the springs fill them.
   const bool matrix_free =
       kind == ImplicitLinearSolver::kCg &&
-      (automatic || options_.cg_preconditioner == CgPreconditionerKind::kJacobi) &&
+      (automatic || options_.cg_preconditioner != CgPreconditionerKind::kCholmod) &&
       bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_ &&
       // Contact pairs between bodies and added forces' Jacobians add blocks off the springs'
       // bands: the assembled matrix.
@@ -363,6 +372,11 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       az_.setZero(n);
       size_vectors();
       matrix_free_ = true;
+      use_multigrid_ = false;
+      coarse_stale_ = true;
+      if (options_.cg_preconditioner == CgPreconditionerKind::kMultigrid)
+        use_multigrid_ = multigrid_.build(model, *bands);
+      if (const char* e = std::getenv("JELLY_MG_ADDITIVE")) multigrid_.set_additive(e[0] == '1');
       factorization_seconds_ += seconds_since(start);
     }
     last_h_ = h;
@@ -372,6 +386,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       jacobian_->num_springs() != model.springs.size()) {
     const auto start = Clock::now();
     matrix_free_ = false;
+    use_multigrid_ = false;
     band_.reset();
     extra_blocks_.clear();
     force_blocks_.clear();
@@ -415,6 +430,7 @@ StepResult ImplicitEuler::Impl::assemble(const Dynamics& dynamics, const VecX& x
     solver_->set_threads(threads_);
   }
   if (matrix_free_) {
+    coarse_stale_ = true;
     if (dynamics.anchors() != nullptr) {
       for (const AnchorSpring& anchor : *dynamics.anchors()) {
         band_->add_diagonal(anchor.particle, h * anchor.damping + h * h * anchor.stiffness);
@@ -467,21 +483,30 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
                                                   bool constrained, Real t, Real tolerance,
                                                   bool resume) {
   auto start = Clock::now();
-  // Block Jacobi: the inverses of the (filtered) diagonal blocks (kept when resuming).
+  // Block Jacobi: the inverses of the (filtered) diagonal blocks (kept when resuming); with
+  // multigrid they are its finest smoother's, and its coarse operators are rebuilt at the first
+  // solve after an assembly (a later solve of the step with another contact set keeps them:
+  // the V-cycle stays symmetric positive definite, only a little less sharp).
   LinearResult r;
+  const ProductFilter filter = constrained ? contact_.product_filter() : ProductFilter{};
   if (!resume) {
-    r = band_cg_.set_diagonal_blocks(
-        model.num_particles(),
-        [&](int i, Real d[9]) {
-          band_->diagonal_block(i, d);
-          if (constrained) contact_.filter_diagonal_block(i, d);
-        },
-        threads_);
+    const auto diagonal = [&](int i, Real d[9]) {
+      band_->diagonal_block(i, d);
+      if (constrained) contact_.filter_diagonal_block(i, d);
+    };
+    if (use_multigrid_) {
+      r = multigrid_.set_diagonal_blocks(model.num_particles(), diagonal, filter, threads_);
+      if (r.ok() && coarse_stale_) {
+        multigrid_.set_operator(*band_, filter, threads_);
+        coarse_stale_ = false;
+      }
+    } else {
+      r = band_cg_.set_diagonal_blocks(model.num_particles(), diagonal, threads_);
+    }
   }
   factorization_seconds_ += seconds_since(start);
   if (r.ok()) {
     start = Clock::now();
-    const ProductFilter filter = constrained ? contact_.product_filter() : ProductFilter{};
     const auto apply = [&](const VecX& in, VecX& out) {
       band_->multiply(in, out, threads_, filter);
     };
@@ -489,7 +514,15 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
     // iterations the loose solve left, so that it is one solve in every respect.
     if (resume) y = cg_x_;
     const int done = resume ? loose_iterations_ : 0;
-    r = band_cg_.solve(apply, b, y, tolerance, options_.cg_max_iterations - done, threads_, resume);
+    const int limit = options_.cg_max_iterations - done;
+    if (use_multigrid_) {
+      const auto precondition = [&](const VecX& in, VecX& out) {
+        multigrid_.apply(apply, in, out, threads_);
+      };
+      r = band_cg_.solve(apply, precondition, b, y, tolerance, limit, threads_, resume);
+    } else {
+      r = band_cg_.solve(apply, b, y, tolerance, limit, threads_, resume);
+    }
     r.iterations += done;
     if (!resume && tolerance > options_.cg_tolerance) {  // a loose solve: kept for resuming
       cg_x_ = y;
