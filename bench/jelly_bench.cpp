@@ -124,6 +124,8 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   speed_cmd->add_option("--ks", speed.ks, "spring stiffness of every type (N/m)")
       ->capture_default_str();
+  speed_cmd->add_option("--warmup-steps", speed.warmup_steps, "untimed steps before the timed ones")
+      ->capture_default_str();
   speed_cmd->add_option("--steps", speed.steps, "timed steps per configuration")
       ->capture_default_str();
   speed_cmd

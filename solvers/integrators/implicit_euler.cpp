@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <optional>
 
 #include <jelly/core/detail/anchor_jacobian.hpp>
@@ -32,6 +31,13 @@ constexpr int kAutoDirectMaxDofs = 1000;
 // in single precision (BandSystem): A is then exact to 6e-8 relative per spring, 1/16 of this,
 // and the products read half the bytes (docs/implicit.md, "Matrix-free CG on lattices").
 constexpr Real kSingleCoefficientsTolerance = 1e-6;
+
+// Multigrid: the coarse operators (Galerkin products, many fine products' worth of work) are
+// rebuilt every this many assemblies, and sooner when the contacts' set changes, when dt
+// changes, or when a solve needs more than twice the iterations of the first solve with them
+// (docs/implicit.md, "Multigrid on lattices"). Whatever coarse operators it holds, the V-cycle
+// is symmetric positive definite.
+constexpr int kMultigridMaxAge = 5;
 
 // Uniform translations are in the null space of K and D, so 1^T A = 1^T M and an exact solve
 // of A y = b changes the momentum by sum(b). An iterative solve misses by the sum of its
@@ -179,6 +185,8 @@ struct ImplicitEuler::Impl {
   LatticeMultigrid multigrid_;
   bool use_multigrid_ = false;
   bool coarse_stale_ = true;
+  int coarse_age_ = 0;          // assemblies since the coarse operators were built
+  int coarse_iterations_ = -1;  // CG iterations of the first solve with them (-1: none yet)
   VecX az_;
   VecX cg_x_;                      // a loose matrix-free solve's iterate, for resuming it
   int loose_iterations_ = 0;       // ... and its CG iterations
@@ -308,6 +316,7 @@ std::vector<Real> ImplicitEuler::internal_state() const {
 
 void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
   Impl& m = *impl_;
+  m.coarse_stale_ = true;  // multigrid: rebuilt from the restored state
   if (data.empty()) {
     m.have_dv_ = false;
     m.contact_.restore(nullptr, 0);
@@ -376,9 +385,9 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       coarse_stale_ = true;
       if (options_.cg_preconditioner == CgPreconditionerKind::kMultigrid)
         use_multigrid_ = multigrid_.build(model, *bands);
-      if (const char* e = std::getenv("JELLY_MG_ADDITIVE")) multigrid_.set_additive(e[0] == '1');
       factorization_seconds_ += seconds_since(start);
     }
+    if (h != last_h_) coarse_stale_ = true;
     last_h_ = h;
     return StepResult::success();
   }
@@ -415,6 +424,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
     size_vectors();
   }
   if (h != last_h_) solver_->invalidate();
+  if (h != last_h_) coarse_stale_ = true;
   last_h_ = h;
   return StepResult::success();
 }
@@ -430,7 +440,7 @@ StepResult ImplicitEuler::Impl::assemble(const Dynamics& dynamics, const VecX& x
     solver_->set_threads(threads_);
   }
   if (matrix_free_) {
-    coarse_stale_ = true;
+    ++coarse_age_;
     if (dynamics.anchors() != nullptr) {
       for (const AnchorSpring& anchor : *dynamics.anchors()) {
         band_->add_diagonal(anchor.particle, h * anchor.damping + h * h * anchor.stiffness);
@@ -476,7 +486,11 @@ bool ImplicitEuler::Impl::update_contacts(const Terrains& terrains, const VecX& 
   for (const auto& c : contact_.contacts())
     if (!c.pinned) contact_rows_.push_back(c.particle);
   band_->multiply_rows(dv_, contact_rows_, az_, threads_);
-  return contact_.update_from_product(terrains, b, dv_, commit, az_, screening);
+  const bool changed = contact_.update_from_product(terrains, b, dv_, commit, az_, screening);
+  // Multigrid: coarse operators of another contact set are far from this one's (a released
+  // contact's coupling is missing from them): rebuilt for the next solve.
+  if (changed && commit) coarse_stale_ = true;
+  return changed;
 }
 
 StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX& b, VecX& y,
@@ -496,9 +510,11 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
     };
     if (use_multigrid_) {
       r = multigrid_.set_diagonal_blocks(model.num_particles(), diagonal, filter, threads_);
-      if (r.ok() && coarse_stale_) {
+      if (r.ok() && (coarse_stale_ || coarse_age_ >= kMultigridMaxAge)) {
         multigrid_.set_operator(*band_, filter, threads_);
         coarse_stale_ = false;
+        coarse_age_ = 0;
+        coarse_iterations_ = -1;
       }
     } else {
       r = band_cg_.set_diagonal_blocks(model.num_particles(), diagonal, threads_);
@@ -524,6 +540,14 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
       r = band_cg_.solve(apply, b, y, tolerance, limit, threads_, resume);
     }
     r.iterations += done;
+    if (use_multigrid_ && tolerance <= options_.cg_tolerance) {
+      // Coarse operators that need twice the iterations they needed when built: rebuilt.
+      if (coarse_iterations_ < 0) {
+        coarse_iterations_ = r.iterations;
+      } else if (r.iterations > 2 * coarse_iterations_ + 2) {
+        coarse_stale_ = true;
+      }
+    }
     if (!resume && tolerance > options_.cg_tolerance) {  // a loose solve: kept for resuming
       cg_x_ = y;
       loose_iterations_ = r.iterations;

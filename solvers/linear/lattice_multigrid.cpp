@@ -671,13 +671,6 @@ void LatticeMultigrid::cycle(int l, const Product& product, int threads) {
         3 * kMgRowsPerThread, 3);
   };
   level.x.setZero();
-  if (l == 0 && additive_) {  // block Jacobi plus the coarse levels' correction of r itself
-    smooth(l, level.r, level.x, 1.0, threads);
-    restrict_to(l, level.r, next.r, threads);
-    cycle(l + 1, product, threads);
-    prolong_add(l, next.x, level.x, threads);
-    return;
-  }
   smooth(l, level.r, level.x, level.omega, threads);
   residual();
   restrict_to(l, level.t, next.r, threads);

@@ -59,9 +59,6 @@ class LatticeMultigrid {
   void apply(const Product& product, const VecX& r, VecX& z, int threads);
 
   int levels() const { return static_cast<int>(levels_.size()); }
-  // Level 0 additive (B = D^-1 + S P B_1 P^T S: no product of level 0 inside B) instead of a
-  // symmetric V-cycle (two products of level 0 per application).
-  void set_additive(bool additive) { additive_ = additive; }
   // Unknowns of level 1.
   int coarse_unknowns() const { return levels_.size() > 1 ? 3 * levels_[1].nodes : 0; }
 
@@ -125,7 +122,6 @@ class LatticeMultigrid {
   std::vector<Edge> edges_;
   std::vector<int> lattice_particle_;  // [stencil nodes of level 0]: particle index
   ProductFilter filter_;
-  bool additive_ = false;
   Eigen::LLT<Eigen::MatrixXd> coarsest_;
   std::vector<Real> scratch_;  // Galerkin sweeps' intermediate stencils
 };
