@@ -473,6 +473,8 @@ void LatticeMultigrid::set_operator(const BandSystem& band, const ProductFilter&
       }
     }
   coarsest_.compute(dense);
+  // Not positive definite to rounding (it should be): its block Jacobi instead.
+  coarsest_factored_ = coarsest_.info() == Eigen::Success;
 }
 
 LinearResult LatticeMultigrid::set_diagonal_blocks(int particles, const DiagonalBlock& block,
@@ -652,8 +654,13 @@ void LatticeMultigrid::prolong_add(int l, const VecX& coarse, VecX& fine, int th
 void LatticeMultigrid::cycle(int l, const Product& product, int threads) {
   Level& level = levels_[l];
   if (l + 1 == levels()) {  // the coarsest: solved
-    level.x = level.r;
-    coarsest_.solveInPlace(level.x);
+    if (coarsest_factored_) {
+      level.x = level.r;
+      coarsest_.solveInPlace(level.x);
+    } else {
+      level.x.setZero();
+      smooth(l, level.r, level.x, 1.0, threads);
+    }
     return;
   }
   Level& next = levels_[l + 1];

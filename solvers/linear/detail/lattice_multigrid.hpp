@@ -123,6 +123,7 @@ class LatticeMultigrid {
   std::vector<int> lattice_particle_;  // [stencil nodes of level 0]: particle index
   ProductFilter filter_;
   Eigen::LLT<Eigen::MatrixXd> coarsest_;
+  bool coarsest_factored_ = false;
   std::vector<Real> scratch_;  // Galerkin sweeps' intermediate stencils
 };
 
