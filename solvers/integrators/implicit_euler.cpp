@@ -187,6 +187,11 @@ struct ImplicitEuler::Impl {
   bool coarse_stale_ = true;
   int coarse_age_ = 0;          // assemblies since the coarse operators were built
   int coarse_iterations_ = -1;  // CG iterations of the first solve with them (-1: none yet)
+  // The contacts (particle, stick or slide) the coarse operators were built with: those of
+  // another set are far from its operator (a released contact's coupling is missing from them,
+  // and a solve needed up to 87 iterations instead of 6), so a solve with another set rebuilds
+  // them.
+  std::vector<std::pair<int, int>> coarse_contacts_, contacts_now_;
   VecX az_;
   VecX cg_x_;                      // a loose matrix-free solve's iterate, for resuming it
   int loose_iterations_ = 0;       // ... and its CG iterations
@@ -486,11 +491,7 @@ bool ImplicitEuler::Impl::update_contacts(const Terrains& terrains, const VecX& 
   for (const auto& c : contact_.contacts())
     if (!c.pinned) contact_rows_.push_back(c.particle);
   band_->multiply_rows(dv_, contact_rows_, az_, threads_);
-  const bool changed = contact_.update_from_product(terrains, b, dv_, commit, az_, screening);
-  // Multigrid: coarse operators of another contact set are far from this one's (a released
-  // contact's coupling is missing from them): rebuilt for the next solve.
-  if (changed && commit) coarse_stale_ = true;
-  return changed;
+  return contact_.update_from_product(terrains, b, dv_, commit, az_, screening);
 }
 
 StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX& b, VecX& y,
@@ -498,9 +499,8 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
                                                   bool resume) {
   auto start = Clock::now();
   // Block Jacobi: the inverses of the (filtered) diagonal blocks (kept when resuming); with
-  // multigrid they are its finest smoother's, and its coarse operators are rebuilt at the first
-  // solve after an assembly (a later solve of the step with another contact set keeps them:
-  // the V-cycle stays symmetric positive definite, only a little less sharp).
+  // multigrid they are its finest smoother's, and its coarse operators are rebuilt when
+  // kMultigridMaxAge says so or when the contacts' set is not theirs.
   LinearResult r;
   const ProductFilter filter = constrained ? contact_.product_filter() : ProductFilter{};
   if (!resume) {
@@ -510,8 +510,14 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
     };
     if (use_multigrid_) {
       r = multigrid_.set_diagonal_blocks(model.num_particles(), diagonal, filter, threads_);
-      if (r.ok() && (coarse_stale_ || coarse_age_ >= kMultigridMaxAge)) {
+      contacts_now_.clear();
+      if (constrained)
+        for (const ImplicitContact::Contact& c : contact_.contacts())
+          contacts_now_.emplace_back(c.particle, c.pinned ? 2 : static_cast<int>(c.mode));
+      if (r.ok() &&
+          (coarse_stale_ || coarse_age_ >= kMultigridMaxAge || contacts_now_ != coarse_contacts_)) {
         multigrid_.set_operator(*band_, filter, threads_);
+        coarse_contacts_ = contacts_now_;
         coarse_stale_ = false;
         coarse_age_ = 0;
         coarse_iterations_ = -1;

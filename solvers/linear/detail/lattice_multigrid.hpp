@@ -23,7 +23,7 @@
 // level is solved by a dense Cholesky factor. Every loop is a gather over rows on a static
 // split: the same bits for any thread count. The V-cycle is symmetric positive definite
 // whatever coarse operator it holds, so the coarse operators may lag behind the fine one
-// (implicit_euler rebuilds them once per assembly, not per contact re-solve).
+// (implicit_euler rebuilds them every few steps and when the contacts' set changes).
 #include <array>
 #include <functional>
 #include <vector>
