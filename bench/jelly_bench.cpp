@@ -117,6 +117,15 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->capture_default_str();
   speed_cmd->add_option("--dt", speed.dt, "time step (s)")->capture_default_str();
+  speed_cmd
+      ->add_option("--preconditioners", speed.preconditioners,
+                   "implicit_euler's cg_preconditioner values (jacobi, cholmod, multigrid), a row "
+                   "each, labelled implicit_euler[name] (default: its default only)")
+      ->delimiter(',');
+  speed_cmd->add_option("--ks", speed.ks, "spring stiffness of every type (N/m)")
+      ->capture_default_str();
+  speed_cmd->add_option("--warmup-steps", speed.warmup_steps, "untimed steps before the timed ones")
+      ->capture_default_str();
   speed_cmd->add_option("--steps", speed.steps, "timed steps per configuration")
       ->capture_default_str();
   speed_cmd

@@ -25,6 +25,9 @@ void SpeedOptions::validate() const {
   require(!threads.empty(), "--threads", "(empty)", "at least one thread count");
   for (int t : threads) require(t >= 0, "--threads", t, "thread counts >= 0 (0 = all cores)");
   require(interleave_block >= 1, "--interleave-block", interleave_block, "an integer >= 1");
+  require(std::isfinite(ks) && ks > 0, "--ks", ks, "a stiffness > 0 N/m");
+  for (const std::string& p : preconditioners)
+    value_of(cg_preconditioner_kinds(), p, "--preconditioners");
 }
 
 namespace {
@@ -55,13 +58,15 @@ struct SpeedRun {
   int timed = 0;
   Statistics before_timing;
 
-  SpeedRun(std::vector<Cell> row_head, const std::string& integrator, int n, int thread_count)
+  SpeedRun(std::vector<Cell> row_head, const std::string& integrator, int n, int thread_count,
+           Real ks, const IntegratorOptions& options)
       : head(std::move(row_head)), threads(thread_count) {
     if (threads == 0)
       chooser = std::make_unique<parallel::TeamChooser>(parallel::available_cores());
     SceneSpec spec;
     spec.name = "slope";
     spec.n = n;
+    spec.ks = ks;
     parts = build_scene(spec);
     // Lower the cube onto the slope: the deepest particle 1 mm below the surface.
     Real lowest = INFINITY;
@@ -71,7 +76,7 @@ struct SpeedRun {
     const Vec3 normal = parts.terrains.front()->normal(Vec3::Zero(), 0);
     for (int i = 0; i < parts.model.num_particles(); ++i)
       particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
-    method = make_integrator(integrator);
+    method = make_integrator(integrator, options);
     bands = std::make_unique<const SpringBands>(parts.model);
     f.resize(parts.model.num_dofs());
   }
@@ -169,7 +174,22 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
               "the integrator's statistics() over the timed steps (and per timed step)",
               {"item", "integrator:s", "n", "threads", "key:s", "value", "per_step"});
   long item = 0;
+  // implicit_euler once per preconditioner asked for (its default when none).
+  std::vector<std::pair<std::string, std::string>> variants;  // integrator, preconditioner
   for (const std::string& integrator : integrators) {
+    if (integrator == "implicit_euler" && !o.preconditioners.empty()) {
+      for (const std::string& p : o.preconditioners) variants.emplace_back(integrator, p);
+    } else {
+      variants.emplace_back(integrator, "");
+    }
+  }
+  for (const auto& [integrator, preconditioner] : variants) {
+    IntegratorOptions options;
+    if (!preconditioner.empty())
+      options.implicit.cg_preconditioner =
+          value_of(cg_preconditioner_kinds(), preconditioner, "--preconditioners");
+    const std::string label =
+        preconditioner.empty() ? integrator : integrator + "[" + preconditioner + "]";
     for (int n : o.sizes) {
       // The rows of this integrator and size that this shard owns.
       std::vector<std::unique_ptr<SpeedRun>> runs;
@@ -178,7 +198,7 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
         if (!o.shard.owns(this_item)) continue;
         // 0: the default, each step's team size chosen as the Simulator chooses it.
         const int threads = requested_threads;
-        std::vector<Cell> head{static_cast<double>(this_item), integrator, static_cast<double>(n),
+        std::vector<Cell> head{static_cast<double>(this_item), label, static_cast<double>(n),
                                static_cast<double>(threads)};
         if (is_adaptive_integrator(integrator)) {
           std::vector<Cell> row = head;
@@ -188,11 +208,11 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
           continue;
         }
         if (o.interleave) {
-          runs.push_back(std::make_unique<SpeedRun>(head, integrator, n, threads));
+          runs.push_back(std::make_unique<SpeedRun>(head, integrator, n, threads, o.ks, options));
           continue;
         }
         const bool reset = reset_peak_memory();
-        SpeedRun run(head, integrator, n, threads);
+        SpeedRun run(head, integrator, n, threads, o.ks, options);
         run.memory_reset = reset;
         run.advance(o, o.warmup_steps + o.steps);
         run.add_rows(o.dt, speed, stats);

@@ -15,6 +15,10 @@ namespace jelly::bench {
 struct SpeedOptions {
   std::vector<std::string> integrators;  // empty: every registered integrator
   std::vector<int> sizes{5, 10, 20, 30};
+  // implicit_euler's cg_preconditioner values, a row each (labelled "implicit_euler[name]");
+  // empty: its default only.
+  std::vector<std::string> preconditioners;
+  Real ks = 1400;  // N/m, every spring type (kd stays the seed's 50)
   // Thread counts, each a row (the scaling table); 0 = all cores.
   std::vector<int> threads{0};
   Real dt = 1e-3;

@@ -312,6 +312,23 @@ void BandSystem::diagonal_block(int i, Real out[9]) const {
   out[5] = out[7] = d[5 * n];
 }
 
+void BandSystem::slot_block(size_t band, int slot, Real out[6]) const {
+  const int n = num_particles_;
+  const SpringBands::Band& b = bands_->bands()[band];
+  const int i = b.first + slot, j = i + b.offset;
+  const Real* sx = positions_.data();
+  const Real e[3] = {sx[i] - sx[j], sx[n + i] - sx[n + j], sx[2 * n + i] - sx[2 * n + j]};
+  const Slots& s = slots_[band];
+  const Real e1 = single_ ? s.e1_single[slot] : s.e1[slot];
+  const Real c2 = single_ ? s.c2_single[slot] : s.c2[slot];
+  out[0] = e1 * e[0] * e[0] + c2;
+  out[1] = e1 * e[1] * e[1] + c2;
+  out[2] = e1 * e[2] * e[2] + c2;
+  out[3] = e1 * e[0] * e[1];
+  out[4] = e1 * e[0] * e[2];
+  out[5] = e1 * e[1] * e[2];
+}
+
 void BandSystem::multiply_rows(const VecX& p, const std::vector<int>& particles, VecX& y,
                                int threads) const {
   const int n = num_particles_;

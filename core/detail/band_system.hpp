@@ -64,6 +64,13 @@ class BandSystem {
                      int threads = 1) const;
   // The diagonal 3x3 block of particle i, row-major.
   void diagonal_block(int i, Real out[9]) const;
+  // For operators built from A's pieces (the multigrid's coarse levels): the bands it was built
+  // for, the mass term of particle i (m_i plus add_diagonal's values: A_ii = that I + the
+  // springs' blocks), and the block B of slot `slot` of band `band` as 6 numbers (xx, yy, zz,
+  // xy, xz, yz; zero for an empty slot), exactly the block the products use.
+  const SpringBands& bands() const { return *bands_; }
+  Real mass_term(int i) const { return mass_[i]; }
+  void slot_block(size_t band, int slot, Real out[6]) const;
 
  private:
   struct Slots {

@@ -280,7 +280,7 @@ void bind_solvers(py::module_& m) {
           choice_getter(&ImplicitEulerOptions::cg_preconditioner, cg_preconditioner_kinds),
           choice_setter(&ImplicitEulerOptions::cg_preconditioner, cg_preconditioner_kinds,
                         "cg_preconditioner"),
-          "\"jacobi\" or \"cholmod\".")
+          "\"jacobi\", \"cholmod\" or \"multigrid\" (lattice bodies; docs/implicit.md).")
       .def_readwrite("cg_tolerance", &ImplicitEulerOptions::cg_tolerance,
                      "Relative residual of CG.")
       .def_readwrite("contact_screening_tolerance",

@@ -15,6 +15,7 @@
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/lattice_multigrid.hpp>
 #include <jelly/solvers/linear/ldlt_solver.hpp>
 
 namespace jelly {
@@ -30,6 +31,13 @@ constexpr int kAutoDirectMaxDofs = 1000;
 // in single precision (BandSystem): A is then exact to 6e-8 relative per spring, 1/16 of this,
 // and the products read half the bytes (docs/implicit.md, "Matrix-free CG on lattices").
 constexpr Real kSingleCoefficientsTolerance = 1e-6;
+
+// Multigrid: the coarse operators (Galerkin products, many fine products' worth of work) are
+// rebuilt every this many assemblies, and sooner when the contacts' set changes, when dt
+// changes, or when a solve needs more than twice the iterations of the first solve with them
+// (docs/implicit.md, "Multigrid on lattices"). Whatever coarse operators it holds, the V-cycle
+// is symmetric positive definite.
+constexpr int kMultigridMaxAge = 5;
 
 // Uniform translations are in the null space of K and D, so 1^T A = 1^T M and an exact solve
 // of A y = b changes the momentum by sum(b). An iterative solve misses by the sum of its
@@ -195,6 +203,18 @@ struct ImplicitEuler::Impl {
   bool matrix_free_failed_ = false;  // a collapsed spring: the assembled path from then on
   std::optional<BandSystem> band_;
   MatrixFreeCg band_cg_;
+  // cg_preconditioner = multigrid on the matrix-free path, when the model has a lattice body:
+  // the V-cycle, and whether its coarse operators are older than the last assembly.
+  LatticeMultigrid multigrid_;
+  bool use_multigrid_ = false;
+  bool coarse_stale_ = true;
+  int coarse_age_ = 0;          // assemblies since the coarse operators were built
+  int coarse_iterations_ = -1;  // CG iterations of the first solve with them (-1: none yet)
+  // The contacts (particle, stick or slide) the coarse operators were built with: those of
+  // another set are far from its operator (a released contact's coupling is missing from them,
+  // and a solve needed up to 87 iterations instead of 6), so a solve with another set rebuilds
+  // them.
+  std::vector<std::pair<int, int>> coarse_contacts_, contacts_now_;
   VecX az_;
   VecX cg_x_;                      // a loose matrix-free solve's iterate, for resuming it
   int loose_iterations_ = 0;       // ... and its CG iterations
@@ -262,7 +282,8 @@ const VecX& ImplicitEuler::last_velocity_change() const { return impl_->dv_; }
 bool ImplicitEuler::last_step_had_body_contact() const { return impl_->bodies_active_; }
 
 std::string_view ImplicitEuler::linear_solver_name() const {
-  if (impl_->matrix_free_) return "cg_jacobi_matrix_free";
+  if (impl_->matrix_free_)
+    return impl_->use_multigrid_ ? "cg_multigrid_matrix_free" : "cg_jacobi_matrix_free";
   return impl_->solver_ ? impl_->solver_->name() : std::string_view();
 }
 
@@ -300,6 +321,7 @@ void ImplicitEuler::Impl::add_statistics(Statistics& s) const {
   s["assembly_seconds"] = assembly_seconds_;
   s["factorization_seconds"] = factorization_seconds_;
   s["solve_seconds"] = solve_seconds_;
+  if (use_multigrid_) s["multigrid_levels"] = static_cast<double>(multigrid_.levels());
   if (resolves_contact()) {
     const ImplicitContact::Counters& cc = contact_.counters();
     s["contact_extra_solves"] = static_cast<double>(cc.extra_solves);
@@ -332,6 +354,7 @@ std::vector<Real> ImplicitEuler::internal_state() const {
 
 void ImplicitEuler::restore_internal_state(const std::vector<Real>& data) {
   Impl& m = *impl_;
+  m.coarse_stale_ = true;  // multigrid: rebuilt from the restored state
   if (data.empty()) {
     m.have_dv_ = false;
     m.contact_.restore(nullptr, 0);
@@ -371,7 +394,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
   // Block-Jacobi CG needs only products with A: from the bands when the springs fill them.
   const bool matrix_free =
       kind == ImplicitLinearSolver::kCg &&
-      (automatic || options_.cg_preconditioner == CgPreconditionerKind::kJacobi) &&
+      (automatic || options_.cg_preconditioner != CgPreconditionerKind::kCholmod) &&
       bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_ &&
       // Contact pairs between bodies and added forces' Jacobians add blocks off the springs'
       // bands: the assembled matrix.
@@ -396,8 +419,13 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       az_.setZero(n);
       size_vectors();
       matrix_free_ = true;
+      use_multigrid_ = false;
+      coarse_stale_ = true;
+      if (options_.cg_preconditioner == CgPreconditionerKind::kMultigrid)
+        use_multigrid_ = multigrid_.build(model, *bands);
       factorization_seconds_ += seconds_since(start);
     }
+    if (h != last_h_) coarse_stale_ = true;
     last_h_ = h;
     return StepResult::success();
   }
@@ -405,6 +433,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       jacobian_->num_springs() != model.springs.size()) {
     const auto start = Clock::now();
     matrix_free_ = false;
+    use_multigrid_ = false;
     band_.reset();
     extra_blocks_.clear();
     force_blocks_.clear();
@@ -433,6 +462,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
     size_vectors();
   }
   if (h != last_h_) solver_->invalidate();
+  if (h != last_h_) coarse_stale_ = true;
   last_h_ = h;
   return StepResult::success();
 }
@@ -448,6 +478,7 @@ StepResult ImplicitEuler::Impl::assemble(const Dynamics& dynamics, const VecX& x
     solver_->set_threads(threads_);
   }
   if (matrix_free_) {
+    ++coarse_age_;
     if (dynamics.anchors() != nullptr) {
       for (const AnchorSpring& anchor : *dynamics.anchors()) {
         band_->add_diagonal(anchor.particle, h * anchor.damping + h * h * anchor.stiffness);
@@ -500,21 +531,37 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
                                                   bool constrained, Real t, Real tolerance,
                                                   bool resume) {
   auto start = Clock::now();
-  // Block Jacobi: the inverses of the (filtered) diagonal blocks (kept when resuming).
+  // Block Jacobi: the inverses of the (filtered) diagonal blocks (kept when resuming); with
+  // multigrid they are its finest smoother's, and its coarse operators are rebuilt when
+  // kMultigridMaxAge says so or when the contacts' set is not theirs.
   LinearResult r;
+  const ProductFilter filter = constrained ? contact_.product_filter() : ProductFilter{};
   if (!resume) {
-    r = band_cg_.set_diagonal_blocks(
-        model.num_particles(),
-        [&](int i, Real d[9]) {
-          band_->diagonal_block(i, d);
-          if (constrained) contact_.filter_diagonal_block(i, d);
-        },
-        threads_);
+    const auto diagonal = [&](int i, Real d[9]) {
+      band_->diagonal_block(i, d);
+      if (constrained) contact_.filter_diagonal_block(i, d);
+    };
+    if (use_multigrid_) {
+      r = multigrid_.set_diagonal_blocks(model.num_particles(), diagonal, filter, threads_);
+      contacts_now_.clear();
+      if (constrained)
+        for (const ImplicitContact::Contact& c : contact_.contacts())
+          contacts_now_.emplace_back(c.particle, c.pinned ? 2 : static_cast<int>(c.mode));
+      if (r.ok() &&
+          (coarse_stale_ || coarse_age_ >= kMultigridMaxAge || contacts_now_ != coarse_contacts_)) {
+        multigrid_.set_operator(*band_, filter, threads_);
+        coarse_contacts_ = contacts_now_;
+        coarse_stale_ = false;
+        coarse_age_ = 0;
+        coarse_iterations_ = -1;
+      }
+    } else {
+      r = band_cg_.set_diagonal_blocks(model.num_particles(), diagonal, threads_);
+    }
   }
   factorization_seconds_ += seconds_since(start);
   if (r.ok()) {
     start = Clock::now();
-    const ProductFilter filter = constrained ? contact_.product_filter() : ProductFilter{};
     const auto apply = [&](const VecX& in, VecX& out) {
       band_->multiply(in, out, threads_, filter);
     };
@@ -522,8 +569,24 @@ StepResult ImplicitEuler::Impl::solve_matrix_free(const Model& model, const VecX
     // iterations the loose solve left, so that it is one solve in every respect.
     if (resume) y = cg_x_;
     const int done = resume ? loose_iterations_ : 0;
-    r = band_cg_.solve(apply, b, y, tolerance, options_.cg_max_iterations - done, threads_, resume);
+    const int limit = options_.cg_max_iterations - done;
+    if (use_multigrid_) {
+      const auto precondition = [&](const VecX& in, VecX& out) {
+        multigrid_.apply(apply, in, out, threads_);
+      };
+      r = band_cg_.solve(apply, precondition, b, y, tolerance, limit, threads_, resume);
+    } else {
+      r = band_cg_.solve(apply, b, y, tolerance, limit, threads_, resume);
+    }
     r.iterations += done;
+    if (use_multigrid_ && tolerance <= options_.cg_tolerance) {
+      // Coarse operators that need twice the iterations they needed when built: rebuilt.
+      if (coarse_iterations_ < 0) {
+        coarse_iterations_ = r.iterations;
+      } else if (r.iterations > 2 * coarse_iterations_ + 2) {
+        coarse_stale_ = true;
+      }
+    }
     if (!resume && tolerance > options_.cg_tolerance) {  // a loose solve: kept for resuming
       cg_x_ = y;
       loose_iterations_ = r.iterations;

@@ -21,6 +21,8 @@ const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds() {
   static const std::vector<EnumName<CgPreconditionerKind>> table{
       {CgPreconditionerKind::kJacobi, "jacobi", "3x3 block Jacobi"},
       {CgPreconditionerKind::kCholmod, "cholmod", "a lagged CHOLMOD factor of an earlier matrix"},
+      {CgPreconditionerKind::kMultigrid, "multigrid",
+       "a geometric multigrid V-cycle on lattice bodies (block Jacobi on the others)"},
   };
   return table;
 }

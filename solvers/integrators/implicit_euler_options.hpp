@@ -24,6 +24,8 @@ const std::vector<EnumName<ImplicitLinearSolver>>& implicit_linear_solvers();
 enum class CgPreconditionerKind {
   kJacobi,   // 3x3 block Jacobi
   kCholmod,  // a CHOLMOD factor of an earlier matrix, refreshed when it stops paying
+  // A geometric multigrid V-cycle on lattice bodies (matrix-free CG; block Jacobi elsewhere)
+  kMultigrid,
 };
 const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds();
 

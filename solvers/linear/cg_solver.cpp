@@ -594,4 +594,18 @@ LinearResult MatrixFreeCg::solve(const Product& apply, const VecX& b, VecX& x, R
                 &blocks, resume);
 }
 
+LinearResult MatrixFreeCg::solve(const Product& apply, const Preconditioner& precondition,
+                                 const VecX& b, VecX& x, Real tolerance, int max_iterations,
+                                 int threads, bool resume) {
+  CgWork& work = impl_->work;
+  if (b.size() % 3 != 0 || x.size() != b.size())
+    return LinearResult::failure(LinearStatus::kInvalidInput, "CG: solve: wrong vector size");
+  work.resize(b.size());
+  work.threads = std::max(1, threads);
+  ++impl_->counters.solves;
+  if (!resume) work.stop = {};
+  return cg_run(work, tolerance, apply, precondition, b, x, max_iterations, impl_->counters,
+                nullptr, resume);
+}
+
 }  // namespace jelly

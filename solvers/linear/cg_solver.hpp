@@ -71,6 +71,12 @@ class MatrixFreeCg {
   // the iterates are those of one solve to this tolerance, at max_iterations more.
   LinearResult solve(const Product& apply, const VecX& b, VecX& x, Real tolerance,
                      int max_iterations, int threads, bool resume = false);
+  // The same, preconditioned by z = precondition(r) instead (a fixed symmetric positive
+  // definite operator, e.g. a multigrid V-cycle; threaded by the caller); set_diagonal_blocks
+  // is not needed. A resumed solve restarts the search direction from its residual.
+  using Preconditioner = std::function<void(const VecX& r, VecX& z)>;
+  LinearResult solve(const Product& apply, const Preconditioner& precondition, const VecX& b,
+                     VecX& x, Real tolerance, int max_iterations, int threads, bool resume = false);
   const LinearSolverCounters& counters() const;
 
  private:

@@ -291,6 +291,36 @@ def test_arkode_linear_solver_is_one_of_its_table():
         options.arkode.linear_solver = "lu"
 
 
+def test_multigrid_preconditioner_is_an_option_and_follows_block_jacobi():
+    # cg_preconditioner = "multigrid" on the matrix-free path (an 8^3 cube, stretched, falling freely):
+    # the same motion as block Jacobi to a tight CG tolerance, in fewer CG iterations.
+    options = jelly.IntegratorOptions()
+    assert options.implicit.cg_preconditioner == "jacobi"
+    with pytest.raises(ValueError, match="cg_preconditioner"):
+        options.implicit.cg_preconditioner = "amg"
+    runs = {}
+    for name in ["jacobi", "multigrid"]:
+        options = jelly.IntegratorOptions()
+        options.implicit.cg_preconditioner = name
+        options.implicit.cg_tolerance = 1e-10
+        assert options.implicit.cg_preconditioner == name
+        spec = jelly.CubeSpec()
+        spec.n, spec.edge_length, spec.origin = 8, 1.0, [0.0, 2.0, 0.0]
+        model = jelly.build_cube(spec)
+        state = jelly.rest_state(model)
+        x = np.array(state.x)
+        x[:, 0] *= 1.1  # stretched: the springs work
+        state.x = x
+        sim_options = jelly.SimulatorOptions()
+        sim_options.dt = 1 / 60
+        sim = jelly.Simulator(model, state, "implicit_euler", options, sim_options)
+        report = sim.run_until(0.25)
+        assert report.ok, report.brief()
+        runs[name] = (np.array(sim.state.x), report.statistics["cg_iterations"])
+    assert np.abs(runs["multigrid"][0] - runs["jacobi"][0]).max() < 1e-7
+    assert runs["multigrid"][1] < runs["jacobi"][1]
+
+
 def test_contact_screening_equals_jelly_run_and_is_validated(scenes, run_cli, tmp_path):
     # implicit_euler's contact_screening_tolerance on the matrix-free path (8^3 particles
     # lowered onto the coulomb slope): the module's run is the jelly program's bit for bit, with

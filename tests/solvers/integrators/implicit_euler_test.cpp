@@ -169,6 +169,45 @@ TEST(ImplicitEuler, MatrixFreeSolveAgreesWithCholmod) {
   EXPECT_LT((matrix_free.v - exact.v).cwiseAbs().maxCoeff(), 1e-5);
 }
 
+// cg_preconditioner = "multigrid" (the V-cycle of solvers/linear/detail/lattice_multigrid.hpp on
+// the matrix-free path): a cube sliding down the slope with its contacts inside the solve ends
+// where the block-Jacobi run ends (both to a tight CG tolerance), with far fewer CG iterations,
+// and its run is the same bits on 1 and 2 threads.
+TEST(ImplicitEuler, MultigridAgreesWithBlockJacobiOnAnyThreadCount) {
+  Model model = build_cube(testing::small_cube(12, 1.0, Vec3(0, 0.4, 0)));  // 5,184 unknowns
+  const auto run = [&](CgPreconditionerKind preconditioner, int threads, std::string* solver,
+                       double* iterations) {
+    IntegratorOptions o;
+    o.implicit.cg_preconditioner = preconditioner;
+    o.implicit.cg_tolerance = 1e-11;
+    o.implicit.contact_screening_tolerance = 0;
+    SimulatorOptions so{1.0 / 60, 0, {}};
+    so.threads = threads;
+    Simulator sim = Simulator(model, rest_state(model), make_integrator("implicit_euler", o), so);
+    sim.add_terrain(std::make_unique<Plane>(Plane::slope(20)));
+    const RunReport report = sim.run_until(0.5);
+    EXPECT_TRUE(report.ok()) << report.reason;
+    EXPECT_GT(report.statistics.at("contact_extra_solves") + sim.integrator().contacts_resolved(),
+              0);
+    *solver = std::string(static_cast<const ImplicitEuler&>(sim.integrator()).linear_solver_name());
+    *iterations = report.statistics.at("cg_iterations");
+    return sim.state();
+  };
+  std::string jacobi_name, mg_name, mg2_name;
+  double jacobi_iterations = 0, mg_iterations = 0, mg2_iterations = 0;
+  const State jacobi = run(CgPreconditionerKind::kJacobi, 1, &jacobi_name, &jacobi_iterations);
+  const State mg = run(CgPreconditionerKind::kMultigrid, 1, &mg_name, &mg_iterations);
+  const State mg2 = run(CgPreconditionerKind::kMultigrid, 2, &mg2_name, &mg2_iterations);
+  EXPECT_EQ(jacobi_name, "cg_jacobi_matrix_free");
+  EXPECT_EQ(mg_name, "cg_multigrid_matrix_free");
+  EXPECT_LT((mg.x - jacobi.x).cwiseAbs().maxCoeff(), 1e-7);
+  EXPECT_LT((mg.v - jacobi.v).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_LT(2 * mg_iterations, jacobi_iterations);
+  EXPECT_TRUE(mg2.x == mg.x);
+  EXPECT_TRUE(mg2.v == mg.v);
+  EXPECT_EQ(mg2_iterations, mg_iterations);
+}
+
 // Changing dt forces a fresh factor for the lagged preconditioner.
 TEST(ImplicitEuler, NewDtRefreshesTheLaggedFactor) {
   const Model model = build_cube(testing::small_cube(4, 1.0));
@@ -268,7 +307,7 @@ TEST(ImplicitEuler, InvalidOptionsNameTheField) {
           {R"({"ordering": "colamd"})",
            R"(integrator.options.ordering = "colamd" is invalid: one of "amd", "metis", "nesdis", "best")"},
           {R"({"cg_preconditioner": "ilu"})",
-           R"(integrator.options.cg_preconditioner = "ilu" is invalid: one of "jacobi", "cholmod")"},
+           R"(integrator.options.cg_preconditioner = "ilu" is invalid: one of "jacobi", "cholmod", "multigrid")"},
           {R"({"definiteness": "psd"})",
            R"(integrator.options.definiteness = "psd" is invalid: one of "clamp", "project", "none")"},
           {R"({"cg_tolerance": 0})",
