@@ -11,7 +11,8 @@ Generated, never committed (all under BUILD/docs-src):
   reference/cpp.md, cpp-api/  Doxygen HTML of the headers listed in cmake/public_headers.txt
   reference/python.md      pydoc of every name in jelly.__all__ (the module's docstrings)
 
-A link from a page to a file of the repository outside docs/ (e.g. ../assets/README.md) is
+A built page that loads a script, style sheet, icon or image from another site fails the
+build (the site must need no network to be read). A link from a page to a file of the repository outside docs/ (e.g. ../assets/README.md) is
 served from a copy under repo/, so that every link of the site resolves offline. A generator
 whose program is missing (doxygen; the built jelly, jelly-bench or Python module) leaves a page
 that says so and what to build, and a warning on stderr; --require-all makes that an error.
@@ -269,6 +270,24 @@ def python_page(source, build, problems):
     return "\n".join(parts + body)
 
 
+EXTERNAL = re.compile(r"<(?:script|img|iframe|source|link(?=[^>]*rel=\"?(?:stylesheet|preload|"
+                      r"icon|modulepreload)))[^>]*\s(?:src|href)=\"?((?:https?:)?//[^\"\s>]+)")
+
+
+def external_resources(site):
+    """(page, url) of every script, style sheet, icon or image a built page loads from
+    elsewhere (a plain link to another site is not loaded, and allowed)."""
+    found = []
+    for root, _, files in os.walk(site):
+        for name in files:
+            if name.endswith(".html"):
+                path = os.path.join(root, name)
+                with open(path, encoding="utf-8", errors="replace") as f:
+                    for url in EXTERNAL.findall(f.read()):
+                        found.append((os.path.relpath(path, site), url))
+    return found
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -332,6 +351,12 @@ def main():
     if status != 0:
         print("build_docs: mkdocs build --strict failed (a warning above is an error)",
               file=sys.stderr)
+        return 1
+    external = external_resources(site)
+    if external:
+        for page, url in external[:20]:
+            print(f"build_docs: {page} loads {url}: the site must need no network",
+                  file=sys.stderr)
         return 1
     print(f"build_docs: site in {site} (open {os.path.join(site, 'index.html')})")
     return 0
