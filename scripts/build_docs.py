@@ -12,8 +12,9 @@ Generated, never committed (all under BUILD/docs-src):
   reference/python.md      pydoc of every name in jelly.__all__ (the module's docstrings)
 
 A built page that loads a script, style sheet, icon or image from another site fails the
-build (the site must need no network to be read). A link from a page to a file of the repository outside docs/ (e.g. ../assets/README.md) is
-served from a copy under repo/, so that every link of the site resolves offline. A generator
+build (the site must need no network to be read). A link from a page to a file of the
+repository outside docs/ (e.g. ../assets/README.md) is served from a copy under repo/, so that
+every link of the site resolves offline. A generator
 whose program is missing (doxygen; the built jelly, jelly-bench or Python module) leaves a page
 that says so and what to build, and a warning on stderr; --require-all makes that an error.
 
