@@ -39,7 +39,7 @@ def browse(browser, url, profile, extra):
     """(exit status, stdout, console lines) of one headless run."""
     command = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
                "--no-first-run", "--disable-extensions", "--disable-background-networking",
-               "--disable-component-update", "--window-size=1200,900",
+               "--disable-component-update", "--disable-dev-shm-usage", "--window-size=1200,900",
                f"--user-data-dir={profile}", "--enable-logging=stderr", "--v=0"] + extra + [url]
     result = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             timeout=120)
