@@ -264,7 +264,7 @@ def python_page(source, build, problems):
     body = []
     for section in sections:
         name, _, doc = section.partition("\n")
-        index.append(f"[`{name}`](#{name.lower().replace('_', '_')})")
+        index.append(f"[`{name}`](#{name.lower()})")
         doc = re.sub(r".\x08", "", doc).rstrip()
         body.append(f"## {name}\n\n```text\n{doc}\n```\n")
     parts.append(", ".join(index) + "\n")
