@@ -4,7 +4,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
 JELLY = $(BUILD)/cli/jelly
 
-.PHONY: all deps configure build test test-sanitize demo bench format clean
+.PHONY: all deps configure build test test-sanitize demo docs bench format clean
 
 all: build
 
@@ -12,6 +12,7 @@ all: build
 deps:
 	bash scripts/install-deps.sh $(DEPS_FLAGS)
 test: DEPS_FLAGS = --tests
+docs: DEPS_FLAGS = --docs
 
 # ccache, when installed (install-deps does), makes rebuilds after a checkout cheap.
 LAUNCHER := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
@@ -62,6 +63,16 @@ demo: build
 	elif [ $$status -ne 0 ]; then exit $$status; fi
 	@echo "demo: written:"; for f in out/demo.h5 out/demo.xdmf out/demo.png out/demo.mp4; do \
 	  if [ -e $$f ]; then echo "  $(CURDIR)/$$f"; fi; done
+
+# The documentation site, offline: build/site/index.html (scripts/build_docs.py; search works
+# when served, e.g. `python3 -m http.server -d build/site`). The reference pages come from the
+# programs, the Python module and the public headers: those targets are built first. mkdocs runs
+# with --strict, and a reference page that cannot be generated is an error too.
+docs: configure
+	targets="jelly_cli jelly_bench"; \
+	if cmake --build $(BUILD) --target help | grep -q jelly_python; then targets="$$targets jelly_python"; fi; \
+	cmake --build $(BUILD) -j $(JOBS) --target $$targets
+	/usr/bin/python3 scripts/build_docs.py --build $(BUILD) --require-all
 
 format:
 	clang-format -i $$(git ls-files '*.hpp' '*.cpp')

@@ -2,7 +2,9 @@
 # Installs, with apt, the Debian packages jelly needs that are missing. Idempotent: a machine
 # that already has everything is left untouched and nothing is downloaded.
 #   install-deps.sh           what building, running and `make demo` need
-#   install-deps.sh --tests   and what only tests need (`make test` and CI pass it)
+#   install-deps.sh --tests   and what only tests need (`make test` and CI pass it), which
+#                             includes what --docs installs (the site's tests)
+#   install-deps.sh --docs    and what `make docs` needs: MkDocs, Doxygen, Chromium
 set -euo pipefail
 
 packages=(
@@ -30,7 +32,14 @@ packages=(
   # jelly.dlpack: arrays handed to torch/JAX without copies (DLPack's header only)
   libdlpack-dev
 )
-if [ "${1:-}" = "--tests" ]; then
+# `make docs` (scripts/build_docs.py): the site (mkdocs, its material theme), the C++ API
+# reference (doxygen), and the test that opens pages in headless Chromium (chromium, about
+# 100 MB to download).
+docs_packages=(mkdocs mkdocs-material doxygen chromium)
+if [ "${1:-}" = "--docs" ]; then
+  packages+=("${docs_packages[@]}")
+elif [ "${1:-}" = "--tests" ]; then
+  packages+=("${docs_packages[@]}")
   # The test jelly_paraview (tests/io/paraview_test.py; it skips without them): ParaView and its
   # pvpython (python3-paraview, only recommended by paraview). About 120 MB to download.
   packages+=(paraview python3-paraview)
@@ -39,7 +48,7 @@ if [ "${1:-}" = "--tests" ]; then
   # stack traces (llvm)
   packages+=(clang libclang-rt-dev libomp-dev llvm)
 elif [ $# -gt 0 ]; then
-  echo "usage: $0 [--tests]" >&2
+  echo "usage: $0 [--tests | --docs]" >&2
   exit 2
 fi
 
