@@ -1,6 +1,7 @@
 #include <jelly/viewer/video_writer.hpp>
 
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
 
 extern char** environ;
@@ -70,7 +72,15 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
         "split[a][b];[a]palettegen=stats_mode=diff[p];[b][p]paletteuse=dither=bayer:"
         "bayer_scale=4");
   }
-  args.push_back(path);
+  if (format_ == VideoFormat::kPngSequence) {
+    ffmpeg_path_ = detail::FileReplacement::temporary_name(
+        path, detail::FileReplacement::Name::kBeforeExtension);
+  } else {
+    replacement_ = std::make_unique<detail::FileReplacement>(
+        path, detail::FileReplacement::Name::kBeforeExtension);
+    ffmpeg_path_ = replacement_->temporary();
+  }
+  args.push_back(ffmpeg_path_);
 
   int fds[2];
   if (pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
@@ -97,9 +107,29 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
 }
 
 VideoWriter::~VideoWriter() {
-  try {
-    close();
-  } catch (...) {
+  // Not closed: ffmpeg is ended and what it wrote is removed; existing files stay as they were.
+  if (pipe_ != nullptr) {
+    std::fclose(pipe_);
+    pipe_ = nullptr;
+    int status = 0;
+    while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+  }
+  remove_temporaries();
+}
+
+std::string VideoWriter::frame_name(const std::string& pattern, int k) {
+  std::vector<char> name(pattern.size() + 32);
+  std::snprintf(name.data(), name.size(), pattern.c_str(), k);
+  return name.data();
+}
+
+void VideoWriter::remove_temporaries() {
+  if (replacement_) replacement_->discard();
+  if (format_ == VideoFormat::kPngSequence) {
+    // ffmpeg writes at most one file per frame it was given.
+    for (int k = 0; k <= frames_; ++k) std::remove(frame_name(ffmpeg_path_, k).c_str());
   }
 }
 
@@ -120,9 +150,36 @@ void VideoWriter::close() {
   while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
   }
   pid_ = -1;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    remove_temporaries();
     throw std::runtime_error("ffmpeg failed to write '" + path_ + "' (exit status " +
-                             std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+                             std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
+                             "); existing files were left as they were");
+  }
+  if (replacement_) {
+    struct stat info {};
+    if (frames_ > 0 && (stat(ffmpeg_path_.c_str(), &info) != 0 || info.st_size == 0)) {
+      remove_temporaries();
+      throw std::runtime_error("ffmpeg wrote nothing to '" + path_ + "'");
+    }
+    replacement_->commit();
+    return;
+  }
+  // A PNG sequence: every frame's file must be there before any is renamed.
+  std::vector<detail::FileReplacement> files;
+  for (int k = 0; k < frames_; ++k) {
+    files.push_back(
+        detail::FileReplacement::adopt(frame_name(path_, k), frame_name(ffmpeg_path_, k)));
+  }
+  for (int k = 0; k < frames_; ++k) {
+    struct stat info {};
+    if (stat(files[k].temporary().c_str(), &info) != 0 || info.st_size == 0) {
+      remove_temporaries();
+      throw std::runtime_error("ffmpeg did not write frame " + std::to_string(k) + " of '" + path_ +
+                               "'");
+    }
+  }
+  for (detail::FileReplacement& file : files) file.commit();
 }
 
 }  // namespace jelly::viewer
