@@ -82,25 +82,46 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
   }
   args.push_back(ffmpeg_path_);
 
-  int fds[2];
+  int fds[2], errors[2];
   if (pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  if (pipe(errors) != 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
-  posix_spawn_file_actions_addclose(&actions, fds[0]);
-  posix_spawn_file_actions_addclose(&actions, fds[1]);
+  posix_spawn_file_actions_adddup2(&actions, errors[1], STDERR_FILENO);
+  for (int fd : {fds[0], fds[1], errors[0], errors[1]}) {
+    posix_spawn_file_actions_addclose(&actions, fd);
+  }
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   const int spawned = posix_spawnp(&pid_, "ffmpeg", &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   ::close(fds[0]);
+  ::close(errors[1]);
   if (spawned != 0) {
     ::close(fds[1]);
+    ::close(errors[0]);
     pid_ = -1;
     throw std::runtime_error(std::string("cannot run ffmpeg (") + std::strerror(spawned) +
                              "): install it (apt-get install ffmpeg)");
   }
+  // ffmpeg runs with -loglevel error: what it prints is an error. Some it does not count in its
+  // exit status (the GIF muxer's "Error writing trailer" on a full disk exits 0), so the text
+  // decides too; read on a thread so that a long message cannot block ffmpeg.
+  errors_ = std::thread([this, fd = errors[0]] {
+    char buffer[4096];
+    for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) != 0;) {
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) break;
+      error_text_.append(buffer, static_cast<size_t>(n));
+    }
+    ::close(fd);
+  });
   pipe_ = fdopen(fds[1], "wb");
   // A dead ffmpeg makes writes fail with EPIPE instead of killing this process.
   std::signal(SIGPIPE, SIG_IGN);
@@ -116,6 +137,7 @@ VideoWriter::~VideoWriter() {
     }
     pid_ = -1;
   }
+  if (errors_.joinable()) errors_.join();
   remove_temporaries();
 }
 
@@ -150,10 +172,13 @@ void VideoWriter::close() {
   while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
   }
   pid_ = -1;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+  if (errors_.joinable()) errors_.join();  // ffmpeg has exited: its end of the pipe is closed
+  while (!error_text_.empty() && error_text_.back() == '\n') error_text_.pop_back();
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !error_text_.empty()) {
     remove_temporaries();
     throw std::runtime_error("ffmpeg failed to write '" + path_ + "' (exit status " +
                              std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
+                             (error_text_.empty() ? "" : ": " + error_text_) +
                              "); existing files were left as they were");
   }
   if (replacement_) {

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <thread>
 
 namespace jelly::detail {
 class FileReplacement;
@@ -55,6 +56,8 @@ class VideoWriter {
   int frames_ = 0;
   std::FILE* pipe_ = nullptr;
   pid_t pid_ = -1;
+  std::thread errors_;      // reads ffmpeg's stderr into error_text_ until ffmpeg exits
+  std::string error_text_;  // written by errors_ only until it is joined
 };
 
 }  // namespace jelly::viewer
