@@ -293,6 +293,24 @@ TEST(DataLoss, AnOutputThatIsTheInputIsRefusedNamingBoth) {
   EXPECT_EQ(read_file(file), recording);
 }
 
+// Issue 44, item 9: `jelly run -o` naming a mesh file the scene reads (here a tet mesh body's,
+// through a hard link) is refused naming both; before, --overwrite replaced it.
+TEST(DataLoss, ARunNeverWritesOverAMeshFileOfItsScene) {
+  const std::string msh = temp_path(".msh");
+  Result r = jelly("mesh " + quoted(cube_obj()) + " -o " + quoted(msh) + " --size 0.5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string before = read_file(msh);
+  const std::string scene_file =
+      write_scene(R"({"bodies": [{"kind": "tetmesh", "file": ")" + msh +
+                  R"("}], "integrator": {"name": "rk4"}, "duration": 0.01})");
+  const std::string out = temp_path(".h5");
+  ASSERT_EQ(link(msh.c_str(), out.c_str()), 0);
+  r = jelly("run " + quoted(scene_file) + " -q --overwrite -o " + quoted(out));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("-o " + out + " is the mesh file " + msh));
+  EXPECT_EQ(read_file(msh), before);
+}
+
 // ---- Damaged files ----
 
 // Writes `value` over every element of the double dataset `name`, in place.
