@@ -407,6 +407,19 @@ TEST(Silent, AFitWhoseResidualsCannotBeEvaluatedExitsThree) {
   }
 }
 
+// Issue 44, item 11: a size so small or a position so far out that the particles' distances are
+// lost in double precision is named by the body (and its size fields), not as
+// springs[0].rest_length, a field no scene has.
+TEST(Silent, ABodyWhoseParticlesCollapseIsNamed) {
+  for (const std::string set : {"cube.edge_length=1e-300", "cube.origin=[1e308,0,0]"}) {
+    const Result r = jelly("run " + kSmallSlope + " --set '" + set + "' --duration 0.01 -q");
+    EXPECT_EQ(r.code, 2) << set;
+    EXPECT_THAT(r.err, HasSubstr("error: bodies[0] (the cube \"jelly\") = particles ")) << set;
+    EXPECT_THAT(r.err, HasSubstr("edge_length")) << set;
+    EXPECT_THAT(r.err, Not(HasSubstr("rest_length"))) << set;
+  }
+}
+
 // Issue 44, item 11: an unknown command is named, with the commands there are (CLI11 said "A
 // subcommand is required").
 TEST(Silent, AnUnknownCommandIsNamed) {
