@@ -2,6 +2,7 @@
 // lost file, no silent run, and the documented exit codes. Each test is one class of finding.
 #include <hdf5.h>
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -309,6 +310,41 @@ TEST(DataLoss, ARunNeverWritesOverAMeshFileOfItsScene) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_THAT(r.err, HasSubstr("-o " + out + " is the mesh file " + msh));
   EXPECT_EQ(read_file(msh), before);
+}
+
+// Issue 44, item 9: while another program writes a file (it holds the write lock every jelly
+// writer takes: here this test does, as a first run would), a second jelly told to --overwrite
+// it is refused, exit 2, and leaves it alone; once the lock is released it may replace it.
+TEST(DataLoss, ASecondWriterIsRefusedWhileTheFileIsBeingWritten) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string msh = temp_path(".msh");
+  std::ofstream(msh) << "precious";
+  const std::string before = read_file(file);
+  std::vector<int> locks;
+  for (const std::string& path : {file, msh}) {
+    const int fd = open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    ASSERT_GE(fd, 0);
+    struct flock lock {};
+    lock.l_type = F_WRLCK;
+    lock.l_whence = SEEK_SET;
+    ASSERT_EQ(fcntl(fd, F_OFD_SETLK, &lock), 0);
+    locks.push_back(fd);
+  }
+  const std::string run =
+      "run " + kSmallSlope + " --duration 0.1 -q --overwrite -o " + quoted(file);
+  const std::string mesh = "mesh " + quoted(cube_obj()) + " -o " + quoted(msh) + " --overwrite";
+  for (const std::string& command : {run, mesh}) {
+    const Result r = jelly(command);
+    EXPECT_EQ(r.code, 2) << command << ": " << r.err;
+    EXPECT_THAT(r.err, HasSubstr("is being written by another run")) << command;
+  }
+  EXPECT_EQ(read_file(file), before);
+  EXPECT_EQ(read_file(msh), "precious");
+  EXPECT_EQ(partial_files(), 0);
+  for (const int fd : locks) close(fd);
+  EXPECT_EQ(jelly(run).code, 0);
+  EXPECT_EQ(jelly(mesh).code, 0);
 }
 
 // ---- Damaged files ----
