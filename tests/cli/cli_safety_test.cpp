@@ -57,20 +57,7 @@ void set_attribute(const std::string& path, const std::string& object, const std
 
 void set_attribute(const std::string& path, const std::string& object, const std::string& name,
                    const std::string& value) {
-  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  const hid_t group = H5Oopen(file, object.c_str(), H5P_DEFAULT);
-  H5Adelete(group, name.c_str());
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  H5Tset_size(type, H5T_VARIABLE);
-  const hid_t space = H5Screate(H5S_SCALAR);
-  const hid_t attribute = H5Acreate2(group, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
-  const char* text = value.c_str();
-  H5Awrite(attribute, type, &text);
-  H5Aclose(attribute);
-  H5Sclose(space);
-  H5Tclose(type);
-  H5Oclose(group);
-  H5Fclose(file);
+  testing::set_string_attribute(path, object, name, value);
 }
 
 // ---- Crashes ----
