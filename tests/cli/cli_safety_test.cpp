@@ -406,6 +406,8 @@ TEST(Silent, NaNTimesFramesOutOfRangeAndEmptyNamesAreRefused) {
            {"view " + quoted(file) + " --frames 0 --screenshot ''", "--screenshot"}}) {
     const Result r = jelly(command);
     EXPECT_EQ(r.code, 2) << command << ": " << r.err;
+    // A jelly built without the viewer (CI's sanitizer build) refuses render and view as such.
+    if (r.err.find("this jelly was built without") != std::string::npos) continue;
     EXPECT_THAT(r.err, HasSubstr(field)) << command;
   }
 }
