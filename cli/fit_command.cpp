@@ -3,11 +3,12 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 
+#include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
 #include <jelly/fit/recording_trajectory.hpp>
@@ -41,7 +42,8 @@ void check_write_scene(const FitArgs& args) {
   if (stat(path.c_str(), &target) == 0) {
     if (stat(args.recording.c_str(), &recording) == 0 && target.st_dev == recording.st_dev &&
         target.st_ino == recording.st_ino) {
-      throw InputError("--write-scene " + path + " is the recording: it would be overwritten");
+      throw InputError("--write-scene " + path + " is the recording " + args.recording +
+                       " (the same file): it would be overwritten; choose another name");
     }
     if (!S_ISREG(target.st_mode)) {
       throw InputError("--write-scene " + path + " exists and is not a file");
@@ -60,25 +62,6 @@ void check_write_scene(const FitArgs& args) {
   if (fd < 0) throw InputError("--write-scene " + path + ": " + std::strerror(errno));
   close(fd);
   std::remove(path.c_str());
-}
-
-// Writes under a temporary name, then renames: a failure leaves no half-written scene.
-void write_text_file(const std::string& path, const std::string& text) {
-  const std::string partial = path + ".partial-" + std::to_string(static_cast<long>(getpid()));
-  {
-    std::ofstream out(partial);
-    out << text;
-    out.close();
-    if (!out) {
-      std::remove(partial.c_str());
-      throw std::runtime_error("--write-scene " + path + ": cannot write " + partial);
-    }
-  }
-  if (std::rename(partial.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    std::remove(partial.c_str());
-    throw std::runtime_error("--write-scene " + path + ": " + why);
-  }
 }
 
 }  // namespace
@@ -101,8 +84,19 @@ int fit_command(const FitArgs& args) {
   }
   const FitResult result = fit_recording(trajectory, options);
   std::fputs(result.report().c_str(), stdout);
+  // Ceres reports a cost of -1 when the residuals could not be evaluated at all (every replay
+  // from the starting values failed): nothing was fitted, so no scene is written.
+  const auto evaluated = [](Real cost) { return std::isfinite(cost) && cost >= 0; };
+  if (!evaluated(result.initial_cost) || !evaluated(result.final_cost)) {
+    std::fprintf(stderr,
+                 "error: the fit's residuals could not be evaluated (initial cost %g, final cost "
+                 "%g: %s); nothing was fitted%s\n",
+                 result.initial_cost, result.final_cost, result.termination.c_str(),
+                 args.write_scene.empty() ? "" : " and no scene was written");
+    return kExitRunFailed;
+  }
   if (!args.write_scene.empty()) {
-    write_text_file(args.write_scene, scene_to_json(fitted_scene(recording, result)) + "\n");
+    detail::replace_file(args.write_scene, scene_to_json(fitted_scene(recording, result)) + "\n");
     std::printf("fitted scene written to %s\n", args.write_scene.c_str());
   }
   return kExitOk;

@@ -142,8 +142,9 @@ int main(int argc, char** argv) {
                 "per coordinate of its start state (6 x particles replays per window), most of "
                 "the time on a large body");
 
-  CLI::App* list = app.add_subcommand(
-      "list", "List the integrators, body and terrain kinds, contact models, forces and optional parts, one per line");
+  CLI::App* list = app.add_subcommand("list",
+                                      "List the integrators, body and terrain kinds, contact "
+                                      "models, forces and optional parts, one per line");
 
   ViewArgs view_args;
   CLI::App* view = app.add_subcommand(
@@ -161,7 +162,8 @@ int main(int argc, char** argv) {
   view->add_option("--screenshot", view_args.screenshot,
                    "Write the window as PNG after --frames N frames and exit (live: each frame "
                    "is then one output interval of simulated time; replay: the next recorded "
-                   "frame)");
+                   "frame)")
+      ->check(kNonEmpty);
   view->add_option("--frames", view_args.frames, "Exit after this many frames");
   view->add_option("--frame", view_args.frame, "Replay: the frame shown first");
   view->add_option("--speed", view_args.speed,
@@ -233,6 +235,22 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   mesh->add_flag("--overwrite", mesh_args.overwrite, "Replace an existing -o file");
 
+  // A first word that is no command ("jelly simulate") is named, with the commands there are
+  // (CLI11 would say only that a subcommand is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string word = argv[1];
+    std::string known;
+    bool found = false;
+    for (const CLI::App* command : app.get_subcommands({})) {
+      found = found || command->get_name() == word;
+      known += (known.empty() ? "" : ", ") + command->get_name();
+    }
+    if (!found) {
+      std::fprintf(stderr, "error: unknown command '%s'; the commands are %s (jelly --help)\n",
+                   word.c_str(), known.c_str());
+      return kExitBadInput;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -19,8 +19,10 @@ int mesh_command(const MeshArgs& args) {
   require(ext == ".msh", "-o", "\"" + args.output + "\"", "a Gmsh file name ending in .msh");
   std::error_code error;
   if (fs::exists(args.output, error)) {
+    // The same file also through symbolic and hard links.
     if (fs::equivalent(args.output, args.input, error)) {
-      throw InputError("-o " + args.output + " is the input surface");
+      throw InputError("-o " + args.output + " is the input surface " + args.input +
+                       " (the same file): it would be overwritten; choose another name");
     }
     if (!args.overwrite) {
       throw InputError("-o " + args.output +

@@ -44,9 +44,25 @@ bool same_file(const std::string& a, const std::string& b) {
   return exists(a, &x) && exists(b, &y) && x.st_dev == y.st_dev && x.st_ino == y.st_ino;
 }
 
+// Every "file" field of the scene (the mesh and tet mesh files of bodies and obstacles, of any
+// kind), as the scene resolved them (absolute, or relative to the current directory).
+void collect_files(const nlohmann::json& value, std::vector<std::string>& files) {
+  if (value.is_object()) {
+    for (auto it = value.begin(); it != value.end(); ++it) {
+      if (it.key() == "file" && it.value().is_string()) {
+        files.push_back(it.value().get<std::string>());
+      } else {
+        collect_files(it.value(), files);
+      }
+    }
+  } else if (value.is_array()) {
+    for (const nlohmann::json& item : value) collect_files(item, files);
+  }
+}
+
 // A run never destroys a file it did not create unless told to (--overwrite), and never the
 // files it reads from: checked before anything is computed.
-void check_output_paths(const RunArgs& args) {
+void check_output_paths(const RunArgs& args, const Scene& scene) {
   const std::string& out = args.output;
   const std::string sidecar = sidecar_path_for(out);
   const std::string o = "-o " + out;
@@ -62,6 +78,17 @@ void check_output_paths(const RunArgs& args) {
   if (same_file(sidecar, args.scene)) {
     throw InputError(o + ": its XDMF sidecar " + sidecar +
                      " is the scene file: the run would overwrite it");
+  }
+  std::vector<std::string> files;
+  collect_files(nlohmann::json::parse(scene_to_json(scene)), files);
+  for (const std::string& file : files) {
+    for (const std::string& path : {out, sidecar}) {
+      if (same_file(path, file)) {
+        throw InputError(o + (path == out ? "" : ": its XDMF sidecar " + path) +
+                         " is the mesh file " + file +
+                         " that the scene reads (the same file): it would be overwritten");
+      }
+    }
   }
   if (!args.restart.empty() && same_file(out, args.restart)) {
     throw InputError(o +
@@ -116,7 +143,7 @@ int run_command(const RunArgs& args) {
   const Scene scene = load_scene(args.scene, overrides(args));
   std::shared_ptr<const Checkpoint> checkpoint;
   if (!args.restart.empty()) checkpoint = read_restart(args.restart, scene);
-  if (!args.output.empty()) check_output_paths(args);
+  if (!args.output.empty()) check_output_paths(args, scene);
 
   RunLimits limits;
   if (!args.output.empty()) limits.disk_bytes = free_disk_bytes(args.output);

@@ -32,8 +32,10 @@ void check_new_file(const std::string& flag, const std::string& path, bool overw
                     const std::string& input) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) return;
+  // equivalent(): the same file also through symbolic and hard links.
   if (!input.empty() && std::filesystem::equivalent(path, input, error))
-    throw InputError(flag + " " + path + " is the recording it is made from");
+    throw InputError(flag + " " + path + " is the recording it is made from, " + input +
+                     " (the same file): it would be overwritten; choose another name");
   if (!overwrite)
     throw InputError(flag + " " + path +
                      " exists (a file this command did not create): pass --overwrite to replace "
@@ -153,7 +155,8 @@ int export_command(const ExportArgs& args) {
   if (args.obj_sequence.empty() && args.pc2.empty())
     throw InputError("jelly export", args.recording, "--obj-sequence DIR and/or --pc2 FILE.pc2");
   if (!args.obj_sequence.empty())
-    check_new_file("--obj-sequence", args.obj_sequence + "/frame_0000.obj", args.overwrite, "");
+    check_new_file("--obj-sequence", args.obj_sequence + "/frame_0000.obj", args.overwrite,
+                   args.recording);
   if (!args.pc2.empty()) {
     check_new_file("--pc2", args.pc2, args.overwrite, args.recording);
     check_new_file("--pc2 (its rest surface)",

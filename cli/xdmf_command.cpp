@@ -20,6 +20,11 @@ int xdmf_command(const XdmfArgs& args) {
     throw InputError("'" + args.recording + "': no such file");
   }
   std::error_code error;
+  // Through a symbolic or hard link the sidecar's name can be the recording itself.
+  if (std::filesystem::equivalent(sidecar, args.recording, error)) {
+    throw InputError("'" + sidecar + "', the sidecar of '" + args.recording +
+                     "', is the recording itself (the same file): it would be overwritten");
+  }
   if (std::filesystem::exists(sidecar, error) && !args.overwrite) {
     throw InputError("'" + sidecar +
                      "' exists: pass --overwrite to replace it (it is rewritten from the "

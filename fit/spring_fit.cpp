@@ -436,6 +436,10 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
   if (options.compute_covariance) {
     if (result.residuals <= unknowns) {
       result.covariance_message = "fewer residuals than unknowns";
+    } else if (!(summary.initial_cost >= 0 && summary.final_cost >= 0)) {
+      // Ceres' cost -1: the residuals could not be evaluated, so neither can their Jacobian
+      // (ceres::Covariance on such a problem crashed).
+      result.covariance_message = "the residuals could not be evaluated";
     } else {
       // Ceres returns the log-coefficients' block of (J^T J)^-1 (all unknowns): the covariance
       // for residuals that are independent with unit variance.

@@ -1,5 +1,5 @@
-#include <jelly/geometry/body_spec.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/body_spec.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -232,12 +232,48 @@ Json BodySpec::to_json() const {
   return j;
 }
 
+namespace {
+
+// What a body's size fields built, checked before the model sees it: a size so small, or
+// positions so far out, that double precision loses the particles' distances gives springs of
+// rest length 0 or inf, which the model would report as springs[k].rest_length, a field no
+// scene has. Named here by the body's own path instead.
+void check_built(const BodyPart& part, const std::string& prefix, const BodySpec& spec) {
+  const std::string body =
+      (prefix.empty() ? std::string("body") : prefix.substr(0, prefix.size() - 1)) + " (the " +
+      std::string(spec.kind()) + " \"" + spec.name + "\")";
+  for (int i = 0; i < part.num_particles(); ++i) {
+    const Vec3 x = part.position.segment<3>(3 * i);
+    if (!x.allFinite()) {
+      throw InputError(body, "particle " + std::to_string(i) + " at " + to_text(x.transpose()),
+                       "size and position fields (e.g. edge_length, size_u, scale, origin, "
+                       "position) that place every particle at finite coordinates");
+    }
+  }
+  const Springs& springs = part.springs;
+  for (int k = 0; k < springs.size(); ++k) {
+    const Real length = springs.rest_length[k];
+    if (!(std::isfinite(length) && length > 0)) {
+      throw InputError(
+          body,
+          "particles " + std::to_string(springs.a[k]) + " and " + std::to_string(springs.b[k]) +
+              " " + to_text(length) + " m apart",
+          "size and position fields (e.g. edge_length, size_u, scale, origin, position) that "
+          "keep neighbouring particles apart in double precision: a larger size, or a "
+          "position nearer the origin");
+    }
+  }
+}
+
+}  // namespace
+
 void add_body(Model& model, const BodySpec& spec, const std::string& prefix) {
   spec.validate(prefix);
   require(model.find_body(spec.name) == nullptr, prefix + "name", "\"" + spec.name + "\"",
           "a name no other body has");
-  const int index =
-      model.add_body(spec.name, spec.shape->build(spec.material, prefix), spec.radius);
+  BodyPart part = spec.shape->build(spec.material, prefix);
+  check_built(part, prefix, spec);
+  const int index = model.add_body(spec.name, std::move(part), spec.radius);
   model.bodies[index].velocity = spec.velocity;
   model.bodies[index].angular_velocity = spec.angular_velocity;
   model.bodies[index].color = spec.color;

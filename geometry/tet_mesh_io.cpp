@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/detail/mesh_file.hpp>
 #include <jelly/geometry/detail/msh_reader.hpp>
@@ -37,8 +38,7 @@ TetMesh read_tet_mesh(const std::string& path, const std::string& field) {
 
 void write_msh(const std::string& path, const TetMesh& mesh) {
   require(lower_extension(path) == ".msh", "mesh file", quoted(path), "a file ending in .msh");
-  std::ofstream out(path);
-  require(static_cast<bool>(out), "mesh file", quoted(path), "a file that can be written");
+  std::ostringstream out;
   out.precision(17);
   const std::vector<Triangle> boundary = tet_boundary(mesh.tets, mesh.vertices);
   std::vector<char> on_boundary(mesh.vertices.size(), 0);
@@ -93,7 +93,7 @@ void write_msh(const std::string& path, const TetMesh& mesh) {
         << "\n";
   }
   out << "$EndElements\n";
-  require(static_cast<bool>(out.flush()), "mesh file", quoted(path), "a file that can be written");
+  detail::replace_file(path, out.str());
 }
 
 }  // namespace jelly

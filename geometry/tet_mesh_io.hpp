@@ -20,7 +20,9 @@ TetMesh read_tet_mesh(const std::string& path, const std::string& field);
 
 // Writes a tet mesh as Gmsh .msh 4.1 (ASCII): the tets as volume 1 (physical group "volume"),
 // the boundary triangles as surface 1 (physical group "boundary"); vertex groups are not
-// written. Throws InputError naming the path when it does not end in .msh or cannot be written.
+// written. Throws InputError when the path does not end in .msh, std::runtime_error naming it
+// when it cannot be written; the file is written beside and renamed, so a failed write leaves an
+// existing file as it was.
 void write_msh(const std::string& path, const TetMesh& mesh);
 
 }  // namespace jelly

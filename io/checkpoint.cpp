@@ -169,6 +169,21 @@ Checkpoint read_checkpoint(const std::string& path) {
     cp.state.t = h5::read_double_attribute(g.get(), "t");
     cp.state.x = Eigen::Map<const VecX>(x.data(), static_cast<Eigen::Index>(x.size()));
     cp.state.v = Eigen::Map<const VecX>(v.data(), static_cast<Eigen::Index>(v.size()));
+    // A value that is not finite is damage to the file, or the last state of a run that
+    // diverged: nothing a run can continue from either way (checked below, with the status).
+    std::string not_finite;
+    for (const auto& [name, values] :
+         {std::pair{"position", &cp.state.x}, std::pair{"velocity", &cp.state.v}}) {
+      for (Eigen::Index i = 0; i < values->size() && not_finite.empty(); ++i) {
+        if (!std::isfinite((*values)[i])) {
+          not_finite = std::string("/checkpoint/") + name + " of particle " +
+                       std::to_string(i / 3) + " is " + to_text((*values)[i]);
+        }
+      }
+    }
+    if (not_finite.empty() && !std::isfinite(cp.state.t)) {
+      not_finite = "/checkpoint attribute t is " + to_text(cp.state.t);
+    }
     cp.total_steps = h5::read_long_attribute(g.get(), "total_steps");
     cp.next_output = h5::read_double_attribute(g.get(), "next_output");
     cp.contact_count = static_cast<int>(h5::read_long_attribute(g.get(), "contact_count"));
@@ -198,6 +213,19 @@ Checkpoint read_checkpoint(const std::string& path) {
       if (h5::has_attribute(parameters.get(), "output_interval")) {
         cp.output_interval = h5::read_double_attribute(parameters.get(), "output_interval");
       }
+    }
+    if (!not_finite.empty()) {
+      std::string status;
+      if (h5::exists(file.get(), "parameters")) {
+        h5::Handle parameters = h5::open_group(file.get(), "parameters");
+        if (h5::has_attribute(parameters.get(), "run_status")) {
+          status = h5::read_string_attribute(parameters.get(), "run_status");
+        }
+      }
+      throw InputError("'" + path + "' has an invalid /checkpoint: " + not_finite +
+                       (status == "diverged"
+                            ? " (its run diverged: there is no finite state to continue from)"
+                            : " (not finite: the file is damaged)"));
     }
   } catch (const InputError&) {
     throw;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/detail/input_file.hpp>
 #include <jelly/core/errors.hpp>
 
@@ -21,25 +22,29 @@ void put_f32(std::FILE* f, float v) { std::fwrite(&v, 4, 1, f); }
 
 }  // namespace
 
-void write_obj(const std::string& path, const std::vector<ObjObject>& objects,
-               const std::string& one_object) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr)
-    throw InputError("output", path,
-                     "a file that can be written (" + std::string(std::strerror(errno)) + ")");
-  std::fprintf(f, "# jelly render surface\n");
-  if (!one_object.empty()) std::fprintf(f, "o %s\n", one_object.c_str());
+std::string obj_text(const std::vector<ObjObject>& objects, const std::string& one_object) {
+  std::string text = "# jelly render surface\n";
+  if (!one_object.empty()) text += "o " + one_object + "\n";
+  char line[128];
   int base = 1;
   for (const ObjObject& o : objects) {
-    std::fprintf(f, "%s %s\n", one_object.empty() ? "o" : "g", o.name.c_str());
-    for (const Vec3& v : o.vertices) std::fprintf(f, "v %.9g %.9g %.9g\n", v.x(), v.y(), v.z());
-    for (const auto& t : o.triangles)
-      std::fprintf(f, "f %d %d %d\n", t[0] + base, t[1] + base, t[2] + base);
+    text += (one_object.empty() ? "o " : "g ") + o.name + "\n";
+    for (const Vec3& v : o.vertices) {
+      std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", v.x(), v.y(), v.z());
+      text += line;
+    }
+    for (const auto& t : o.triangles) {
+      std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + base, t[1] + base, t[2] + base);
+      text += line;
+    }
     base += static_cast<int>(o.vertices.size());
   }
-  const bool ok = std::ferror(f) == 0;
-  if (std::fclose(f) != 0 || !ok)
-    throw InputError("output", path, "a file that can be written (the write failed)");
+  return text;
+}
+
+void write_obj(const std::string& path, const std::vector<ObjObject>& objects,
+               const std::string& one_object) {
+  detail::replace_file(path, obj_text(objects, one_object));
 }
 
 std::vector<ObjObject> read_obj(const std::string& path) {
@@ -86,10 +91,10 @@ Pc2Writer::Pc2Writer(const std::string& path, int num_points, float start_frame,
     : path_(path) {
   require(num_points >= 0, "num_points", num_points, ">= 0");  // before the buffer's size
   buffer_.resize(3 * static_cast<size_t>(num_points));
-  file_ = std::fopen(path.c_str(), "wb");
+  replacement_ = std::make_unique<detail::FileReplacement>(path);
+  file_ = std::fopen(replacement_->temporary().c_str(), "wb");
   if (file_ == nullptr)
-    throw InputError("--pc2", path,
-                     "a file that can be written (" + std::string(std::strerror(errno)) + ")");
+    throw std::runtime_error("cannot write '" + path + "' (" + std::strerror(errno) + ")");
   std::fwrite(kPc2Signature, 1, sizeof kPc2Signature, file_);
   put_i32(file_, 1);  // file version
   put_i32(file_, num_points);
@@ -99,10 +104,8 @@ Pc2Writer::Pc2Writer(const std::string& path, int num_points, float start_frame,
 }
 
 Pc2Writer::~Pc2Writer() {
-  try {
-    close();
-  } catch (...) {
-  }
+  // Not completed by close(): the temporary is removed, an old file stays as it was.
+  if (file_ != nullptr) std::fclose(file_);
 }
 
 void Pc2Writer::write(const double* xyz) {
@@ -119,8 +122,11 @@ void Pc2Writer::close() {
   const bool ok = !failed_ && std::ferror(file_) == 0;
   const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;
-  if (!ok || !closed)
-    throw InputError("--pc2", path_, "a file that can be written (the write failed)");
+  if (!ok || !closed) {
+    replacement_->discard();
+    throw std::runtime_error("cannot write '" + path_ + "' (the write failed)");
+  }
+  replacement_->commit();
 }
 
 Pc2Data read_pc2(const std::string& path) {

@@ -13,8 +13,10 @@
 #include <deque>
 #include <exception>
 #include <functional>
+#include <optional>
 #include <thread>
 
+#include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/io/detail/checkpoint_h5.hpp>
@@ -166,25 +168,19 @@ void probe_creatable(const std::string& path, const std::string& what) {
   std::remove(path.c_str());
 }
 
-// Beside `path`, for a file that replaces it once complete.
-std::string partial_path(const std::string& path) {
-  return path + ".partial-" + std::to_string(static_cast<long>(getpid()));
-}
-
-void move_file(const std::string& from, const std::string& to) {
-  if (std::rename(from.c_str(), to.c_str()) != 0) {
-    throw std::runtime_error("cannot rename '" + from + "' to '" + to +
-                             "': " + std::strerror(errno));
-  }
-}
-
 }  // namespace
 
 struct H5Recorder::Impl {
   std::string path;          // where the recording ends up
-  std::string write_path;    // where it is written: path, or partial_path(path) when replacing
+  std::string write_path;    // where it is written: path, or the replacement's temporary
   std::string sidecar_path;  // the XDMF sidecar, when written
-  bool replacing = false;    // write_path is moved onto path at the first on_finish
+  // With overwrite and an existing file: the temporary moved onto path at the first on_finish
+  // (removed, the old file kept, when the recorder ends before). Declared before the HDF5
+  // handles, so that they are closed before it is removed.
+  std::optional<detail::FileReplacement> replacement;
+  // Without a replacement, the file is written in place: locked, so that a second recorder told
+  // to overwrite it is refused while this one writes (the replacement locks the file it replaces).
+  detail::WriteLock write_lock;
   RecorderOptions options;
   Model model;
   int n = 0;
@@ -232,7 +228,7 @@ H5Recorder::Impl::Impl(const std::string& p, const Simulator& sim, RecorderOptio
   options.validate();
   if (options.integrator_name.empty()) options.integrator_name = sim.integrator().name();
   require(!path.empty(), "recording path", "\"\"", "a file name");
-  replacing = check_target(path, options.overwrite, "the recording");
+  const bool replacing = check_target(path, options.overwrite, "the recording");
   if (options.write_xdmf) {
     sidecar_path = xdmf_path_for(path);
     if (sidecar_path == path) {
@@ -242,12 +238,15 @@ H5Recorder::Impl::Impl(const std::string& p, const Simulator& sim, RecorderOptio
   }
   const bool sidecar_exists =
       options.write_xdmf && check_target(sidecar_path, options.overwrite, "the XDMF sidecar");
-  write_path = replacing ? partial_path(path) : path;
+  if (replacing) replacement.emplace(path);
+  write_path = replacing ? replacement->temporary() : path;
   {
     std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
     h5::QuietErrors quiet;
-    file = h5::create_file(write_path, /*exclusive=*/true);
+    // The temporary was created empty by the replacement; a new file is created exclusively.
+    file = h5::create_file(write_path, /*exclusive=*/!replacing);
     try {
+      if (!replacing) write_lock = detail::WriteLock(write_path);
       if (options.write_xdmf && !sidecar_exists) probe_creatable(sidecar_path, "the XDMF sidecar");
       write_static(sim);
       h5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + write_path);
@@ -261,7 +260,12 @@ H5Recorder::Impl::Impl(const std::string& p, const Simulator& sim, RecorderOptio
       terrain_rotations.clear();
       checkpoint.reset();
       file.reset();
-      std::remove(write_path.c_str());
+      write_lock.release();
+      if (replacement) {
+        replacement->discard();
+      } else {
+        std::remove(write_path.c_str());
+      }
       throw;
     }
   }
@@ -613,10 +617,9 @@ H5Recorder::~H5Recorder() {
   impl_->stop();
   std::lock_guard<std::recursive_mutex> library(h5::library_mutex());
   h5::QuietErrors quiet;
-  // A replacement that on_finish did not complete is dropped: the old file stays.
-  const std::string unfinished = impl_->replacing ? impl_->write_path : "";
-  impl_.reset();  // closes every handle, then the file
-  if (!unfinished.empty()) std::remove(unfinished.c_str());
+  // Closes every handle, then the file; a replacement that on_finish did not complete is
+  // dropped: the old file stays.
+  impl_.reset();
 }
 
 namespace {
@@ -715,7 +718,7 @@ void H5Recorder::on_finish(const Simulator& sim, const RunReport& report) {
   }
   // The sidecar under a temporary name first, so that a failure leaves no half-written one; the
   // recording is moved onto its path only when everything else has been written.
-  std::string sidecar_written;
+  std::optional<detail::FileReplacement> sidecar;
   if (m.options.write_xdmf) {
     std::string text;
     {
@@ -724,20 +727,17 @@ void H5Recorder::on_finish(const Simulator& sim, const RunReport& report) {
       text = update_xdmf(m.file.get(), m.path, m.options.xdmf);
       h5::check(H5Fflush(m.file.get(), H5F_SCOPE_GLOBAL), "flush " + m.path);
     }
-    sidecar_written = partial_path(m.sidecar_path);
-    try {
-      write_text_file(sidecar_written, text);
-    } catch (...) {
-      std::remove(sidecar_written.c_str());
-      throw;
-    }
+    sidecar.emplace(m.sidecar_path);
+    sidecar->write(text);
   }
-  if (m.replacing) {
-    move_file(m.write_path, m.path);
-    m.replacing = false;
+  if (m.replacement) {
+    m.replacement->commit();
+    m.replacement.reset();
     m.write_path = m.path;
+    // Later run_until() calls write on in place: locked as a file written in place is.
+    m.write_lock = detail::WriteLock(m.path);
   }
-  if (!sidecar_written.empty()) move_file(sidecar_written, m.sidecar_path);
+  if (sidecar) sidecar->commit();
 }
 
 void disable_hdf5_exit_cleanup() {

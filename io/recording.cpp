@@ -178,8 +178,12 @@ Recording read(hid_t file) {
 
   const std::string clock = groups.front().group() + "/position/";
   // A killed run's last frames may not read (h5::Frames): every frame series keeps the frames
-  // that do, and the frames all of them hold are kept below.
-  constexpr h5::Frames kReadable = h5::Frames::kLeadingReadable;
+  // that do, and the frames all of them hold are kept below. A run that finished (its status
+  // written by on_finish after the last flush) stored every frame: one that does not read (a
+  // corrupt compressed chunk) is damage, an error naming the dataset, not a shorter recording.
+  const auto status = r.attributes.find("run_status");
+  const bool finished = status != r.attributes.end() && status->second != "running";
+  const h5::Frames kReadable = finished ? h5::Frames::kAll : h5::Frames::kLeadingReadable;
   r.time = h5::read_doubles(file, clock + "time", nullptr, kReadable);
   r.step = h5::read_longs(file, clock + "step", nullptr, kReadable);
   try {
@@ -261,6 +265,9 @@ std::string describe_recording(const std::string& path) {
   std::ostringstream out;
   try {
     const hid_t f = file.get();
+    // The validation every reader of a recording makes (read_recording): a damaged file is
+    // refused here too, not described as if whole.
+    (void)read(f);
     h5::Handle h5md = h5::open_group(f, "/h5md");
     h5::Handle par = h5::open_group(f, "/parameters");
     auto attributes = attributes_of(par.get());

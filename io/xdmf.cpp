@@ -13,11 +13,13 @@
 #include <sstream>
 #include <vector>
 
+#include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/types.hpp>
 #include <jelly/io/detail/h5.hpp>
 #include <jelly/io/detail/xdmf_h5.hpp>
 #include <jelly/io/h5_recorder.hpp>
+#include <jelly/io/recording.hpp>
 
 namespace jelly {
 
@@ -1022,18 +1024,14 @@ std::string update_xdmf(hid_t file, const std::string& h5_path, const XdmfOption
   return w.out().str();
 }
 
-void write_text_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) throw InputError("cannot write XDMF file '" + path + "'");
-  out << text;
-  out.close();
-  if (!out) throw InputError("cannot write XDMF file '" + path + "'");
-}
-
 std::string write_xdmf_for_recording(const std::string& h5_path, const XdmfOptions& options) {
   options.validate();
   std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
   h5::QuietErrors quiet;
+  // The validation every reader of a recording makes: a damaged file (wrong shapes, masses that
+  // are not finite, a dataset claiming more than it stores, a corrupt chunk) is an InputError
+  // naming it and the dataset, before a sidecar describes it.
+  (void)read_recording(h5_path);
   h5::Handle file = h5::open_file(h5_path, true);
   std::string text;
   try {
@@ -1042,22 +1040,12 @@ std::string write_xdmf_for_recording(const std::string& h5_path, const XdmfOptio
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
-    throw InputError("cannot write the XDMF views into '" + h5_path + "': " + e.what());
+    // A failed write (a full disk), not bad input.
+    throw std::runtime_error("cannot write the XDMF views into '" + h5_path + "': " + e.what());
   }
   // Under a temporary name first: a failure leaves the old sidecar (or none), never half of one.
   const std::string xdmf_path = xdmf_path_for(h5_path);
-  const std::string partial = xdmf_path + ".partial-" + std::to_string(static_cast<long>(getpid()));
-  try {
-    write_text_file(partial, text);
-  } catch (...) {
-    std::remove(partial.c_str());
-    throw;
-  }
-  if (std::rename(partial.c_str(), xdmf_path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
-    std::remove(partial.c_str());
-    throw InputError("cannot write XDMF file '" + xdmf_path + "': " + reason);
-  }
+  detail::replace_file(xdmf_path, text);
   return xdmf_path;
 }
 

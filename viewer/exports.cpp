@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly::viewer {
@@ -40,12 +41,17 @@ int export_obj_sequence(const Recording& recording, const std::string& dir) {
   std::filesystem::create_directories(dir, error);
   if (!std::filesystem::is_directory(dir))
     throw InputError("--obj-sequence", dir, "a folder that can be created");
+  // Every frame is written beside its file first and the files are renamed only when all are
+  // written: a failed write (a full disk) leaves an earlier sequence in the folder as it was.
+  std::vector<detail::FileReplacement> files;
+  files.reserve(static_cast<size_t>(recording.frames()));
   for (int k = 0; k < recording.frames(); ++k) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%04d.obj", k);
-    write_obj((std::filesystem::path(dir) / name).string(),
-              surface_objects(surfaces, recording.position[k]));
+    files.emplace_back((std::filesystem::path(dir) / name).string());
+    files.back().write(obj_text(surface_objects(surfaces, recording.position[k])));
   }
+  for (detail::FileReplacement& file : files) file.commit();
   return recording.frames();
 }
 
@@ -58,8 +64,10 @@ std::string export_pc2(const Recording& recording, const std::string& pc2_path) 
     throw InputError("--pc2", pc2_path, "a path whose extension is not .obj (e.g. out.pc2)");
   // One object (the bodies as its groups): Blender's importer then makes one mesh of every
   // vertex in the cache's order.
-  write_obj(obj_path, surface_objects(surfaces, recording.model.rest_position),
-            std::filesystem::path(pc2_path).stem().string());
+  // Both files are written beside their paths; the rest surface is renamed after the cache.
+  detail::FileReplacement rest(obj_path);
+  rest.write(obj_text(surface_objects(surfaces, recording.model.rest_position),
+                      std::filesystem::path(pc2_path).stem().string()));
   Pc2Writer pc2(pc2_path, points, 0, 1);
   std::vector<double> xyz(static_cast<size_t>(3 * points));
   for (int k = 0; k < recording.frames(); ++k) {
@@ -71,6 +79,7 @@ std::string export_pc2(const Recording& recording, const std::string& pc2_path) 
     pc2.write(xyz.data());
   }
   pc2.close();
+  rest.commit();
   return obj_path;
 }
 

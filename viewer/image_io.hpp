@@ -12,7 +12,9 @@ struct Image {
   std::vector<std::uint8_t> rgb;  // [height][width][3], top row first
 };
 
-// Throws std::runtime_error naming the path when it cannot be written.
+// Written beside the path and renamed (a failed write leaves an existing file as it was). Throws
+// InputError when its folder is missing or not writable, std::runtime_error naming the path when
+// the write fails.
 void write_png(const std::string& path, int width, int height, const std::uint8_t* rgb);
 // Throws std::runtime_error naming the path when it cannot be read.
 Image read_png(const std::string& path);

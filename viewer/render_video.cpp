@@ -1,6 +1,7 @@
 #include <jelly/viewer/render_video.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -27,6 +28,9 @@ RenderVideoReport render_video(const std::string& recording_path, const std::str
   require(options.height > 0 && options.height <= 8192, "--height", options.height,
           "1 to 8192 pixels");
   require(options.samples >= 1 && options.samples <= 16, "--samples", options.samples, "1 to 16");
+  // NaN compares false with everything: it would have meant "the recording's start" silently.
+  require(std::isfinite(options.start), "--start", options.start, "a finite time in seconds");
+  require(std::isfinite(options.end), "--end", options.end, "a finite time in seconds");
   video_format(output);
   const RecordingView view(recording_path);
   const double fps = options.fps > 0 ? options.fps : view.native_fps();

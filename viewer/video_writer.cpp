@@ -1,6 +1,7 @@
 #include <jelly/viewer/video_writer.hpp>
 
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
 
 extern char** environ;
@@ -70,36 +72,86 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
         "split[a][b];[a]palettegen=stats_mode=diff[p];[b][p]paletteuse=dither=bayer:"
         "bayer_scale=4");
   }
-  args.push_back(path);
+  if (format_ == VideoFormat::kPngSequence) {
+    ffmpeg_path_ = detail::FileReplacement::temporary_name(
+        path, detail::FileReplacement::Name::kBeforeExtension);
+  } else {
+    replacement_ = std::make_unique<detail::FileReplacement>(
+        path, detail::FileReplacement::Name::kBeforeExtension);
+    ffmpeg_path_ = replacement_->temporary();
+  }
+  args.push_back(ffmpeg_path_);
 
-  int fds[2];
+  int fds[2], errors[2];
   if (pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  if (pipe(errors) != 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
-  posix_spawn_file_actions_addclose(&actions, fds[0]);
-  posix_spawn_file_actions_addclose(&actions, fds[1]);
+  posix_spawn_file_actions_adddup2(&actions, errors[1], STDERR_FILENO);
+  for (int fd : {fds[0], fds[1], errors[0], errors[1]}) {
+    posix_spawn_file_actions_addclose(&actions, fd);
+  }
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   const int spawned = posix_spawnp(&pid_, "ffmpeg", &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   ::close(fds[0]);
+  ::close(errors[1]);
   if (spawned != 0) {
     ::close(fds[1]);
+    ::close(errors[0]);
     pid_ = -1;
     throw std::runtime_error(std::string("cannot run ffmpeg (") + std::strerror(spawned) +
                              "): install it (apt-get install ffmpeg)");
   }
+  // ffmpeg runs with -loglevel error: what it prints is an error. Some it does not count in its
+  // exit status (the GIF muxer's "Error writing trailer" on a full disk exits 0), so the text
+  // decides too; read on a thread so that a long message cannot block ffmpeg.
+  errors_ = std::thread([this, fd = errors[0]] {
+    char buffer[4096];
+    for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) != 0;) {
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) break;
+      error_text_.append(buffer, static_cast<size_t>(n));
+    }
+    ::close(fd);
+  });
   pipe_ = fdopen(fds[1], "wb");
   // A dead ffmpeg makes writes fail with EPIPE instead of killing this process.
   std::signal(SIGPIPE, SIG_IGN);
 }
 
 VideoWriter::~VideoWriter() {
-  try {
-    close();
-  } catch (...) {
+  // Not closed: ffmpeg is ended and what it wrote is removed; existing files stay as they were.
+  if (pipe_ != nullptr) {
+    std::fclose(pipe_);
+    pipe_ = nullptr;
+    int status = 0;
+    while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+  }
+  if (errors_.joinable()) errors_.join();
+  remove_temporaries();
+}
+
+std::string VideoWriter::frame_name(const std::string& pattern, int k) {
+  std::vector<char> name(pattern.size() + 32);
+  std::snprintf(name.data(), name.size(), pattern.c_str(), k);
+  return name.data();
+}
+
+void VideoWriter::remove_temporaries() {
+  if (replacement_) replacement_->discard();
+  if (format_ == VideoFormat::kPngSequence) {
+    // ffmpeg writes at most one file per frame it was given.
+    for (int k = 0; k <= frames_; ++k) std::remove(frame_name(ffmpeg_path_, k).c_str());
   }
 }
 
@@ -120,9 +172,39 @@ void VideoWriter::close() {
   while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
   }
   pid_ = -1;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+  if (errors_.joinable()) errors_.join();  // ffmpeg has exited: its end of the pipe is closed
+  while (!error_text_.empty() && error_text_.back() == '\n') error_text_.pop_back();
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !error_text_.empty()) {
+    remove_temporaries();
     throw std::runtime_error("ffmpeg failed to write '" + path_ + "' (exit status " +
-                             std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+                             std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
+                             (error_text_.empty() ? "" : ": " + error_text_) +
+                             "); existing files were left as they were");
+  }
+  if (replacement_) {
+    struct stat info {};
+    if (frames_ > 0 && (stat(ffmpeg_path_.c_str(), &info) != 0 || info.st_size == 0)) {
+      remove_temporaries();
+      throw std::runtime_error("ffmpeg wrote nothing to '" + path_ + "'");
+    }
+    replacement_->commit();
+    return;
+  }
+  // A PNG sequence: every frame's file must be there before any is renamed.
+  std::vector<detail::FileReplacement> files;
+  for (int k = 0; k < frames_; ++k) {
+    files.push_back(
+        detail::FileReplacement::adopt(frame_name(path_, k), frame_name(ffmpeg_path_, k)));
+  }
+  for (int k = 0; k < frames_; ++k) {
+    struct stat info {};
+    if (stat(files[k].temporary().c_str(), &info) != 0 || info.st_size == 0) {
+      remove_temporaries();
+      throw std::runtime_error("ffmpeg did not write frame " + std::to_string(k) + " of '" + path_ +
+                               "'");
+    }
+  }
+  for (detail::FileReplacement& file : files) file.commit();
 }
 
 }  // namespace jelly::viewer

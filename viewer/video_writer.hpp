@@ -5,7 +5,13 @@
 #include <sys/types.h>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
+#include <thread>
+
+namespace jelly::detail {
+class FileReplacement;
+}
 
 namespace jelly::viewer {
 
@@ -15,6 +21,9 @@ enum class VideoFormat { kMp4, kGif, kPngSequence };
 // .gif path, or a .png pattern with one %d conversion).
 VideoFormat video_format(const std::string& path, const std::string& field = "--output");
 
+// ffmpeg writes beside the path (out.partial-<pid>.mp4, frames/0000.partial-<pid>.png: it
+// chooses the format from the name) and close() renames what it wrote onto the path once ffmpeg
+// has finished without an error: a failed or abandoned video leaves existing files as they were.
 class VideoWriter {
  public:
   // Starts ffmpeg. Throws
@@ -28,17 +37,27 @@ class VideoWriter {
   // One frame of width x height RGB bytes, rows top to bottom. Throws std::runtime_error when
   // ffmpeg stopped.
   void write(const std::uint8_t* rgb);
-  // Waits for ffmpeg to finish the file; throws std::runtime_error when it failed.
+  // Waits for ffmpeg to finish the file and renames it onto the path; throws std::runtime_error
+  // when ffmpeg failed or the file could not be moved (nothing is renamed then).
   void close();
   int frames() const { return frames_; }
 
  private:
+  // The name of frame k of a PNG pattern.
+  static std::string frame_name(const std::string& pattern, int k);
+  // Removes what ffmpeg wrote under the temporary names.
+  void remove_temporaries();
+
   std::string path_;
+  std::string ffmpeg_path_;  // the temporary name (or pattern) ffmpeg writes
+  std::unique_ptr<detail::FileReplacement> replacement_;  // .mp4 and .gif
   VideoFormat format_;
   int width_, height_;
   int frames_ = 0;
   std::FILE* pipe_ = nullptr;
   pid_t pid_ = -1;
+  std::thread errors_;      // reads ffmpeg's stderr into error_text_ until ffmpeg exits
+  std::string error_text_;  // written by errors_ only until it is joined
 };
 
 }  // namespace jelly::viewer

@@ -1077,7 +1077,10 @@ std::unique_ptr<ViewerWindow> ViewerWindow::replay(const std::string& path,
   auto impl = std::make_unique<Impl>();
   impl->options = options;
   RecordingView probe(path);  // a bad file fails before a window opens
-  (void)probe;
+  const int frames = probe.recording().frames();
+  require(options.start_frame >= 0 && options.start_frame < frames, "--frame", options.start_frame,
+          "a recorded frame, 0 to " + std::to_string(frames - 1) + " (the recording holds " +
+              std::to_string(frames) + " frames)");
   impl->open("jelly view - " + path);
   impl->init_replay(path);
   return std::unique_ptr<ViewerWindow>(new ViewerWindow(std::move(impl)));

@@ -68,23 +68,29 @@ void write_attribute_raw(hid_t object, const std::string& name, hid_t file_type,
 // does not (a run killed mid-write can leave chunks the file's index names but never stored).
 // `dims` is shortened to the frames kept.
 template <typename T>
-void read_leading_frames(hid_t dataset, hid_t memory_type, std::vector<hsize_t>& dims,
-                         std::vector<T>& data) {
+void read_leading_frames(hid_t dataset, const std::string& name, hid_t memory_type,
+                         std::vector<hsize_t>& dims, std::vector<T>& data) {
   const hsize_t frame_values = dims[0] == 0 ? 0 : data.size() / dims[0];
   Handle file_space(H5Dget_space(dataset), "dataspace");
   std::vector<hsize_t> start(dims.size(), 0), count = dims;
   count[0] = 1;
   Handle memory_space(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr),
                       "frame dataspace");
+  const auto read_frame = [&](hsize_t frame) {
+    start[0] = frame;
+    return H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr,
+                               count.data(), nullptr) >= 0 &&
+           H5Dread(dataset, memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT,
+                   data.data() + frame * frame_values) >= 0;
+  };
   hsize_t frames = 0;
-  for (; frames < dims[0]; ++frames) {
-    start[0] = frames;
-    if (H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
-                            nullptr) < 0 ||
-        H5Dread(dataset, memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT,
-                data.data() + frames * frame_values) < 0) {
-      break;
-    }
+  while (frames < dims[0] && read_frame(frames)) ++frames;
+  // A killed run loses its last frames, never one before frames that read: an unreadable frame
+  // followed by a readable last frame is damage (a corrupt chunk), not a shorter run.
+  if (frames + 1 < dims[0] && read_frame(dims[0] - 1)) {
+    throw std::runtime_error("HDF5: frame " + std::to_string(frames) + " of " + name + " of " +
+                             std::to_string(dims[0]) +
+                             " does not read (a corrupt chunk) while later frames do");
   }
   H5Eclear2(H5E_DEFAULT);
   dims[0] = frames;
@@ -115,7 +121,7 @@ std::vector<T> read_all(hid_t parent, const std::string& name, hid_t memory_type
   if (count > 0 &&
       H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0) {
     if (frames != Frames::kLeadingReadable || dims.empty()) check(-1, "read " + name);
-    read_leading_frames(dataset.get(), memory_type, dims, data);
+    read_leading_frames(dataset.get(), name, memory_type, dims, data);
   }
   if (dims_out != nullptr) *dims_out = dims;
   return data;

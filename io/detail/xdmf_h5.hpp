@@ -15,7 +15,4 @@ namespace jelly {
 // is not a jelly recording.
 std::string update_xdmf(hid_t file, const std::string& h5_path, const XdmfOptions& options);
 
-// Writes text to path. Throws InputError naming the path if it cannot.
-void write_text_file(const std::string& path, const std::string& text);
-
 }  // namespace jelly

@@ -47,6 +47,14 @@ def fit_recording(recording: _Union[Recording, str, _os.PathLike],
     """
     if isinstance(recording, (str, _os.PathLike)):
         recording = read_recording(_os.fspath(recording))
+    if write_scene is not None:
+        # Checked before the fit, as jelly fit --write-scene does: never the file it reads.
+        target = _os.fspath(write_scene)
+        source = getattr(recording, "path", "")
+        if source and _os.path.exists(target) and _os.path.exists(source) \
+                and _os.path.samefile(target, source):
+            raise InputError(f"write_scene '{target}' is the recording '{source}' (the same "
+                             "file): the fitted scene would overwrite it; choose another name")
     chosen = FitOptions()
     if options is not None:
         for name in _FIT_KEYWORDS:

@@ -143,9 +143,18 @@ class Scene(_jelly._Scene):
         return Scene(self._source, (), self._name, self._base)
 
     def save(self, path: Union[str, os.PathLike]) -> None:
-        """Writes the full JSON (to_json()) to a file."""
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(self.to_json())
+        """Writes the full JSON (to_json()) to a file: beside it first, then renamed, so that a
+        failed write leaves an existing file as it was."""
+        path = os.fspath(path)
+        partial = f"{path}.partial-{os.getpid()}"
+        try:
+            with open(partial, "w", encoding="utf-8") as f:
+                f.write(self.to_json())
+            os.replace(partial, path)
+        except BaseException:
+            if os.path.exists(partial):
+                os.remove(partial)
+            raise
 
     @property
     def source_json(self) -> str:

@@ -2,17 +2,23 @@
 // lost file, no silent run, and the documented exit codes. Each test is one class of finding.
 #include <hdf5.h>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "cli/cli_support.hpp"
+#include "support/h5_damage.hpp"
 
 namespace jelly {
 namespace {
@@ -51,20 +57,7 @@ void set_attribute(const std::string& path, const std::string& object, const std
 
 void set_attribute(const std::string& path, const std::string& object, const std::string& name,
                    const std::string& value) {
-  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  const hid_t group = H5Oopen(file, object.c_str(), H5P_DEFAULT);
-  H5Adelete(group, name.c_str());
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  H5Tset_size(type, H5T_VARIABLE);
-  const hid_t space = H5Screate(H5S_SCALAR);
-  const hid_t attribute = H5Acreate2(group, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
-  const char* text = value.c_str();
-  H5Awrite(attribute, type, &text);
-  H5Aclose(attribute);
-  H5Sclose(space);
-  H5Tclose(type);
-  H5Oclose(group);
-  H5Fclose(file);
+  testing::set_string_attribute(path, object, name, value);
 }
 
 // ---- Crashes ----
@@ -162,13 +155,302 @@ TEST(DataLoss, FitWritesNoSceneOverAnExistingFile) {
   const std::string before = read_file(file);
   Result r = jelly("fit " + quoted(file) + " --write-scene " + quoted(file) + " --overwrite");
   EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err, HasSubstr("is the recording: it would be overwritten"));
+  EXPECT_THAT(r.err, HasSubstr("is the recording " + file + " (the same file)"));
   EXPECT_EQ(read_file(file), before);
   const std::string other = write_scene("{}");
   r = jelly("fit " + quoted(file) + " --write-scene " + quoted(other));
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, HasSubstr("exists (a file this run did not create): pass --overwrite"));
   EXPECT_EQ(read_file(other), "{}");
+}
+
+// Files of this run's test folder (and its subfolders) whose name has ".partial-".
+int partial_files() {
+  int count = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(test_dir().path())) {
+    if (entry.path().filename().string().find(".partial-") != std::string::npos) ++count;
+  }
+  return count;
+}
+
+// A unit cube as an OBJ surface (8 vertices, 12 triangles outward).
+std::string cube_obj() {
+  const std::string path = temp_path(".obj");
+  std::ofstream(path) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                         "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
+                         "f 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+  return path;
+}
+
+// Issue 44, item 8: with --overwrite, a write that fails (a full disk) exits 1 and leaves the
+// old file byte for byte; without the failure the file is replaced. Before, each of these opened
+// the old file for writing at once: the full disk left it truncated.
+TEST(DataLoss, AFailedMeshWriteLeavesTheOldFileAsItWas) {
+  const std::string surface = cube_obj();
+  const std::string out = temp_path(".msh");
+  std::ofstream(out) << "precious";
+  Result r = jelly("mesh " + quoted(surface) + " -o " + quoted(out) + " --size 0.2 --overwrite",
+                   kFullDisk);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("cannot write '" + out + "'"));
+  EXPECT_EQ(read_file(out), "precious");
+  EXPECT_EQ(partial_files(), 0);
+  r = jelly("mesh " + quoted(surface) + " -o " + quoted(out) + " --size 0.2 --overwrite");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(read_file(out), StartsWith("$MeshFormat"));
+}
+
+TEST(DataLoss, AFailedExportLeavesTheOldFilesAsTheyWere) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string folder = temp_path("");
+  std::filesystem::create_directory(folder);
+  const std::string frame = folder + "/frame_0000.obj";
+  std::ofstream(frame) << "precious";
+  Result r = jelly("export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --overwrite",
+                   kFullDisk);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(read_file(frame), "precious");
+  // No frame of the new sequence either: every frame is written before any is renamed.
+  EXPECT_FALSE(exists(folder + "/frame_0001.obj"));
+  const std::string pc2 = temp_path(".pc2");
+  const std::string rest = pc2.substr(0, pc2.size() - 4) + ".obj";
+  std::ofstream(pc2) << "precious cache";
+  std::ofstream(rest) << "precious surface";
+  r = jelly("export " + quoted(file) + " --pc2 " + quoted(pc2) + " --overwrite", kFullDisk);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(read_file(pc2), "precious cache");
+  EXPECT_EQ(read_file(rest), "precious surface");
+  EXPECT_EQ(partial_files(), 0);
+  r = jelly("export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --pc2 " +
+            quoted(pc2) + " --overwrite");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(read_file(frame), StartsWith("# jelly render surface"));
+  EXPECT_THAT(read_file(pc2), StartsWith("POINTCACHE2"));
+}
+
+// The scene of `jelly fit --write-scene` and the sidecar of `jelly xdmf` go through the same
+// replacement.
+TEST(DataLoss, AFailedSceneOrSidecarWriteLeavesTheOldFileAsItWas) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string sidecar = file.substr(0, file.size() - 3) + ".xdmf";
+  const std::string before = read_file(sidecar);
+  ASSERT_GT(before.size(), 1024u);
+  Result r = jelly("xdmf " + quoted(file) + " --overwrite", kFullDisk);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(read_file(sidecar), before);
+  EXPECT_EQ(partial_files(), 0);
+}
+
+// Issue 44, item 9: an output that is an input of the command, also through a hard or a
+// symbolic link, is refused (exit 2) naming both, and the input is untouched.
+TEST(DataLoss, AnOutputThatIsTheInputIsRefusedNamingBoth) {
+  const std::string surface = cube_obj();
+  const std::string msh = temp_path(".msh");
+  ASSERT_EQ(link(surface.c_str(), msh.c_str()), 0);
+  const std::string before = read_file(surface);
+  Result r = jelly("mesh " + quoted(surface) + " -o " + quoted(msh) + " --size 0.2 --overwrite");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("-o " + msh + " is the input surface " + surface));
+  EXPECT_EQ(read_file(surface), before);
+
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string recording = read_file(file);
+  const std::string folder = temp_path("");
+  std::filesystem::create_directory(folder);
+  ASSERT_EQ(link(file.c_str(), (folder + "/frame_0000.obj").c_str()), 0);
+  const std::string pc2 = temp_path(".pc2");
+  std::filesystem::create_symlink(file, pc2);
+  const std::string scene = temp_path(".json");
+  std::filesystem::create_symlink(file, scene);
+  const std::string sidecar = file.substr(0, file.size() - 3) + ".xdmf";
+  std::remove(sidecar.c_str());
+  ASSERT_EQ(link(file.c_str(), sidecar.c_str()), 0);
+  for (const std::string& command :
+       {"export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --overwrite",
+        "export " + quoted(file) + " --pc2 " + quoted(pc2) + " --overwrite",
+        "fit " + quoted(file) + " --write-scene " + quoted(scene) + " --overwrite",
+        "xdmf " + quoted(file) + " --overwrite"}) {
+    r = jelly(command);
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_THAT(r.err, HasSubstr(file)) << command;
+    EXPECT_THAT(r.err, HasSubstr("(the same file)")) << command;
+  }
+  EXPECT_EQ(read_file(file), recording);
+}
+
+// Issue 44, item 9: `jelly run -o` naming a mesh file the scene reads (here a tet mesh body's,
+// through a hard link) is refused naming both; before, --overwrite replaced it.
+TEST(DataLoss, ARunNeverWritesOverAMeshFileOfItsScene) {
+  const std::string msh = temp_path(".msh");
+  Result r = jelly("mesh " + quoted(cube_obj()) + " -o " + quoted(msh) + " --size 0.5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string before = read_file(msh);
+  const std::string scene_file =
+      write_scene(R"({"bodies": [{"kind": "tetmesh", "file": ")" + msh +
+                  R"("}], "integrator": {"name": "rk4"}, "duration": 0.01})");
+  const std::string out = temp_path(".h5");
+  ASSERT_EQ(link(msh.c_str(), out.c_str()), 0);
+  r = jelly("run " + quoted(scene_file) + " -q --overwrite -o " + quoted(out));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("-o " + out + " is the mesh file " + msh));
+  EXPECT_EQ(read_file(msh), before);
+}
+
+// Issue 44, item 9: while another program writes a file (it holds the write lock every jelly
+// writer takes: here this test does, as a first run would), a second jelly told to --overwrite
+// it is refused, exit 2, and leaves it alone; once the lock is released it may replace it.
+TEST(DataLoss, ASecondWriterIsRefusedWhileTheFileIsBeingWritten) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string msh = temp_path(".msh");
+  std::ofstream(msh) << "precious";
+  const std::string before = read_file(file);
+  std::vector<int> locks;
+  for (const std::string& path : {file, msh}) {
+    const int fd = open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    ASSERT_GE(fd, 0);
+    struct flock lock {};
+    lock.l_type = F_WRLCK;
+    lock.l_whence = SEEK_SET;
+    ASSERT_EQ(fcntl(fd, F_OFD_SETLK, &lock), 0);
+    locks.push_back(fd);
+  }
+  const std::string run =
+      "run " + kSmallSlope + " --duration 0.1 -q --overwrite -o " + quoted(file);
+  const std::string mesh = "mesh " + quoted(cube_obj()) + " -o " + quoted(msh) + " --overwrite";
+  for (const std::string& command : {run, mesh}) {
+    const Result r = jelly(command);
+    EXPECT_EQ(r.code, 2) << command << ": " << r.err;
+    EXPECT_THAT(r.err, HasSubstr("is being written by another run")) << command;
+  }
+  EXPECT_EQ(read_file(file), before);
+  EXPECT_EQ(read_file(msh), "precious");
+  EXPECT_EQ(partial_files(), 0);
+  for (const int fd : locks) close(fd);
+  EXPECT_EQ(jelly(run).code, 0);
+  EXPECT_EQ(jelly(mesh).code, 0);
+}
+
+// ---- Damaged files ----
+
+// Writes `value` over every element of the double dataset `name`, in place.
+void fill_dataset(const std::string& path, const std::string& name, double value) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t dataset = H5Dopen2(file, name.c_str(), H5P_DEFAULT);
+  const hid_t space = H5Dget_space(dataset);
+  const std::vector<double> values(static_cast<size_t>(H5Sget_simple_extent_npoints(space)), value);
+  H5Dwrite(dataset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
+  H5Sclose(space);
+  H5Dclose(dataset);
+  H5Fclose(file);
+}
+
+// Issue 44, item 10a: one validation of a recording for every reader. A corrupt compressed
+// chunk of a finished run and masses that are not finite exit 2 naming the file and the dataset,
+// in info, export, xdmf and fit alike (before: export wrote 0 frames and exited 0, info
+// described 7 frames, xdmf rewrote the sidecar).
+TEST(DamagedFiles, EveryReaderRefusesADamagedRecordingNamingTheDataset) {
+  for (const std::string damage : {"chunk", "mass"}) {
+    const std::string file = temp_path(".h5");
+    record(file);
+    std::string dataset;
+    if (damage == "chunk") {
+      dataset = "/particles/jelly/position/value";
+      ASSERT_EQ(testing::corrupt_chunk(file, dataset, 0), 0);
+    } else {
+      dataset = "its model is invalid: mass";
+      fill_dataset(file, "/particles/jelly/mass", std::nan(""));
+    }
+    for (const std::string& command :
+         {"info " + quoted(file), "export " + quoted(file) + " --pc2 " + quoted(temp_path(".pc2")),
+          "xdmf " + quoted(file) + " --overwrite", "fit " + quoted(file)}) {
+      const Result r = jelly(command);
+      EXPECT_EQ(r.code, 2) << damage << ": " << command << ": " << r.err;
+      EXPECT_THAT(r.err, HasSubstr("'" + file + "' is not a readable jelly recording"))
+          << damage << ": " << command;
+      EXPECT_THAT(r.err, HasSubstr(dataset)) << damage << ": " << command;
+    }
+  }
+}
+
+// A checkpoint whose positions are not finite is a damaged file (exit 2), not a divergence of
+// the continued run (exit 3, before).
+TEST(DamagedFiles, ARestartFromACheckpointThatIsNotFiniteExitsTwo) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  fill_dataset(file, "/checkpoint/position", std::nan(""));
+  const Result r = jelly("run " + kSmallSlope + " --duration 0.2 -q --restart " + quoted(file) +
+                         " -o " + quoted(temp_path(".h5")));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("/checkpoint/position of particle 0 is nan"));
+  EXPECT_THAT(r.err, HasSubstr(file));
+}
+
+// Issue 44, item 10: values that were taken silently. `render --start NaN` meant "the
+// recording's start", `view --frame` past the recording showed its last frame, and an empty
+// `--screenshot` name meant "no screenshot" (and exit 0). Each is refused before a window or an
+// offscreen context is opened.
+TEST(Silent, NaNTimesFramesOutOfRangeAndEmptyNamesAreRefused) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  for (const auto& [command, field] : std::vector<std::pair<std::string, std::string>>{
+           {"render " + quoted(file) + " -o " + quoted(temp_path(".mp4")) + " --start nan",
+            "--start"},
+           {"render " + quoted(file) + " -o " + quoted(temp_path(".mp4")) + " --end nan", "--end"},
+           {"view " + quoted(file) + " --frame 1000 --frames 0 --screenshot " +
+                quoted(temp_path(".png")),
+            "--frame = 1000 is invalid: a recorded frame, 0 to "},
+           {"view " + quoted(file) + " --frames 0 --screenshot ''", "--screenshot"}}) {
+    const Result r = jelly(command);
+    EXPECT_EQ(r.code, 2) << command << ": " << r.err;
+    // A jelly built without the viewer (CI's sanitizer build) refuses render and view as such.
+    if (r.err.find("this jelly was built without") != std::string::npos) continue;
+    EXPECT_THAT(r.err, HasSubstr(field)) << command;
+  }
+}
+
+// Issue 44, item 10: a fit whose residuals cannot be evaluated (ks 1e9 makes every rk4 replay
+// of the drop diverge: Ceres' cost -1) exits 3 and writes no scene; before, it exited 0 with
+// "cost -1, NOT converged", or crashed (SIGSEGV) computing the covariance.
+TEST(Silent, AFitWhoseResidualsCannotBeEvaluatedExitsThree) {
+  const std::string file = temp_path(".h5");
+  Result r = jelly("run " + quoted(scene("drop_coulomb.json")) +
+                   " --set cube.n=3 --set 'cube.origin=[-1,0.3,-1]' --set integrator.name='\"rk4\"'"
+                   " --set output_interval=0.01 --duration 0.5 -q -o " +
+                   quoted(file));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string fitted = temp_path(".json");
+  for (const std::string covariance : {"", " --no-covariance"}) {
+    r = jelly("fit " + quoted(file) + " --initial ks=1e9 --write-scene " + quoted(fitted) +
+              covariance);
+    EXPECT_EQ(r.code, 3) << covariance << ": " << r.err;
+    EXPECT_THAT(r.err, HasSubstr("error: the fit's residuals could not be evaluated"));
+    EXPECT_FALSE(exists(fitted));
+  }
+}
+
+// Issue 44, item 11: a size so small or a position so far out that the particles' distances are
+// lost in double precision is named by the body (and its size fields), not as
+// springs[0].rest_length, a field no scene has.
+TEST(Silent, ABodyWhoseParticlesCollapseIsNamed) {
+  for (const std::string set : {"cube.edge_length=1e-300", "cube.origin=[1e308,0,0]"}) {
+    const Result r = jelly("run " + kSmallSlope + " --set '" + set + "' --duration 0.01 -q");
+    EXPECT_EQ(r.code, 2) << set;
+    EXPECT_THAT(r.err, HasSubstr("error: bodies[0] (the cube \"jelly\") = particles ")) << set;
+    EXPECT_THAT(r.err, HasSubstr("edge_length")) << set;
+    EXPECT_THAT(r.err, Not(HasSubstr("rest_length"))) << set;
+  }
+}
+
+// Issue 44, item 11: an unknown command is named, with the commands there are (CLI11 said "A
+// subcommand is required").
+TEST(Silent, AnUnknownCommandIsNamed) {
+  const Result r = jelly("simulate " + kSmallSlope);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("error: unknown command 'simulate'; the commands are run, "));
 }
 
 // ---- Hangs ----

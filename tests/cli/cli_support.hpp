@@ -45,12 +45,13 @@ inline std::string temp_path(const std::string& suffix) {
   return pattern + suffix;
 }
 
-// Runs `jelly ARGS` with stdout and stderr captured (neither is a terminal).
-inline Result jelly(const std::string& args) {
+// Runs `jelly ARGS` with stdout and stderr captured (neither is a terminal); `shell` is run
+// before it in the same shell (kFullDisk).
+inline Result jelly(const std::string& args, const std::string& shell = "") {
   const std::string out = temp_path(".out");
   const std::string err = temp_path(".err");
   const std::string command =
-      std::string("'") + JELLY_CLI + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+      shell + "'" + JELLY_CLI + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
   const int status = std::system(command.c_str());
   Result r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -60,6 +61,11 @@ inline Result jelly(const std::string& args) {
   std::remove(err.c_str());
   return r;
 }
+
+// As a disk that is full: every write of a file past its first 1,024 bytes fails (the file size
+// limit, with its signal ignored, makes write() fail with EFBIG, for jelly and the programs it
+// starts, such as ffmpeg).
+inline const std::string kFullDisk = "trap '' XFSZ; ulimit -f 2; ";
 
 inline std::string scene(const std::string& name) {
   return std::string(JELLY_SCENES_DIR) + "/" + name;

@@ -149,5 +149,28 @@ TEST(OutputFiles, AnUnfinishedReplacementLeavesTheOldFile) {
   EXPECT_EQ(partial_files(dir.file("")), 0);
 }
 
+// Issue 44, item 9: a second recorder told to overwrite a file that a first one still writes
+// is refused (the first holds a write lock on it), whether the first writes the file in place or
+// replaces an older one; once the first has finished, the second may replace it.
+TEST(OutputFiles, ASecondWriterIsRefusedWhileTheFirstWrites) {
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  RecorderOptions overwrite;
+  overwrite.overwrite = true;
+  for (const bool first_replaces : {false, true}) {
+    Simulator sim = testing::slope_sim();
+    {
+      H5Recorder first(path, sim, first_replaces ? overwrite : RecorderOptions{});
+      sim.add_observer(first);
+      sim.run_until(0.01);
+      EXPECT_THAT(creation_error(path, overwrite),
+                  HasSubstr("'" + path + "' is being written by another run"));
+      sim.remove_observer(first);
+    }
+    EXPECT_EQ(creation_error(path, overwrite), "");
+  }
+  EXPECT_EQ(partial_files(dir.path().string()), 0);
+}
+
 }  // namespace
 }  // namespace jelly

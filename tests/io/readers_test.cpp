@@ -7,6 +7,7 @@
 #include <hdf5.h>
 #include <sys/stat.h>
 
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -18,6 +19,7 @@
 #include <jelly/io/recording.hpp>
 
 #include "io/io_support.hpp"
+#include "support/h5_damage.hpp"
 
 namespace jelly {
 namespace {
@@ -106,36 +108,14 @@ TEST_F(DamagedRecording, TheUndamagedFileReads) {
 }
 
 // A run killed while HDF5 wrote can leave its last chunk named in the index but not stored:
-// here the last stored chunk of the positions is overwritten so that it does not inflate. The
-// reader keeps the frames before it (the same values as undamaged) instead of refusing the file.
+// here the last stored chunk of the positions is overwritten so that it does not inflate, and
+// the status is a killed run's ("running"). The reader keeps the frames before it (the same
+// values as undamaged) instead of refusing the file.
 TEST_F(DamagedRecording, AnUnreadableLastChunkKeepsTheFramesBeforeIt) {
   const Recording whole = read_recording(path_);
-  haddr_t address = 0;
-  hsize_t size = 0, first_frame = 0;
-  {
-    const hid_t file = H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-    const hid_t dataset = H5Dopen2(file, "/particles/jelly/position/value", H5P_DEFAULT);
-    const hid_t space = H5Dget_space(dataset);
-    hsize_t chunks = 0;
-    ASSERT_GE(H5Dget_num_chunks(dataset, space, &chunks), 0);
-    ASSERT_GE(chunks, 2u);
-    hsize_t offset[3] = {0, 0, 0};
-    unsigned mask = 0;
-    ASSERT_GE(H5Dget_chunk_info(dataset, space, chunks - 1, offset, &mask, &address, &size), 0);
-    first_frame = offset[0];
-    H5Sclose(space);
-    H5Dclose(dataset);
-    H5Fclose(file);
-  }
-  ASSERT_GT(first_frame, 0u);
-  {
-    std::FILE* f = std::fopen(path_.c_str(), "r+b");
-    ASSERT_NE(f, nullptr);
-    ASSERT_EQ(std::fseek(f, static_cast<long>(address), SEEK_SET), 0);
-    const std::vector<unsigned char> garbage(size, 0xA5);
-    ASSERT_EQ(std::fwrite(garbage.data(), 1, size, f), size);
-    std::fclose(f);
-  }
+  testing::set_string_attribute(path_, "/parameters", "run_status", "running");
+  const long first_frame = testing::corrupt_chunk(path_, "/particles/jelly/position/value", -1);
+  ASSERT_GT(first_frame, 0);
   const Recording damaged = read_recording(path_);
   ASSERT_EQ(damaged.frames(), static_cast<int>(first_frame));
   for (int f = 0; f < damaged.frames(); ++f) {
@@ -143,6 +123,38 @@ TEST_F(DamagedRecording, AnUnreadableLastChunkKeepsTheFramesBeforeIt) {
     EXPECT_EQ(damaged.velocity[f], whole.velocity[f]) << "frame " << f;
     EXPECT_EQ(damaged.time[f], whole.time[f]) << "frame " << f;
   }
+}
+
+// Issue 44, item 10a: a corrupt chunk is damage, an InputError naming the file and the dataset,
+// when the run finished (it stored every frame) or when frames after it read (a killed run loses
+// only its last ones). Before, a corrupt first chunk read as a recording of 0 frames.
+TEST_F(DamagedRecording, ACorruptChunkOfAFinishedRunIsAnError) {
+  ASSERT_EQ(testing::corrupt_chunk(path_, "/particles/jelly/position/value", 0), 0);
+  const std::string error = recording_error(path_);
+  EXPECT_THAT(error, HasSubstr("'" + path_ + "' is not a readable jelly recording"));
+  EXPECT_THAT(error, HasSubstr("/particles/jelly/position/value"));
+}
+
+TEST_F(DamagedRecording, ACorruptChunkBeforeReadableFramesIsAnError) {
+  testing::set_string_attribute(path_, "/parameters", "run_status", "running");
+  ASSERT_EQ(testing::corrupt_chunk(path_, "/particles/jelly/velocity/value", 0), 0);
+  const std::string error = recording_error(path_);
+  EXPECT_THAT(error, HasSubstr("frame 0 of /particles/jelly/velocity/value of 26 does not read"));
+  EXPECT_THAT(error, HasSubstr(path_));
+}
+
+// A checkpoint whose state is not finite is a damaged file (InputError, exit 2), not a run that
+// diverges when continued (exit 3).
+TEST_F(DamagedRecording, ACheckpointThatIsNotFiniteIsAnError) {
+  std::vector<double> x(81, 0.5);
+  x[4] = std::nan("");
+  replace<double>(path_, "/checkpoint/position", {27, 3}, x);
+  EXPECT_THAT(checkpoint_error(path_),
+              HasSubstr("'" + path_ +
+                        "' has an invalid /checkpoint: /checkpoint/position of "
+                        "particle 1 is nan (not finite: the file is damaged)"));
+  testing::set_string_attribute(path_, "/parameters", "run_status", "diverged");
+  EXPECT_THAT(checkpoint_error(path_), HasSubstr("its run diverged"));
 }
 
 TEST_F(DamagedRecording, SpringArraysOfDifferentLengths) {

@@ -61,3 +61,17 @@ def test_fit_options_are_validated(scenes, tmp_path):
     assert [p.name for p in result.parameters] == ["ks.structural", "kd"]
     assert result.iterations <= 3 and result.windows == 2
     assert jelly.parse_free_parameters("ks.shear,kd") == ["ks.shear", "kd"]
+
+
+def test_write_scene_is_never_the_recording(scenes, tmp_path):
+    """Issue 44, item 9: as jelly fit --write-scene, write_scene naming the recording (also
+    through a link) is refused before the fit and the recording is untouched (before: the fitted
+    scene was written over it)."""
+    make_recording(scenes, tmp_path / "run.h5")
+    before = (tmp_path / "run.h5").read_bytes()
+    (tmp_path / "link.json").symlink_to(tmp_path / "run.h5")
+    for recording in (tmp_path / "run.h5", jelly.read_recording(str(tmp_path / "run.h5"))):
+        for target in (tmp_path / "run.h5", tmp_path / "link.json"):
+            with pytest.raises(jelly.InputError, match=r"is the recording .*run\.h5.*same file"):
+                jelly.fit_recording(recording, write_scene=target, max_iterations=1)
+    assert (tmp_path / "run.h5").read_bytes() == before

@@ -282,5 +282,41 @@ TEST(RenderCli, WritesVideosFfprobeConfirms) {
   }
 }
 
+// Issue 44, item 8: `render --overwrite` on a full disk (every write past 2 KiB fails, for
+// ffmpeg too) exits 1 and leaves the old video or frames byte for byte. Before, ffmpeg truncated
+// the old file at once.
+TEST(RenderCli, AFailedWriteLeavesTheOldVideoAsItWas) {
+  TempDir dir;
+  const std::string jelly = std::string("'") + JELLY_CLI + "' ";
+  testing::Result r = testing::run(
+      jelly + "run '" JELLY_SCENES_DIR "/seed_slope.json' --duration 0.25 --quiet -o '" +
+          dir.file("r.h5") + "'",
+      dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::filesystem::create_directory(dir.file("frames"));
+  for (const std::string old : {"v.mp4", "v.gif", "frames/000.png"}) {
+    std::ofstream(dir.file(old)) << "precious";
+    const std::string out = old == "frames/000.png" ? "frames/%03d.png" : old;
+    r = testing::run("trap '' XFSZ; ulimit -f 4; " + jelly + "render '" + dir.file("r.h5") +
+                         "' -o '" + dir.file(out) +
+                         "' --width 160 --height 120 --samples 1 --overwrite",
+                     dir);
+    if (r.err.find("no offscreen") != std::string::npos) GTEST_SKIP() << r.err;
+    EXPECT_EQ(r.code, 1) << old << ": " << r.err;
+    EXPECT_EQ(testing::read_text(dir.file(old)), "precious") << old;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(dir.path())) {
+      EXPECT_EQ(entry.path().filename().string().find(".partial-"), std::string::npos)
+          << entry.path();
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("frames/001.png")));
+  // Without the full disk the old file is replaced.
+  r = testing::run(jelly + "render '" + dir.file("r.h5") + "' -o '" + dir.file("v.mp4") +
+                       "' --width 160 --height 120 --samples 1 --end 0 --overwrite",
+                   dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(testing::read_text(dir.file("v.mp4")), "precious");
+}
+
 }  // namespace
 }  // namespace jelly

@@ -263,5 +263,24 @@ TEST(Window, ExitsZeroWhenClosed) {
   EXPECT_EQ(window->run(), 0);
 }
 
+// Issue 44, item 8: a screenshot that cannot be written (a full disk: every write past 2 KiB
+// fails) exits 1 and leaves the old image byte for byte. Before, stb_image_write truncated it,
+// ignored the failed write and the program exited 0.
+TEST(Window, AFailedScreenshotKeepsTheOldFile) {
+  TempDir dir;
+  std::ofstream(dir.file("s.png")) << "precious";
+  const testing::Result r = testing::run(
+      "trap '' XFSZ; ulimit -f 4; " + jelly() + "view '" + kSlope + "' --frames 0 --screenshot '" +
+          dir.file("s.png") + "' --overwrite --width 320 --height 240",
+      dir);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot write '" + dir.file("s.png") + "'"), std::string::npos) << r.err;
+  EXPECT_EQ(testing::read_text(dir.file("s.png")), "precious");
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    EXPECT_EQ(entry.path().filename().string().find(".partial-"), std::string::npos)
+        << entry.path();
+  }
+}
+
 }  // namespace
 }  // namespace jelly
