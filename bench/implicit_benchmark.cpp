@@ -300,7 +300,7 @@ BENCHMARK(BM_Assemble)->Apply(sizes)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CholmodAnalyze)->Apply(orderings)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CholmodFactorize)->Apply(orderings)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CholmodSolve)->Args({10, 1400, 1})->Args({20, 1400, 1})->Unit(benchmark::kMillisecond);
-// LDLT at n = 20 is left out: one factorization took 57 s of CPU time (docs/implicit.md).
+// LDLT at n = 20 is left out: one factorization takes minutes (docs/implicit.md).
 void small_sizes(benchmark::internal::Benchmark* b) {
   b->Args({10, 1400});
   b->Args({10, 100000});

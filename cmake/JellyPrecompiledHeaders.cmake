@@ -1,8 +1,8 @@
 # Precompiled headers: the third-party headers nearly every source includes (Eigen, nlohmann's
 # JSON through <jelly/core/json.hpp>, the standard library; GoogleTest in the test programs,
-# pybind11 in the Python module) are parsed once per target instead of once per source. A build
-# of build/ from nothing on 2 cores went from 722 to 581 s with them; most of what is left is
-# template instantiation and code generation (docs/fuzzing.md, "In CI": CI builds from nothing).
+# pybind11 in the Python module) are parsed once per target instead of once per source, which
+# shortens a build from nothing (what CI does; docs/fuzzing.md, "In CI"); most of what is left is
+# template instantiation and code generation.
 #
 # They hide a source's missing include of one of these headers: no test catches that while they
 # are on. Configure with -DJELLY_PRECOMPILE_HEADERS=OFF to check (a build without them).
@@ -32,10 +32,10 @@ set(JELLY_PCH_HEADERS
 # before the common ones (pybind11's, which include Python.h before any standard header).
 #
 # In a unity build (JELLY_UNITY_BUILD) a target of at most two units (16 sources) gets none: its
-# header would cost more than it saves (a build from nothing on 2 cores, 2026-11-27: the small
-# test programs, the CLI, jelly-bench's library, the viewer's core and the Python module each
-# compiled 3 to 17 s faster without; the library's 12 units 65 s and the solver tests' 3 units
-# 46 s slower). Call it after the target's sources are all added.
+# header would cost more than it saves (measured from nothing on 2 cores: the small test
+# programs, the CLI, jelly-bench's library, the viewer's core and the Python module compiled
+# faster without; the library and the solver tests slower). Call it after the target's sources
+# are all added.
 function(jelly_precompile_headers target)
   if(NOT JELLY_PRECOMPILE_HEADERS)
     return()

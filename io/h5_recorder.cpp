@@ -109,7 +109,7 @@ struct Batch {
 // compressed chunk that the file on disk already points to: a killed run leaves intact chunks.
 // The frames of a block held in memory (each block waits in one of up to four batches: being
 // filled, two queued, one being written) are limited to this many bytes of particle data: a large
-// body is flushed in blocks of fewer frames than flush_every_frames (n = 40: 2 frames of 3 MB).
+// body is flushed in blocks of fewer frames than flush_every_frames.
 constexpr size_t kMaxBlockBytes = size_t{8} << 20;
 
 // Frames per block: flush_every_frames, or when frames of `frame_bytes` bytes would exceed

@@ -8,11 +8,9 @@ namespace jelly {
 
 double estimate_memory_bytes(std::int64_t particles, std::int64_t springs,
                              const std::string& integrator, bool recording) {
-  // Peak resident sizes measured with `jelly run` (Release, /usr/bin/time -f %M) on the seed
-  // slope: rk4 18 MB for n = 10, 26 MB for 20, 100 MB for 40, 297 MB for 60 (1,300 bytes per
-  // particle with its 15 springs); implicit_euler 24 / 87 / 265 / 616 / 1,200 MB for n = 10 / 20
-  // / 30 / 40 / 50 (8,200 bytes more per particle, the same with linear_solver "cg"); a recorder
-  // 220 MB more for n = 40 (its frame blocks and HDF5's buffers).
+  // The constants are fitted to the peak resident sizes of `jelly run` (Release, /usr/bin/time
+  // -f %M) on the seed slope at several sizes, per integrator and with a recorder: an estimate of
+  // the order of the peak, used to refuse runs that cannot fit, not a bound.
   const double n = static_cast<double>(particles);
   const double m = static_cast<double>(springs);
   double per_particle = 300;  // state, masses, work vectors of the integrator

@@ -36,8 +36,8 @@ using h5::member_names;
 
 constexpr long kLayoutVersion = 2;    // of /xdmf; a group of another version is rebuilt
 constexpr hsize_t kBlockFrames = 32;  // frames read and derived at a time, at most
-// ... and at most this many bytes of them (n = 40: 7 MB a frame, 2 frames at a time; before, 32
-// frames took 230 MB and were most of a recorded run's peak memory).
+// ... and at most this many bytes of them: a large body's blocks hold fewer frames, so that the
+// derived arrays never dominate a recorded run's peak memory.
 constexpr hsize_t kBlockBytes = hsize_t{16} << 20;
 
 // Frames per pass for frames of `frame_bytes` bytes: kBlockFrames, fewer for large frames, >= 1.

@@ -19,7 +19,7 @@ namespace jelly {
 
 struct XdmfOptions {
   // Strain of every spring at every frame (|xa - xb| / rest length - 1) as a cell array: float32
-  // [T][M], the largest part of /xdmf (with the seed cube about 28 KB a frame, compressed).
+  // [T][M], the largest part of /xdmf.
   bool strain = true;
   int compression_level = 1;  // deflate (with byte shuffle) of the derived arrays, 0 = off
 
