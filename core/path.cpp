@@ -1,5 +1,5 @@
-#include <jelly/core/path.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/core/path.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
-#include <jelly/geometry/box.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/box.hpp>
 
 #include <cmath>
 

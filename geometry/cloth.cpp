@@ -1,5 +1,5 @@
-#include <jelly/geometry/cloth.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/cloth.hpp>
 
 #include <algorithm>
 #include <cmath>

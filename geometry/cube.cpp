@@ -1,5 +1,5 @@
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/cube.hpp>
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
-#include <jelly/geometry/pose.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/pose.hpp>
 
 #include <cmath>
 #include <string>
