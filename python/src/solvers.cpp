@@ -466,11 +466,12 @@ void bind_solvers(py::module_& m) {
               contacts.append(py::make_tuple(c.particle, c.normal, c.friction));
             py::object model_values = py::none();
             if (s.model_values) {  // an edited model's values (Simulator's live edits)
-              const ModelValues& m = *s.model_values;
+              const ModelValues& values = *s.model_values;
               std::vector<std::string> paths;
-              for (const Path& p : m.pins.paths) paths.push_back(p.to_json().dump());
-              model_values = py::make_tuple(m.ks, m.kd, m.mass, m.gravity, m.pins.particles,
-                                            m.pins.anchors, m.pins.path, paths);
+              for (const Path& p : values.pins.paths) paths.push_back(p.to_json().dump());
+              model_values = py::make_tuple(values.ks, values.kd, values.mass, values.gravity,
+                                            values.pins.particles, values.pins.anchors,
+                                            values.pins.path, paths);
             }
             return py::make_tuple(s.state.t, s.state.x, s.state.v, contacts, s.contact_count,
                                   s.total_steps, s.next_output, s.integrator_state, model_values);
@@ -493,16 +494,16 @@ void bind_solvers(py::module_& m) {
             s.next_output = t[6].cast<Real>();
             s.integrator_state = t[7].cast<std::vector<Real>>();
             if (t.size() == 9 && !t[8].is_none()) {
-              const auto m = t[8].cast<py::tuple>();
+              const auto saved = t[8].cast<py::tuple>();
               ModelValues v;
-              v.ks = m[0].cast<std::vector<Real>>();
-              v.kd = m[1].cast<std::vector<Real>>();
-              v.mass = m[2].cast<VecX>();
-              v.gravity = m[3].cast<Vec3>();
-              v.pins.particles = m[4].cast<std::vector<int>>();
-              v.pins.anchors = m[5].cast<std::vector<Vec3>>();
-              v.pins.path = m[6].cast<std::vector<int>>();
-              for (const std::string& text : m[7].cast<std::vector<std::string>>())
+              v.ks = saved[0].cast<std::vector<Real>>();
+              v.kd = saved[1].cast<std::vector<Real>>();
+              v.mass = saved[2].cast<VecX>();
+              v.gravity = saved[3].cast<Vec3>();
+              v.pins.particles = saved[4].cast<std::vector<int>>();
+              v.pins.anchors = saved[5].cast<std::vector<Vec3>>();
+              v.pins.path = saved[6].cast<std::vector<int>>();
+              for (const std::string& text : saved[7].cast<std::vector<std::string>>())
                 v.pins.paths.push_back(Path::read(Json::parse(text), "snapshot pin path"));
               s.model_values = std::move(v);
             }
