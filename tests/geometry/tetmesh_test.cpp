@@ -16,6 +16,7 @@
 namespace jelly {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 using testing::input_error;
 using testing::TempDir;
@@ -137,6 +138,16 @@ TEST(Tetmesh, GmshFillsASphereAndTheMeshIsConsistent) {
   const TetMesh fine = tetrahedralize(sphere, 0.25, "--size");
   EXPECT_GT(fine.num_tets(), mesh.num_tets());
   EXPECT_NEAR(volume_of(fine), enclosed / 6, 0.05 * enclosed / 6);
+}
+
+// A size that would make Gmsh fill the surface with billions of tetrahedra is refused before
+// Gmsh starts, naming the size field, the estimate and the smallest size allowed.
+TEST(Tetmesh, ATinyElementSizeIsRefusedBeforeGmshStarts) {
+  const TriangleMesh sphere = sphere_mesh(1, 8, 16);
+  EXPECT_THAT(input_error([&] { tetrahedralize(sphere, 1e-4, "IN", "ball", "--size"); }),
+              AllOf(HasSubstr("--size = 0.0001"), HasSubstr("at most 1e+07 tetrahedra"),
+                    HasSubstr("the smallest size allowed is about 0.01")));
+  EXPECT_NO_THROW(tetrahedralize(sphere, 0.5, "IN", "ball", "--size"));
 }
 
 TEST(Tetmesh, MshAndTetgenFilesReadBack) {
