@@ -21,6 +21,17 @@ namespace jelly::python {
 
 namespace {
 
+// The State argument of Body.x / Body.v: a TypeError naming the type given otherwise (an array
+// of positions is a common mistake), not pybind11's "Unable to cast".
+const State& body_state_argument(const py::object& state, const char* method) {
+  if (!py::isinstance<State>(state)) {
+    throw py::type_error(std::string("Body.") + method + "(state): state must be a jelly.State " +
+                         "(sim.state, a snapshot's state), not " +
+                         py::str(py::type::of(state).attr("__name__")).cast<std::string>());
+  }
+  return state.cast<const State&>();
+}
+
 // The positions of a State, or an (N, 3) / (3N,) array of them, as the flat vector they are
 // in C++ (copied only for an array).
 VecX positions_of(const py::object& x, const std::string& field) {
@@ -428,7 +439,7 @@ void bind_core(py::module_& m) {
       .def(
           "x",
           [](const Body& b, py::object state) {
-            const State& s = state.cast<const State&>();
+            const State& s = body_state_argument(state, "x");
             require(b.end_particle() <= s.x.size() / 3, "state.num_particles", s.x.size() / 3,
                     "at least " + std::to_string(b.end_particle()) + " (body " + b.name + ")");
             return rows_view(s.x, b.first_particle, b.num_particles, state);
@@ -438,7 +449,7 @@ void bind_core(py::module_& m) {
       .def(
           "v",
           [](const Body& b, py::object state) {
-            const State& s = state.cast<const State&>();
+            const State& s = body_state_argument(state, "v");
             require(b.end_particle() <= s.v.size() / 3, "state.num_particles", s.v.size() / 3,
                     "at least " + std::to_string(b.end_particle()) + " (body " + b.name + ")");
             return rows_view(s.v, b.first_particle, b.num_particles, state);

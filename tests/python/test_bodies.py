@@ -259,3 +259,14 @@ def test_two_free_bodies_collide_with_momentum_kept():
     assert np.abs(sim.linear_momentum()).max() < 1e-12
     assert np.abs(sim.angular_momentum() - L0).max() < 1e-12 * np.abs(L0).max()
     assert a.v(sim.state)[:, 0].mean() < 0 < b.v(sim.state)[:, 0].mean()  # bounced back
+
+
+def test_body_x_and_v_of_something_not_a_state_is_a_type_error_naming_it(scenes):
+    """An array of positions instead of a State: a TypeError naming what was given and what is
+    expected, not pybind11's "Unable to cast"."""
+    sim = jelly.Simulator(jelly.load_scene(scenes / "seed_slope.json", {"cube.n": 3}))
+    body = sim.model.bodies[0]
+    for method in (body.x, body.v):
+        with pytest.raises(TypeError, match=r"must be a jelly\.State .*not ndarray"):
+            method(np.zeros((27, 3)))
+    assert body.x(sim.state).shape == (27, 3)
