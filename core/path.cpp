@@ -1,4 +1,3 @@
-#include <jelly/core/json.hpp>
 #include <jelly/core/path.hpp>
 
 #include <algorithm>
@@ -6,6 +5,7 @@
 #include <string>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 

@@ -1,10 +1,10 @@
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/body_spec.hpp>
 
 #include <algorithm>
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/geometry/body_kinds.hpp>
 
 namespace jelly {

@@ -1,9 +1,9 @@
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/cube.hpp>
 
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 

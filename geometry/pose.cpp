@@ -1,10 +1,10 @@
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/pose.hpp>
 
 #include <cmath>
 #include <string>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 

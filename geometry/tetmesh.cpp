@@ -1,5 +1,4 @@
 #include <jelly/geometry/tetmesh.hpp>
-#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -7,6 +6,7 @@
 #include <cstdint>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/geometry/detail/mesh_file.hpp>
 #include <jelly/geometry/tet_mesh_io.hpp>
 

@@ -1,5 +1,4 @@
 #include <jelly/geometry/voxelized.hpp>
-#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -8,6 +7,7 @@
 #include <deque>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/geometry/winding_number.hpp>
 
 namespace jelly {

@@ -1,10 +1,10 @@
 #include <jelly/io/detail/scene_override.hpp>
-#include <jelly/core/json.hpp>
 
 #include <cctype>
 #include <vector>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/scene.hpp>
 

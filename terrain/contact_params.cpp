@@ -1,9 +1,9 @@
 #include <jelly/terrain/contact_params.hpp>
-#include <jelly/core/json.hpp>
 
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 

@@ -1,10 +1,10 @@
 #include <jelly/terrain/elevator.hpp>
-#include <jelly/core/json.hpp>
 
 #include <cmath>
 #include <limits>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 

@@ -1,10 +1,10 @@
 #include <jelly/terrain/mesh_obstacle.hpp>
-#include <jelly/core/json.hpp>
 
 #include <atomic>
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/geometry/detail/mesh_file.hpp>
 #include <jelly/geometry/mesh_io.hpp>
 

@@ -1,7 +1,7 @@
 #include <jelly/terrain/terrain_kinds.hpp>
-#include <jelly/core/json.hpp>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/mesh_obstacle.hpp>
 #include <jelly/terrain/obstacle.hpp>

@@ -1,5 +1,4 @@
 #include <jelly/io/detail/json_parse.hpp>
-#include <jelly/core/json.hpp>
 
 #include <sys/stat.h>
 
@@ -12,6 +11,7 @@
 
 #include <jelly/core/detail/input_file.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly::detail {
 

@@ -1,5 +1,4 @@
 #include <jelly/solvers/arkode/arkode_options.hpp>
-#include <jelly/core/json.hpp>
 
 #include <cmath>
 
@@ -7,6 +6,7 @@
 #include <arkode/arkode_butcher_erk.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 

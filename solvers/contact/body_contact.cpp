@@ -1,11 +1,11 @@
 #include <jelly/solvers/contact/body_contact.hpp>
-#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 

@@ -1,9 +1,9 @@
 #include <jelly/solvers/integrators/implicit_euler_options.hpp>
-#include <jelly/core/json.hpp>
 
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 

@@ -1,5 +1,4 @@
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/core/json.hpp>
 
 #include <algorithm>
 #include <functional>
@@ -8,6 +7,7 @@
 #include <utility>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 #include <jelly/solvers/arkode/arkode_dirk.hpp>
 #include <jelly/solvers/arkode/arkode_erk.hpp>
 #include <jelly/solvers/integrators/explicit_euler.hpp>

@@ -1,7 +1,7 @@
 #include <jelly/solvers/integrators/xpbd_options.hpp>
-#include <jelly/core/json.hpp>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
 
 namespace jelly {
 
