@@ -39,21 +39,35 @@ Simulator::~Simulator() = default;
 Simulator::Simulator(Simulator&&) noexcept = default;
 Simulator& Simulator::operator=(Simulator&&) noexcept = default;
 
-void Simulator::add_terrain(std::unique_ptr<Terrain> terrain) {
+void Simulator::check_terrain(const Terrain* terrain, size_t index) const {
   require(terrain != nullptr, "terrain", "null", "a terrain");
-  if (terrain->contact().model == ContactModel::kSeedFramework &&
+  if (terrain_contact_model(*terrain).acts_in_evaluation() &&
       !integrator_->supports_in_evaluation_contact()) {
-    throw InputError("terrains[" + std::to_string(terrains_.size()) + "].contact.model",
-                     "\"seed_framework\"", in_evaluation_contact_requirement(integrator_->name()));
+    throw InputError("terrains[" + std::to_string(index) + "].contact.model", "\"seed_framework\"",
+                     in_evaluation_contact_requirement(integrator_->name()));
   }
+}
+
+void Simulator::check_terrain_index(int index) const {
+  require(index >= 0 && index < static_cast<int>(terrains_.size()), "terrain index", index,
+          "an index in [0, " + std::to_string(terrains_.size()) + ")");
+}
+
+void Simulator::add_terrain(std::unique_ptr<Terrain> terrain) {
+  check_terrain(terrain.get(), terrains_.size());
   terrains_.push_back(std::move(terrain));
 }
 
 void Simulator::remove_terrain(int index) {
-  require(index >= 0 && index < static_cast<int>(terrains_.size()), "terrain index", index,
-          "an index in [0, " + std::to_string(terrains_.size()) + ")");
+  check_terrain_index(index);
   terrains_.erase(terrains_.begin() + index);
   // Seed contacts name no terrain; the implicit solve's active set is rebuilt each step.
+}
+
+void Simulator::replace_terrain(int index, std::unique_ptr<Terrain> terrain) {
+  check_terrain_index(index);
+  check_terrain(terrain.get(), static_cast<size_t>(index));
+  terrains_[static_cast<size_t>(index)] = std::move(terrain);
 }
 
 ForceHandle Simulator::add_force(std::shared_ptr<Force> force) {
@@ -114,7 +128,7 @@ void Simulator::set_particle_mass(int body, Real particle_mass) {
 void Simulator::set_integrator(std::unique_ptr<Integrator> integrator) {
   require(integrator != nullptr, "integrator", "null", "an integrator");
   for (std::size_t k = 0; k < terrains_.size(); ++k) {
-    if (terrains_[k]->contact().model == ContactModel::kSeedFramework &&
+    if (terrain_contact_model(*terrains_[k]).acts_in_evaluation() &&
         !integrator->supports_in_evaluation_contact()) {
       throw InputError("terrains[" + std::to_string(k) + "].contact.model", "\"seed_framework\"",
                        in_evaluation_contact_requirement(integrator->name()));

@@ -161,6 +161,12 @@ class Simulator {
   // Removes terrains()[index] (the active contacts are kept for the others). Throws InputError
   // for an index out of range.
   void remove_terrain(int index);
+  // Puts `terrain` in place of terrains()[index] (a terrain moved, reshaped or given another
+  // contact between steps; the others keep their indices). Contacts carried from the last step
+  // (implicit_euler's friction state) stay with the terrain at that index and are checked
+  // against the new one. Throws InputError as add_terrain and remove_terrain do; nothing
+  // changes then.
+  void replace_terrain(int index, std::unique_ptr<Terrain> terrain);
 
   // Forces of your own (core/force.hpp): evaluated at every force evaluation of every
   // integrator, after the model's own, until removed. Returns the handle remove_force() takes.
@@ -254,6 +260,9 @@ class Simulator {
   long force_evaluations() const { return force_evaluations_; }
 
  private:
+  // add_terrain's and remove_terrain's checks (InputError naming terrains[index]).
+  void check_terrain(const Terrain* terrain, size_t index) const;
+  void check_terrain_index(int index) const;
   void emit_frame();
   // After an edit of model_: the force loop's bands again, and the model validated.
   void model_changed();

@@ -542,6 +542,30 @@ void bind_solvers(py::module_& m) {
           py::arg("spec"),
           "Adds a terrain of any kind from its scene JSON (a dict or JSON text, see "
           "make_terrain).")
+      .def(
+          "replace_terrain",
+          [](Simulator& s, int index, const Plane& p) {
+            s.replace_terrain(index, std::make_unique<Plane>(p));
+          },
+          py::arg("index"), py::arg("terrain"),
+          "Puts a copy of a terrain in place of terrains[index] (moved, reshaped or with "
+          "another contact; the others keep their indices).")
+      .def(
+          "replace_terrain",
+          [](Simulator& s, int index, const Elevator& e) {
+            s.replace_terrain(index, std::make_unique<Elevator>(e));
+          },
+          py::arg("index"), py::arg("terrain"),
+          "Puts a copy of a terrain in place of terrains[index].")
+      .def(
+          "replace_terrain",
+          [](Simulator& s, int index, const py::object& spec) {
+            s.replace_terrain(index, terrain_from_spec(spec));
+          },
+          py::arg("index"), py::arg("spec"),
+          "Puts a terrain of any kind, from its scene JSON (a dict or JSON text), in place of "
+          "terrains[index]: an obstacle moved between steps is the same spec at its new "
+          "position.")
       .def("add_observer", py::overload_cast<Observer&>(&Simulator::add_observer),
            py::arg("observer"), py::keep_alive<1, 2>(),
            "Calls observer.on_frame at every output frame of run_until (and on_finish at its end).")

@@ -209,6 +209,28 @@ def test_a_terrain_added_from_its_spec_equals_the_scene_s():
         added.add_terrain(added.terrains[0])
 
 
+def test_an_obstacle_moved_between_steps_is_replaced_in_place():
+    # A sphere moved from far away to under the cube mid-run: the cube lands on it from then on,
+    # the floor (terrains[1]) keeps its index, and a bad index or spec changes nothing.
+    cube = {"kind": "cube", "name": "a", "n": 3, "edge_length": 1, "origin": [-0.5, 1.6, -0.5]}
+    far = {"kind": "sphere", "center": [20, 0, 0], "radius": 1}
+    floor = {"kind": "plane", "point": [0, -3, 0], "normal": [0, 1, 0]}
+    sim = jelly.Simulator(scene_of([cube], terrains=[far, floor]))
+    assert sim.run_until(0.1).ok
+    sim.replace_terrain(0, dict(far, center=[0.2, 0, 0]))
+    assert sim.terrains[0].pose(0)[0, 3] == pytest.approx(0.2)
+    assert sim.terrains[1].kind == "plane"
+    with pytest.raises(jelly.InputError, match=r"terrain index = 2 is invalid"):
+        sim.replace_terrain(2, far)
+    with pytest.raises(jelly.InputError, match=r"terrain\.radius = -1 is invalid"):
+        sim.replace_terrain(0, dict(far, radius=-1))
+    assert sim.terrains[0].pose(0)[0, 3] == pytest.approx(0.2)
+    assert sim.run_until(0.6).ok
+    free = jelly.Simulator(scene_of([cube], terrains=[far, floor]))
+    assert free.run_until(0.6).ok
+    assert sim.state.x[:, 1].min() > free.state.x[:, 1].min() + 0.1
+
+
 def test_a_model_of_several_bodies_from_a_scene_runs_in_a_simulator_built_in_code():
     scene = scene_of([
         {"kind": "cloth", "name": "sheet", "nu": 4, "nv": 4, "position": [0, 2, 0],

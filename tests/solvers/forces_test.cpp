@@ -238,6 +238,38 @@ TEST(LiveModel, AKsChangeMidRunEqualsAFreshRunWithThatKs) {
   }
 }
 
+// A terrain moved mid-run (replace_terrain) equals, bit for bit, a run restored at the move into
+// a simulator that had the terrain there from the start; the other terrains keep their indices.
+TEST(LiveModel, AMovedTerrainMidRunEqualsAFreshRunWithItThere) {
+  for (const char* name : {"rk4", "implicit_euler", "projective_dynamics", "xpbd"}) {
+    Simulator edited = deformed_cube(3, make_integrator(name), 1.0 / 120);
+    edited.add_terrain(std::make_unique<Plane>(Vec3(0, 1.6, 0), Vec3(0, 1, 0)));
+    edited.add_terrain(std::make_unique<Plane>(Vec3(-5, 0, 0), Vec3(1, 0, 0)));
+    edited.run_until(0.25);
+    const SimulatorSnapshot at_edit = edited.snapshot();
+    edited.replace_terrain(0, std::make_unique<Plane>(Vec3(0, 1.7, 0), Vec3(0, 1, 0)));
+    ASSERT_EQ(edited.terrains().size(), 2u);
+    EXPECT_EQ(edited.terrains()[0]->position(0).y(), 1.7) << name;
+    EXPECT_EQ(edited.terrains()[1]->position(0).x(), -5) << name;
+    edited.run_until(0.5);
+
+    Simulator fresh(edited.model(), at_edit.state, make_integrator(name), edited.options());
+    fresh.add_terrain(std::make_unique<Plane>(Vec3(0, 1.7, 0), Vec3(0, 1, 0)));
+    fresh.add_terrain(std::make_unique<Plane>(Vec3(-5, 0, 0), Vec3(1, 0, 0)));
+    fresh.restore(at_edit);
+    fresh.run_until(0.5);
+    EXPECT_EQ(edited.state().x, fresh.state().x) << name;
+    EXPECT_EQ(edited.state().v, fresh.state().v) << name;
+
+    // ... and differs from a run without the move (the floor rose into the falling cube).
+    Simulator unmoved = deformed_cube(3, make_integrator(name), 1.0 / 120);
+    unmoved.add_terrain(std::make_unique<Plane>(Vec3(0, 1.6, 0), Vec3(0, 1, 0)));
+    unmoved.add_terrain(std::make_unique<Plane>(Vec3(-5, 0, 0), Vec3(1, 0, 0)));
+    unmoved.run_until(0.5);
+    EXPECT_NE(edited.state().x, unmoved.state().x) << name;
+  }
+}
+
 TEST(LiveModel, InvalidEditsThrowNamingTheFieldAndChangeNothing) {
   Simulator sim = deformed_cube(3, make_integrator("rk4"));
   const Model before = sim.model();
@@ -264,6 +296,12 @@ TEST(LiveModel, InvalidEditsThrowNamingTheFieldAndChangeNothing) {
   expect_message([&] { sim.set_dt(-1); }, "integrator.dt = -1 is invalid");
   expect_message([&] { sim.set_pin_target(0, Vec3::Zero()); }, "pin particle = 0 is invalid");
   expect_message([&] { sim.remove_terrain(0); }, "terrain index = 0 is invalid");
+  expect_message(
+      [&] { sim.replace_terrain(0, std::make_unique<Plane>(Vec3::Zero(), Vec3(0, 1, 0))); },
+      "terrain index = 0 is invalid");
+  sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3(0, 1, 0)));
+  expect_message([&] { sim.replace_terrain(0, nullptr); }, "terrain = null is invalid");
+  EXPECT_EQ(sim.terrains().size(), 1u);
   EXPECT_EQ(sim.model().springs.ks, before.springs.ks);
   EXPECT_EQ(sim.model().mass, before.mass);
   EXPECT_EQ(sim.model().gravity, before.gravity);
