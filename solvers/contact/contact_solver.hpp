@@ -1,19 +1,22 @@
 #pragma once
-// Contact between particles and terrains, the same for every integrator (docs/contact.md):
-//  1. after each integrator step, resolve() applies each terrain's contact model to the new
-//     state: velocity impulses (restitution, friction) and, for coulomb, projection out of the
-//     surface and the tangential displacement that friction removed during the step (an
-//     implicit integrator may resolve the coulomb terrains inside its solve instead);
-//  2. during the next step, every force evaluation calls add_forces(), which applies the seed
-//     model's contact and friction forces to the particles that collided in step 1.
-// The seed_framework model instead acts inside every force evaluation (apply_in_evaluation(),
-// which the explicit integrators call through Dynamics::stage_acceleration()).
+// Contact between particles and terrains, the same for every integrator (docs/contact.md): each
+// terrain's contact model (solvers/contact/terrain_contact_model.hpp: coulomb, seed,
+// seed_framework) answers
+//  1. after each integrator step: resolve() applies each terrain's model to the new state
+//     (velocity impulses, projections); an integrator that held a model's contact inside its
+//     solve (coulomb in implicit_euler, xpbd, projective_dynamics) has resolve() skip it;
+//  2. during the next step, every force evaluation calls add_forces(), which applies the contact
+//     and friction forces of the contacts the models carried (the seed model's);
+//  3. inside every force evaluation, for the models that act there (seed_framework:
+//     apply_in_evaluation(), which the explicit integrators call through
+//     Dynamics::stage_acceleration()).
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
+#include <jelly/solvers/contact/terrain_contact_model.hpp>
 #include <jelly/terrain/terrain.hpp>
 
 namespace jelly {
@@ -22,17 +25,13 @@ using Terrains = std::vector<std::unique_ptr<Terrain>>;
 
 class ContactSolver {
  public:
-  // A particle the seed model flagged at the last resolve(): it gets the contact and friction
-  // forces during the next step.
-  struct SeedContact {
-    int particle;
-    Vec3 normal;
-    Real friction;
-  };
+  // A contact carried into the next step (the seed model's): it gets the contact and friction
+  // forces during that step.
+  using SeedContact = CarriedContact;
 
-  // Which terrains resolve() answers: all, or only those with the seed model (when the
-  // integrator resolved the coulomb ones inside its step).
-  enum class Scope { kAll, kSeedOnly };
+  // Which terrains resolve() answers: all, or only those whose model the integrator did not
+  // hold inside its step (TerrainContactModel::constrains_solves() false).
+  enum class Scope { kAll, kUnsolvedOnly };
 
   // Applies every terrain's contact response to `state` (time state.t) after a step of size h
   // from the state `before`, on up to `threads` threads (each particle's response is its own;
@@ -41,21 +40,18 @@ class ContactSolver {
                Real h, Scope scope = Scope::kAll, int threads = 1);
   // Adds contacts resolved elsewhere (inside an implicit step) to contact_count().
   void add_resolved(int count) { contact_count_ += count; }
-  // Seed model: for each particle that collided at the last resolve() and whose force f pushes
-  // into the surface, cancels the inward normal force N and adds the friction -mu N v_t.
+  // For each contact carried from the last resolve() whose force f pushes into the surface,
+  // cancels the inward normal force N and adds the friction -mu N v_t.
   void add_forces(const VecX& v, VecX& f) const;
   // add_forces for the particles in [begin, end) alone (each particle's terms in the same order).
   void add_forces(const VecX& v, VecX& f, int begin, int end) const;
 
-  // seed_framework, the course framework's collision handler inside a force evaluation at time t
-  // on that evaluation's own state (x, v) with its forces f (gravity, springs, dampers): for each
-  // particle within epsilon of a seed_framework terrain and moving towards it, v is reflected in
-  // place (as resolve() does for seed) and, if f then pushes it into the surface, the contact
-  // force -(f.n) n and the friction -mu N v_t (N = -(f.n)) are added to f. Terrains in order,
-  // each seeing the forces the ones before added.
+  // The models that act inside a force evaluation (seed_framework), at time t on that
+  // evaluation's own state (x, v) with its forces f (gravity, springs, dampers): terrains in
+  // order, each seeing the forces the ones before added (TerrainContactModel::apply_in_evaluation).
   static void apply_in_evaluation(const Model& model, const Terrains& terrains, Real t,
                                   const VecX& x, VecX& v, VecX& f);
-  // True when a terrain uses seed_framework.
+  // True when a terrain's model acts inside force evaluations.
   static bool has_in_evaluation_contact(const Terrains& terrains);
 
   // Particle-terrain contacts found by the last resolve() (seed_framework: the particles within

@@ -8,6 +8,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>
+#include <jelly/solvers/contact/terrain_contact_model.hpp>
 
 namespace jelly {
 
@@ -59,8 +60,9 @@ void write_block(Real* values, const BlockColumn& col, int k, const Mat3& b) {
     for (int r = 0; r < 3; ++r) values[col.start + q * col.stride + 3 * k + r] = b(r, q);
 }
 
+// Whether the terrain's contact model is a constraint of the solve (coulomb).
 bool uses_coulomb(const Terrain& terrain) {
-  return terrain.contact().model == ContactModel::kCoulomb;
+  return terrain_contact_model(terrain).constrains_solves();
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>
+#include <jelly/solvers/contact/terrain_contact_model.hpp>
 
 namespace jelly {
 
@@ -25,7 +26,7 @@ bool PositionContact::begin(const Model& model, const Terrains& terrains, const 
   terrains_ = &terrains;
   coulomb_.clear();
   for (int k = 0; k < static_cast<int>(terrains.size()); ++k)
-    if (terrains[k]->contact().model == ContactModel::kCoulomb) coulomb_.push_back(k);
+    if (terrain_contact_model(*terrains[k]).constrains_solves()) coulomb_.push_back(k);
   if (slot_.size() != static_cast<size_t>(model.num_particles()))
     slot_.assign(model.num_particles(), Slot{});
   if (keep_contacts && same_scene && !coulomb_.empty()) {

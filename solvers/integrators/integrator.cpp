@@ -48,7 +48,7 @@ void resolve_contact_after_step(const Integrator& integrator, ContactSolver& con
     contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kAll, threads);
     return;
   }
-  contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kSeedOnly, threads);
+  contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kUnsolvedOnly, threads);
   contacts.add_resolved(integrator.contacts_resolved());
 }
 

@@ -4,6 +4,8 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/terrain_contact_model.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
@@ -182,6 +184,41 @@ TEST(SeedContact, SeedCubeStaysOnTheSlope) {
   sim.add_observer(probe);
   ASSERT_TRUE(sim.run_until(2.0).ok());
   EXPECT_GT(deepest, -0.05);
+}
+
+// Every contact model named in the scene tables has its model in the registry, which answers
+// with that kind; the places each acts are the documented ones (docs/contact.md).
+TEST(ContactModels, EveryNamedModelIsRegisteredWithItsPlaces) {
+  for (const auto& entry : contact_models()) {
+    const TerrainContactModel& model = terrain_contact_model(entry.value);
+    EXPECT_EQ(model.kind(), entry.value) << entry.name;
+  }
+  EXPECT_TRUE(terrain_contact_model(ContactModel::kCoulomb).constrains_solves());
+  EXPECT_FALSE(terrain_contact_model(ContactModel::kCoulomb).acts_in_evaluation());
+  EXPECT_FALSE(terrain_contact_model(ContactModel::kSeed).constrains_solves());
+  EXPECT_FALSE(terrain_contact_model(ContactModel::kSeed).acts_in_evaluation());
+  EXPECT_TRUE(terrain_contact_model(ContactModel::kSeedFramework).acts_in_evaluation());
+}
+
+// The seed model carries its contacts into the next step: after a resolve() that reflected a
+// particle approaching the floor, the contact is listed with the terrain's friction.
+TEST(ContactModels, TheSeedModelCarriesItsContactsIntoTheNextStep) {
+  const Model model = testing::single_particle();  // at the origin
+  Terrains terrains;
+  ContactParams params;
+  params.model = ContactModel::kSeed;
+  params.friction = 0.3;
+  terrains.push_back(std::make_unique<Plane>(Vec3(0, -0.005, 0), Vec3::UnitY(), params));
+  const State before = rest_state(model);
+  State state = before;
+  state.v = Vec3(1, -2, 0);  // within epsilon (0.01 m) of the floor and approaching
+  ContactSolver contacts;
+  contacts.resolve(model, terrains, before, state, 1e-3);
+  ASSERT_EQ(contacts.seed_contacts().size(), 1u);
+  EXPECT_EQ(contacts.seed_contacts()[0].particle, 0);
+  EXPECT_EQ(contacts.seed_contacts()[0].friction, 0.3);
+  EXPECT_EQ(contacts.contact_count(), 1);
+  EXPECT_NEAR(state.v[1], 2 * params.restitution, 1e-15);  // reflected: -e u1 on a fixed plane
 }
 
 }  // namespace
