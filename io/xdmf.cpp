@@ -1197,6 +1197,8 @@ std::string write_paraview_state(const std::string& h5_path) {
         "SPEED_RANGE[1])\n"
      << "display.SetScalarBarVisibility(view, True)\n"
      << "simple.GetScalarBar(lut, view).Title = \"speed (m/s)\"\n"
+     << "simple.GetAnimationScene().UpdateAnimationUsingDataTimeSteps()\n"
+     << "simple.Render(view)  # the first render resets the camera: it is set after\n"
      << "if BOUNDS is not None:\n"
      << "    # The box's centre, seen from the front, right and above, at the distance where its\n"
      << "    # bounding sphere fills the 30-degree view angle.\n"
@@ -1211,8 +1213,7 @@ std::string write_paraview_state(const std::string& h5_path) {
      << "    view.CameraViewUp = [0.0, 1.0, 0.0]\n"
      << "    view.CameraViewAngle = 30.0\n"
      << "    view.CenterOfRotation = centre\n"
-     << "simple.GetAnimationScene().UpdateAnimationUsingDataTimeSteps()\n"
-     << "simple.Render(view)\n";
+     << "    simple.Render(view)\n";
   detail::replace_file(state, py.str());
   return state;
 }

@@ -422,6 +422,8 @@ def check_state(state, xdmf, rec):
         f"the box centre at {distance:.3g} m (radius {radius:.3g} m)")
     for proxy in list(simple.GetSources().values()):
         simple.Delete(proxy)
+    # A render view still open when sys.exit() runs makes the X server report GLXBadContext.
+    simple.Delete(view)
 
 
 def main():
