@@ -68,7 +68,7 @@ std::vector<ExportTerrain> export_terrains(const Recording& recording) {
 namespace {
 
 // The terrain's mesh placed at `pose`: world coordinates, normals rotated along.
-ObjObject placed(const ExportTerrain& terrain, const Eigen::Isometry3d& pose) {
+ObjObject placed_terrain(const ExportTerrain& terrain, const Eigen::Isometry3d& pose) {
   ObjObject o = terrain.mesh;
   for (Vec3& v : o.vertices) v = pose * v;
   for (Vec3& n : o.normals) n = (pose.linear() * n).normalized();
@@ -101,7 +101,8 @@ int export_obj_sequence(const Recording& recording, const std::string& dir) {
       std::snprintf(suffix, sizeof suffix, "_%04d", k);
       files.emplace_back(
           (std::filesystem::path(dir) / (stem + (terrain.moves ? suffix : "") + ".obj")).string());
-      files.back().write(obj_text({placed(terrain, terrain.poses[static_cast<size_t>(k)])}));
+      files.back().write(
+          obj_text({placed_terrain(terrain, terrain.poses[static_cast<size_t>(k)])}));
     }
   }
   for (detail::FileReplacement& file : files) file.commit();

@@ -395,5 +395,33 @@ TEST(ExportGltf, CliWritesAndRefuses) {
   EXPECT_EQ(r.code, 2);
 }
 
+// `jelly xdmf --state` writes the sidecar and the ParaView state beside the recording, refuses to
+// replace them without --overwrite (exit 2, the old files as they were), and replaces both with
+// it.
+TEST(XdmfState, CliWritesRefusesAndOverwrites) {
+  TempDir dir;
+  record_scene(dir);  // without a sidecar
+  const std::string xdmf = std::string("'") + JELLY_CLI + "' xdmf '" + dir.file("r.h5") + "'";
+  testing::Result r = testing::run(xdmf + " --state", dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("r.paraview.py"), std::string::npos) << r.out;
+  const std::string state = testing::read_text(dir.file("r.paraview.py"));
+  EXPECT_NE(state.find("SIDECAR = \"r.xdmf\""), std::string::npos) << state;
+  EXPECT_NE(state.find("SPEED_RANGE = [0, "), std::string::npos) << state;
+  { std::ofstream(dir.file("r.paraview.py")) << "old"; }
+  r = testing::run(xdmf + " --state", dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
+  EXPECT_EQ(testing::read_text(dir.file("r.paraview.py")), "old");
+  std::filesystem::remove(dir.file("r.xdmf"));  // the state alone is refused too
+  r = testing::run(xdmf + " --state", dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("r.paraview.py"), std::string::npos) << r.err;
+  EXPECT_EQ(testing::read_text(dir.file("r.paraview.py")), "old");
+  r = testing::run(xdmf + " --state --overwrite", dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(testing::read_text(dir.file("r.paraview.py")), state);
+}
+
 }  // namespace
 }  // namespace jelly
