@@ -106,7 +106,8 @@ int main(int argc, char** argv) {
       "Write the XDMF sidecar (FILE.xdmf) that opens a recording in ParaView: for a killed run, "
       "or again for a recording made by an older jelly");
   xdmf->add_option("file", xdmf_args.recording, "HDF5 file")->required()->check(kNonEmpty);
-  xdmf->add_flag("--overwrite", xdmf_args.overwrite, "Replace an existing sidecar");
+  xdmf->add_flag("--overwrite", xdmf_args.overwrite,
+                 "Replace an existing sidecar (and with --state, an existing state file)");
   xdmf->add_flag("--no-strain", xdmf_args.no_strain,
                  "No strain cell array (the largest part of what the sidecar adds to the file)");
   xdmf->add_flag(
