@@ -31,6 +31,7 @@ struct XdmfArgs {
   std::string recording;   // HDF5 file written by `jelly run -o` (or a killed run's)
   bool overwrite = false;  // --overwrite: replace an existing sidecar
   bool no_strain = false;  // --no-strain: no strain cell array (XdmfOptions::strain = false)
+  bool state = false;      // --state: also a ParaView state beside it (write_paraview_state)
 };
 // jelly xdmf FILE.h5: (re)writes the recording's XDMF sidecar for ParaView.
 int xdmf_command(const XdmfArgs& args);
@@ -86,9 +87,10 @@ struct ExportArgs {
   std::string recording;
   std::string obj_sequence;  // folder of one OBJ per frame
   std::string pc2;           // PC2 file (+ the rest surface as .obj beside it)
+  std::string gltf;          // glTF 2.0 binary (.glb), animated
   bool overwrite = false;    // replace existing files
 };
-// jelly export FILE.h5 --obj-sequence DIR | --pc2 out.pc2.
+// jelly export FILE.h5 --obj-sequence DIR | --pc2 out.pc2 | --gltf out.glb.
 int export_command(const ExportArgs& args);
 
 struct MeshArgs {

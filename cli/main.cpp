@@ -106,9 +106,14 @@ int main(int argc, char** argv) {
       "Write the XDMF sidecar (FILE.xdmf) that opens a recording in ParaView: for a killed run, "
       "or again for a recording made by an older jelly");
   xdmf->add_option("file", xdmf_args.recording, "HDF5 file")->required()->check(kNonEmpty);
-  xdmf->add_flag("--overwrite", xdmf_args.overwrite, "Replace an existing sidecar");
+  xdmf->add_flag("--overwrite", xdmf_args.overwrite,
+                 "Replace an existing sidecar (and with --state, an existing state file)");
   xdmf->add_flag("--no-strain", xdmf_args.no_strain,
                  "No strain cell array (the largest part of what the sidecar adds to the file)");
+  xdmf->add_flag(
+      "--state", xdmf_args.state,
+      "Also write FILE.paraview.py beside it: a ParaView state (File > Load State) that "
+      "colours by speed over the range of all frames and frames the bodies over the run");
 
   FitArgs fit_args;
   CLI::App* fit = app.add_subcommand(
@@ -209,13 +214,20 @@ int main(int argc, char** argv) {
 
   ExportArgs export_args;
   CLI::App* export_cmd = app.add_subcommand(
-      "export", "Export a recording's surfaces for Blender, Houdini, ParaView: OBJ per frame, PC2");
+      "export",
+      "Export a recording's surfaces and terrains for Blender, Houdini, ParaView, game engines: "
+      "OBJ per frame, PC2, glTF");
   export_cmd->add_option("recording", export_args.recording, "HDF5 file from `jelly run -o`")
       ->required();
   export_cmd->add_option("--obj-sequence", export_args.obj_sequence,
-                         "Folder for frame_0000.obj, frame_0001.obj, ...");
+                         "Folder for frame_0000.obj, frame_0001.obj, ... (with normals) and the "
+                         "terrains beside them (terrain_<name>.obj, per frame when they move)");
   export_cmd->add_option("--pc2", export_args.pc2,
                          "PC2 point cache (the rest surface goes beside it as .obj)");
+  export_cmd->add_option(
+      "--gltf", export_args.gltf,
+      "glTF 2.0 binary (.glb): the bodies with normals, colours and their "
+      "animation as morph targets, the terrains and obstacles with their motion");
   export_cmd->add_flag("--overwrite", export_args.overwrite,
                        "Replace existing files (an existing file is an error otherwise)");
 

@@ -152,8 +152,18 @@ int render_command(const RenderArgs& args) {
 }
 
 int export_command(const ExportArgs& args) {
-  if (args.obj_sequence.empty() && args.pc2.empty())
-    throw InputError("jelly export", args.recording, "--obj-sequence DIR and/or --pc2 FILE.pc2");
+  if (args.obj_sequence.empty() && args.pc2.empty() && args.gltf.empty())
+    throw InputError("jelly export", args.recording,
+                     "one or more of --obj-sequence DIR, --pc2 FILE.pc2, --gltf FILE.glb");
+  if (!args.gltf.empty()) {
+    if (std::filesystem::path(args.gltf).extension() != ".glb")
+      throw InputError("--gltf", args.gltf, "a path ending in .glb (binary glTF 2.0)");
+    std::error_code error;
+    if (std::filesystem::is_directory(args.gltf, error))
+      throw InputError("--gltf", args.gltf, "a file path (it is a folder)");
+    if (!viewer::gltf_available()) viewer::export_gltf(Recording{}, args.gltf);  // says why
+    check_new_file("--gltf", args.gltf, args.overwrite, args.recording);
+  }
   if (!args.obj_sequence.empty())
     check_new_file("--obj-sequence", args.obj_sequence + "/frame_0000.obj", args.overwrite,
                    args.recording);
@@ -173,6 +183,10 @@ int export_command(const ExportArgs& args) {
     const std::string rest = viewer::export_pc2(recording, args.pc2);
     std::printf("wrote %s (%d samples) and its rest surface %s\n", args.pc2.c_str(),
                 recording.frames(), rest.c_str());
+  }
+  if (!args.gltf.empty()) {
+    viewer::export_gltf(recording, args.gltf);
+    std::printf("wrote %s (%d frames)\n", args.gltf.c_str(), recording.frames());
   }
   return kExitOk;
 }

@@ -5,6 +5,7 @@
 
 #include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/viewer/scene_builder.hpp>
 
 namespace jelly::viewer {
 
@@ -30,10 +31,51 @@ std::vector<ObjObject> surface_objects(const std::vector<BodySurface>& surfaces,
     o.triangles = s.triangles;
     o.vertices.reserve(static_cast<size_t>(s.num_vertices()));
     for (int v = 0; v < s.num_vertices(); ++v) o.vertices.push_back(s.vertex(x, v));
+    vertex_normals(o.vertices, o.triangles, o.normals);
     objects.push_back(std::move(o));
   }
   return objects;
 }
+
+std::vector<ExportTerrain> export_terrains(const Recording& recording) {
+  const Terrains terrains = recording_terrains(recording);
+  std::vector<ExportTerrain> out;
+  if (terrains.empty()) return out;
+  Vec3 lo, hi;
+  if (recording.position.empty())
+    bounds_of(recording.model.rest_position, lo, hi);
+  else
+    bounds_of(recording.position, lo, hi);
+  const bool any = lo.x() <= hi.x();
+  const Vec3 centre = any ? Vec3(0.5 * (lo + hi)) : Vec3::Zero();
+  const Real extent = 0.6 * (any ? (hi - lo).norm() : 0.0) + 1.0;
+  const std::vector<Real> times = recording.time.empty() ? std::vector<Real>{0.0} : recording.time;
+  for (size_t i = 0; i < terrains.size(); ++i) {
+    const Terrain& terrain = *terrains[i];
+    const TriangleMesh mesh = terrain_mesh(terrain, centre, extent);
+    ExportTerrain e;
+    e.mesh = crease_normals(std::to_string(i) + "_" + std::string(terrain.kind()), mesh.vertices,
+                            mesh.triangles);
+    for (Real t : times) {
+      e.poses.push_back(terrain_pose(terrain, t));
+      e.moves = e.moves || !e.poses.back().isApprox(e.poses.front(), 1e-12);
+    }
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+namespace {
+
+// The terrain's mesh placed at `pose`: world coordinates, normals rotated along.
+ObjObject placed_terrain(const ExportTerrain& terrain, const Eigen::Isometry3d& pose) {
+  ObjObject o = terrain.mesh;
+  for (Vec3& v : o.vertices) v = pose * v;
+  for (Vec3& n : o.normals) n = (pose.linear() * n).normalized();
+  return o;
+}
+
+}  // namespace
 
 int export_obj_sequence(const Recording& recording, const std::string& dir) {
   const std::vector<BodySurface> surfaces = surfaces_of(recording);
@@ -51,6 +93,18 @@ int export_obj_sequence(const Recording& recording, const std::string& dir) {
     files.emplace_back((std::filesystem::path(dir) / name).string());
     files.back().write(obj_text(surface_objects(surfaces, recording.position[k])));
   }
+  for (const ExportTerrain& terrain : export_terrains(recording)) {
+    const std::string stem = "terrain_" + terrain.mesh.name;
+    const int count = terrain.moves ? static_cast<int>(terrain.poses.size()) : 1;
+    for (int k = 0; k < count; ++k) {
+      char suffix[32];
+      std::snprintf(suffix, sizeof suffix, "_%04d", k);
+      files.emplace_back(
+          (std::filesystem::path(dir) / (stem + (terrain.moves ? suffix : "") + ".obj")).string());
+      files.back().write(
+          obj_text({placed_terrain(terrain, terrain.poses[static_cast<size_t>(k)])}));
+    }
+  }
   for (detail::FileReplacement& file : files) file.commit();
   return recording.frames();
 }
@@ -65,9 +119,12 @@ std::string export_pc2(const Recording& recording, const std::string& pc2_path) 
   // One object (the bodies as its groups): Blender's importer then makes one mesh of every
   // vertex in the cache's order.
   // Both files are written beside their paths; the rest surface is renamed after the cache.
+  // Without normals: a tool keeps imported normals as they are while the cache moves the
+  // vertices (Blender's custom normals), so they would be the rest pose's in every frame.
+  std::vector<ObjObject> rest_objects = surface_objects(surfaces, recording.model.rest_position);
+  for (ObjObject& o : rest_objects) o.normals.clear();
   detail::FileReplacement rest(obj_path);
-  rest.write(obj_text(surface_objects(surfaces, recording.model.rest_position),
-                      std::filesystem::path(pc2_path).stem().string()));
+  rest.write(obj_text(rest_objects, std::filesystem::path(pc2_path).stem().string()));
   Pc2Writer pc2(pc2_path, points, 0, 1);
   std::vector<double> xyz(static_cast<size_t>(3 * points));
   for (int k = 0; k < recording.frames(); ++k) {

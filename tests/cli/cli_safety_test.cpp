@@ -222,11 +222,18 @@ TEST(DataLoss, AFailedExportLeavesTheOldFilesAsTheyWere) {
   EXPECT_EQ(read_file(pc2), "precious cache");
   EXPECT_EQ(read_file(rest), "precious surface");
   EXPECT_EQ(partial_files(), 0);
+  const std::string glb = temp_path(".glb");
+  std::ofstream(glb) << "precious scene";
+  r = jelly("export " + quoted(file) + " --gltf " + quoted(glb) + " --overwrite", kFullDisk);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(read_file(glb), "precious scene");
+  EXPECT_EQ(partial_files(), 0);
   r = jelly("export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --pc2 " +
-            quoted(pc2) + " --overwrite");
+            quoted(pc2) + " --gltf " + quoted(glb) + " --overwrite");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(read_file(frame), StartsWith("# jelly render surface"));
   EXPECT_THAT(read_file(pc2), StartsWith("POINTCACHE2"));
+  EXPECT_THAT(read_file(glb), StartsWith("glTF"));
 }
 
 // The scene of `jelly fit --write-scene` and the sidecar of `jelly xdmf` go through the same
@@ -265,12 +272,15 @@ TEST(DataLoss, AnOutputThatIsTheInputIsRefusedNamingBoth) {
   std::filesystem::create_symlink(file, pc2);
   const std::string scene = temp_path(".json");
   std::filesystem::create_symlink(file, scene);
+  const std::string glb = temp_path(".glb");
+  ASSERT_EQ(link(file.c_str(), glb.c_str()), 0);
   const std::string sidecar = file.substr(0, file.size() - 3) + ".xdmf";
   std::remove(sidecar.c_str());
   ASSERT_EQ(link(file.c_str(), sidecar.c_str()), 0);
   for (const std::string& command :
        {"export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --overwrite",
         "export " + quoted(file) + " --pc2 " + quoted(pc2) + " --overwrite",
+        "export " + quoted(file) + " --gltf " + quoted(glb) + " --overwrite",
         "fit " + quoted(file) + " --write-scene " + quoted(scene) + " --overwrite",
         "xdmf " + quoted(file) + " --overwrite"}) {
     r = jelly(command);
