@@ -8,6 +8,7 @@
 
 #include <jelly/io/recording.hpp>
 #include <jelly/viewer/camera.hpp>
+#include <jelly/viewer/framing.hpp>
 #include <jelly/viewer/scene_builder.hpp>
 
 namespace jelly::viewer {
@@ -54,10 +55,5 @@ class RecordingView {
   std::unique_ptr<SceneBuilder> builder_;
   Vec3 lo_, hi_;
 };
-
-// The camera that frames particles in [lo, hi] and the ground below their centre (the first
-// terrain surface straight down), from the viewer's default direction.
-Camera framing_camera(const Vec3& lo, const Vec3& hi, const Terrains& terrains, Real t,
-                      float aspect);
 
 }  // namespace jelly::viewer
