@@ -410,5 +410,20 @@ TEST(Window, RecordKeyTakesPanelChangesAndF12WritesAScreenshot) {
   EXPECT_NE(r.err.find("gravity"), std::string::npos) << r.err;
 }
 
+// bear_in_bowl live from the default camera: after 1 s the bears are seen in the bowl, not
+// hidden by its wall (issue 40, item 4).
+TEST(Window, BearsInTheBowlAreSeenLive) {
+  TempDir dir;
+  const testing::Result r =
+      testing::run(jelly() +
+                       "view '" JELLY_SCENES_DIR
+                       "/bear_in_bowl.json' --frames 60 --hide-panel --samples 1 "
+                       "--width 320 --height 180 --screenshot '" +
+                       dir.file("s.png") + "'",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(testing::bear_fraction(viewer::read_png(dir.file("s.png")).rgb), 0.01);
+}
+
 }  // namespace
 }  // namespace jelly
