@@ -103,7 +103,7 @@ void add_sight_points(const VecX& x, const Terrains& terrains, Real t, int count
 }
 
 Camera framing_camera(const Vec3& lo, const Vec3& hi, const Terrains& terrains, Real t,
-                      float aspect, const std::vector<Sight>& sights) {
+                      float aspect, const std::vector<Sight>& sights, bool with_ground) {
   Vec3 a = lo, b = hi;
   const Real ground = ground_below(0.5 * (lo + hi), terrains, t);
   Real below = ground;
@@ -115,7 +115,7 @@ Camera framing_camera(const Vec3& lo, const Vec3& hi, const Terrains& terrains, 
     const float s = occluders.first_hit(centre.cast<float>(), -Vec3f::UnitY(), reach);
     if (s < reach) below = std::max(below, centre.y() - static_cast<Real>(s));
   }
-  if (std::isfinite(below)) {
+  if (with_ground && std::isfinite(below)) {
     a.y() = std::min(a.y(), below);
     b.y() = std::max(b.y(), below);
   }

@@ -29,8 +29,9 @@ void add_sight_points(const VecX& x, const Terrains& terrains, Real t, int count
 // terrain surface straight down), from the viewer's default direction (yaw -20 degrees), at
 // the lowest pitch from 18 degrees up at which the terrains that are not ground planes hide at
 // most 5 % of the sights' points (the least hidden pitch when none does). Without sights or
-// obstacles: pitch 18.
+// obstacles: pitch 18. with_ground false: [lo, hi] alone (a camera that follows the bodies
+// keeps them large; the ground shows around them anyway).
 Camera framing_camera(const Vec3& lo, const Vec3& hi, const Terrains& terrains, Real t,
-                      float aspect, const std::vector<Sight>& sights = {});
+                      float aspect, const std::vector<Sight>& sights = {}, bool with_ground = true);
 
 }  // namespace jelly::viewer

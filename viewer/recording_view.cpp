@@ -103,7 +103,7 @@ RecordingView::Follow::Follow(const RecordingView& view, const std::vector<int>&
     sights.push_back(std::move(sight));
   }
   base_ = framing_camera(centre - 0.5 * extent, centre + 0.5 * extent, view.builder().terrains(),
-                         view.recording().time[static_cast<size_t>(first)], aspect, sights);
+                         view.recording().time[static_cast<size_t>(first)], aspect, sights, false);
   offset_ = base_.target - centre.cast<float>();
 }
 

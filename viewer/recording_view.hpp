@@ -38,7 +38,8 @@ class RecordingView {
   Camera default_camera(float aspect) const;
   // A camera that follows the bodies over `frames` (a video's): follow_camera(k) frames the
   // bodies at frame k at the size of their largest extent over `frames`, from the default
-  // direction; its target moves with the centre of their bounds, so they stay large.
+  // direction (not the ground below them: they fill more of the picture); its target moves with
+  // the centre of their bounds, so they stay large.
   class Follow {
    public:
     Follow(const RecordingView& view, const std::vector<int>& frames, float aspect);

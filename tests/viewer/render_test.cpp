@@ -282,7 +282,8 @@ TEST(RenderCli, KeepsTheBodiesColours) {
 
 // Without --camera, `jelly render` follows the bodies and keeps them large: the seed jelly,
 // 4 s down the slope, fills a good part of the picture at the end of the video (issue 40,
-// item 3: the camera framed the whole motion and the jelly filled under 5 %).
+// items 3 and 9: the camera framed the whole motion and the jelly filled under 5 %; framed
+// with the ground below its start, 5.6 %; now about 12 %).
 TEST(RenderCli, FollowsTheBodies) {
   TempDir dir;
   const std::string jelly = std::string("'") + JELLY_CLI + "' ";
@@ -300,7 +301,7 @@ TEST(RenderCli, FollowsTheBodies) {
     const viewer::Image image = viewer::read_png(dir.file(frame));
     long red = 0;
     for (size_t i = 0; i + 2 < image.rgb.size(); i += 3) red += testing::is_jelly(&image.rgb[i]);
-    EXPECT_GT(static_cast<double>(red) / (image.width * image.height), 0.05) << frame;
+    EXPECT_GT(static_cast<double>(red) / (image.width * image.height), 0.09) << frame;
   }
 }
 
