@@ -769,6 +769,11 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
       g.terrains[t].draw();
     }
   }
+  // The ground and the sky without multisampling: one coverage and depth sample per pixel for
+  // most of the picture (multisampled rasterization is most of llvmpipe's cost); their own
+  // edges meet at the faded horizon, and the bodies' edges over them stay smooth (their samples
+  // were written first).
+  glDisable(GL_MULTISAMPLE);
   if (!g.terrains.empty() || scene.floor) {
     const auto [x0, y0, x1, y1] = shadow_rect;
     if (shadows && x1 > x0 && y1 > y0) {
@@ -803,6 +808,7 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDepthMask(GL_TRUE);
   glDepthFunc(GL_LESS);
+  glEnable(GL_MULTISAMPLE);
 
   // Springs, read from the particle buffer as a texture.
   if (scene.show_springs && g.spring_vertices > 0) {
