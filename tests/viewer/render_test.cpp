@@ -234,6 +234,50 @@ TEST_F(Offscreen, ObstaclesAreDrawnWithoutTheGroundsGrid) {
   EXPECT_GT(grid, 0.01) << "the measure does not see the grid";
 }
 
+// An obstacle's shadow is whole wherever the bodies are: bear_in_bowl's bowl casts its shadow
+// on the floor with the bears 8 m away (issue 40, item 6: the shadow map covered the bodies
+// only, and the bowl's shadow ended along a straight line). Floor points just outside the rim
+// away from the light are in its shadow, points as far out across that direction are lit.
+TEST_F(Offscreen, AnObstaclesShadowIsWholeAwayFromTheBodies) {
+  const Scene scene = load_scene(JELLY_SCENES_DIR "/bear_in_bowl.json");
+  const Model model = make_model(scene);
+  Terrains terrains;
+  for (const auto& t : scene.terrains) terrains.push_back(t->make());
+  VecX x = model.rest_position;
+  for (Eigen::Index i = 0; i < x.size(); i += 3) x[i] += 8;
+  Vec3 lo, hi;
+  viewer::bounds_of(x, lo, hi);
+  const viewer::SceneBuilder builder(model, std::move(terrains), lo, hi);
+  const viewer::RenderScene view = builder.make_scene(x, 0);
+  viewer::Renderer renderer;
+  const Eigen::Vector3f light = renderer.options().light_direction;
+  const Eigen::Vector3f away = Eigen::Vector3f(-light.x(), 0, -light.z()).normalized();
+  const Eigen::Vector3f across(-away.z(), 0, away.x());
+  // Seen from the side the shadow falls on, so that those floor points are not behind the bowl.
+  viewer::Camera camera;
+  camera.yaw_degrees = std::atan2(away.x(), away.z()) * 180 / 3.14159265f;
+  camera.pitch_degrees = 50;
+  camera.distance = 10;
+  const int w = 400, h = 300;
+  const std::vector<std::uint8_t> rgb = draw(renderer, view, camera, w, h);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  const auto grey = [&](const Eigen::Vector3f& p) {
+    const Eigen::Vector2f q = *camera.project(p, w, h);
+    float sum = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int px = static_cast<int>(q.x()) + dx, py = static_cast<int>(q.y()) + dy;
+        const std::uint8_t* c = rgb.data() + 3 * (static_cast<size_t>(py) * w + px);
+        sum += (c[0] + c[1] + c[2]) / 3.0f;
+      }
+    return sum / 9;
+  };
+  const float radius = 1.85f;  // the rim is at 1.6 m, 1.6 m high
+  const float shadow = grey(radius * away);
+  const float lit = std::min(grey(radius * across), grey(-radius * across));
+  EXPECT_LT(shadow, 0.8f * lit) << "shadow " << shadow << ", lit " << lit;
+}
+
 // bear_in_bowl from the default camera, following the bodies: the bears are seen in the bowl at
 // 1, 2 and 4 s, not hidden by its wall (issue 40, item 4: frames 60, 120 and 240 showed an
 // empty bowl).
