@@ -64,6 +64,8 @@ struct ViewArgs {
   bool overwrite = false;  // replace an existing --screenshot file
   double speed = 1;
   int samples = 4;
+  bool record = false;           // live: record from the first frame (F9 / the Record button)
+  std::string record_dir = ".";  // where recordings and F12 screenshots are written
 };
 // jelly view SCENE.json | FILE.h5: the live window or the replay.
 int view_command(const ViewArgs& args);

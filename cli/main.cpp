@@ -183,6 +183,15 @@ int main(int argc, char** argv) {
   view->add_flag("--overwrite", view_args.overwrite, "Replace an existing --screenshot file");
   view->add_flag("--stats", view_args.stats,
                  "Print frames per second, render and simulation times at exit");
+  view->add_flag("--record", view_args.record,
+                 "Live: record the run from the start, as the Record button (F9) does, to "
+                 "jelly-<date>-<time>.h5 in --record-dir (replays and restarts like `jelly run "
+                 "-o`; never replaces a file)");
+  view->add_option("--record-dir", view_args.record_dir,
+                   "Folder of the recordings (Record button, F9, --record) and screenshots "
+                   "(F12)")
+      ->capture_default_str()
+      ->check(kNonEmpty);
 
   RenderArgs render_args;
   CLI::App* render = app.add_subcommand(

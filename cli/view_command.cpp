@@ -84,12 +84,22 @@ int view_command(const ViewArgs& args) {
   options.stats = args.stats;
   options.speed = args.speed;
   options.samples = args.samples;
+  options.record = args.record;
+  options.record_dir = args.record_dir;
+  {
+    std::error_code error;
+    if (!std::filesystem::is_directory(args.record_dir, error))
+      throw InputError("--record-dir", args.record_dir, "an existing folder");
+  }
   try {
     std::unique_ptr<viewer::ViewerWindow> window;
     if (is_recording(args.file)) {
       if (!args.sets.empty() || !args.integrator.empty() || !args.dt.empty())
         throw InputError("--set/--integrator/--dt", args.file,
                          "options of a live scene, not of a recording");
+      if (args.record)
+        throw InputError("--record", args.file,
+                         "an option of a live scene (a replay is a recording already)");
       window = viewer::ViewerWindow::replay(args.file, options);
     } else {
       const Scene scene = load_scene(args.file, overrides(args));
