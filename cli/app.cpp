@@ -1,6 +1,7 @@
-// jelly: simulate scenes (run), describe recordings (info), fit coefficients to a recording
-// (fit), list what a scene can name (list), watch scenes and recordings (view), render videos
-// (render), export surfaces for other tools (export), fill surfaces with tetrahedra (mesh).
+// jelly's commands on the command line: simulate scenes (run), describe recordings (info), fit
+// coefficients to a recording (fit), list what a scene can name (list), watch scenes and
+// recordings (view), render videos (render), export surfaces for other tools (export), fill
+// surfaces with tetrahedra (mesh).
 #include <charconv>
 #include <cstdio>
 #include <exception>
@@ -46,8 +47,9 @@ constexpr const char* kFooter =
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  using namespace jelly::cli;
+namespace jelly::cli {
+
+int run_jelly(int argc, char** argv) {
   prepare_output_library();
   CLI::App app{"jelly " JELLY_VERSION_STRING ": mass-spring soft-body simulation", "jelly"};
   app.footer(kFooter);
@@ -282,3 +284,5 @@ int main(int argc, char** argv) {
   }
   return kExitBadInput;  // unreachable: require_subcommand(1)
 }
+
+}  // namespace jelly::cli
