@@ -229,6 +229,49 @@ TEST(DataLoss, AFailedExportLeavesTheOldFilesAsTheyWere) {
   EXPECT_THAT(read_file(pc2), StartsWith("POINTCACHE2"));
 }
 
+// An OBJ sequence written over a longer one leaves no frame of the old one behind (issue 44):
+// with --overwrite the old frames past the new last are removed, and only files named as frames
+// are; without it any earlier frame (not only frame_0000) is refused.
+TEST(DataLoss, AnObjSequenceOverALongerOneLeavesNoOldFrame) {
+  const std::string file = temp_path(".h5");
+  record(file);  // 0.1 s: a few frames
+  const std::string folder = temp_path("");
+  std::filesystem::create_directory(folder);
+  std::ofstream(folder + "/frame_0030.obj") << "an earlier sequence";
+  Result r = jelly("export " + quoted(file) + " --obj-sequence " + quoted(folder));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr("frame_0030.obj exists"), HasSubstr("--overwrite")));
+  EXPECT_FALSE(exists(folder + "/frame_0000.obj"));
+
+  for (int k = 0; k < 40; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%04d.obj", k);
+    std::ofstream(folder + name) << "an earlier sequence";
+  }
+  // Not frames of a sequence: kept.
+  const std::vector<std::string> others = {"/frame_7.obj", "/frame_00001.obj", "/frame_0050.OBJ",
+                                           "/frame_0051.obj.txt", "/notes.txt"};
+  for (const std::string& name : others) std::ofstream(folder + name) << "keep";
+  std::filesystem::create_directory(folder + "/frame_0060.obj");
+  r = jelly("export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --overwrite");
+  ASSERT_EQ(r.code, 0) << r.err;
+  int frames = 0;
+  ASSERT_EQ(std::sscanf(r.out.c_str(), "wrote %d OBJ files", &frames), 1) << r.out;
+  ASSERT_GT(frames, 1);
+  ASSERT_LT(frames, 40);
+  for (int k = 0; k < 40; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%04d.obj", k);
+    if (k < frames) {
+      EXPECT_THAT(read_file(folder + name), StartsWith("# jelly render surface")) << name;
+    } else {
+      EXPECT_FALSE(exists(folder + name)) << name << " of the earlier sequence was left";
+    }
+  }
+  for (const std::string& name : others) EXPECT_EQ(read_file(folder + name), "keep") << name;
+  EXPECT_TRUE(std::filesystem::is_directory(folder + "/frame_0060.obj"));
+}
+
 // The scene of `jelly fit --write-scene` and the sidecar of `jelly xdmf` go through the same
 // replacement.
 TEST(DataLoss, AFailedSceneOrSidecarWriteLeavesTheOldFileAsItWas) {
