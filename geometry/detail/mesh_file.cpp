@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -43,6 +44,31 @@ void require_mesh_file(const std::string& path, const std::string& field,
   require(!ec && bytes <= kMaxMeshFileBytes, field, value,
           "a mesh file of at most 1 GiB (this one has " + std::to_string(bytes) + " bytes)");
   require(static_cast<bool>(std::ifstream(path)), field, value, "a readable file");
+}
+
+void require_text_mesh(const std::string& path, const std::string& field, const std::string& value,
+                       const std::string& format) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (format == "STL") {
+    // A binary STL file (which may begin with "solid" too) has exactly 84 + 50 n bytes.
+    if (text.compare(0, 5, "solid") != 0) return;
+    if (text.size() >= 84) {
+      std::uint32_t n = 0;
+      for (int k = 3; k >= 0; --k) n = n << 8 | static_cast<unsigned char>(text[80 + k]);
+      if (text.size() == 84 + 50 * static_cast<std::uint64_t>(n)) return;
+    }
+  }
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r') {
+      char byte[8];
+      std::snprintf(byte, sizeof byte, "0x%02x", c);
+      throw InputError(field, value,
+                       "a text " + format + " file (byte " + std::to_string(i) + " is " + byte +
+                           ", a control character no " + format + " file holds)");
+    }
+  }
 }
 
 namespace {

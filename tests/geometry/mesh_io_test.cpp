@@ -1,5 +1,7 @@
 // Reading meshes: formats, welding, vertex groups, topology, and each kind of bad file.
 #include <cstdint>
+#include <fstream>
+#include <iterator>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -206,6 +208,33 @@ TEST(MeshIo, PlyFilesTheWalkCannotFollowAreRefusedBeforeAssimp) {
               HasSubstr("a list length '2.5', not a whole number"));
   EXPECT_THAT(error("ascii_short.ply", tetrahedron_ply("3 1 2")),
               HasSubstr("it ends inside element face 3 of 4"));
+}
+
+// Text formats hold no control characters: an OBJ file with a NUL byte sent assimp's OBJ reader
+// past its buffer (issue 44, jelly_mesh_fuzzer; the input is in tests/fuzz/corpus/mesh). A binary
+// STL file, which may begin with "solid" as well, is still read.
+TEST(MeshIo, TextMeshFilesWithControlCharactersAreRefusedBeforeAssimp) {
+  TempDir dir;
+  const std::string field = "terrains[0].file";
+  const auto error = [&](const std::string& name, const std::string& text) {
+    return input_error([&] { read_mesh(write_text(dir.file(name), text), field); });
+  };
+  EXPECT_THAT(error("nul.obj", std::string("\0p 2v\x12", 6) + "0y0forma 0 m"),
+              HasSubstr("a text OBJ file (byte 0 is 0x00, a control character"));
+  const std::string tetrahedron =
+      "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nv 0 0 1\r\n\tf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  EXPECT_EQ(read_mesh(write_text(dir.file("ok.obj"), tetrahedron), field).mesh.num_triangles(), 4);
+  EXPECT_THAT(error("bell.obj", "v 0 0 0\x07\n" + tetrahedron), HasSubstr("byte 7 is 0x07"));
+  EXPECT_THAT(error("ascii.stl", std::string("solid t\n\0", 9)), HasSubstr("a text STL file"));
+  // Binary, named "solid ...": 84 + 50 n bytes.
+  const TriangleMesh box = box_mesh(Vec3::Ones());
+  write_mesh(dir.file("box.stl"), box);
+  std::ifstream in(dir.file("box.stl"), std::ios::binary);
+  std::string binary((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(binary.size(), 84u + 50u * static_cast<size_t>(box.num_triangles()));
+  binary.replace(0, 6, "solid ");
+  EXPECT_EQ(read_mesh(write_text(dir.file("solid.stl"), binary), field).mesh.num_triangles(),
+            box.num_triangles());
 }
 
 TEST(MeshIo, WriteRefusesOtherExtensions) {
