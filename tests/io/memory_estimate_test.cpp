@@ -12,7 +12,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
-#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -101,13 +100,6 @@ std::string cloth_scene(int n, const std::string& integrator) {
          integrator + R"(", "dt": 0.001}, "duration": 1})";
 }
 
-const std::vector<std::string>& integrators() {
-  static const std::vector<std::string> names = {
-      "explicit_euler", "symplectic_euler",    "midpoint",   "rk4", "xpbd", "arkode_erk",
-      "implicit_euler", "projective_dynamics", "arkode_dirk"};
-  return names;
-}
-
 // Checks the estimate against the measured growth at the sizes small and large of `scene`.
 void expect_within_2x(const std::string& what, const std::string& small, const std::string& large) {
   const double m_small = measured_growth(small), m_large = measured_growth(large);
@@ -119,6 +111,8 @@ void expect_within_2x(const std::string& what, const std::string& small, const s
     return what + " " + part + ": estimated " + bytes_text(estimated) + ", measured " +
            bytes_text(measured);
   };
+  std::printf("%s\n%s\n", report("small", e_small, m_small).c_str(),
+              report("large", e_large, m_large).c_str());
   EXPECT_LE(e_large, 2 * m_large) << report("large", e_large, m_large);
   EXPECT_GE(e_large, 0.5 * m_large) << report("large", e_large, m_large);
   EXPECT_LE(e_small, 2 * m_small) << report("small", e_small, m_small);
@@ -128,19 +122,24 @@ void expect_within_2x(const std::string& what, const std::string& small, const s
   EXPECT_GE(e_slope, 0.5 * m_slope) << report("small to large", e_slope, m_slope);
 }
 
-TEST(MemoryEstimate, WithinTwiceTheMeasuredPeakForEveryIntegratorOnACube) {
+class MemoryEstimateOf : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MemoryEstimateOf, ACubeWithinTwiceTheMeasuredPeak) {
   if (kSanitized) GTEST_SKIP() << "the sanitizers' allocator changes the resident size";
-  for (const std::string& name : integrators()) {
-    expect_within_2x(name + ", cube", cube_scene(14, name), cube_scene(24, name));
-  }
+  expect_within_2x(GetParam() + ", cube", cube_scene(14, GetParam()), cube_scene(24, GetParam()));
 }
 
-TEST(MemoryEstimate, WithinTwiceTheMeasuredPeakForEveryIntegratorOnACloth) {
+TEST_P(MemoryEstimateOf, AClothWithinTwiceTheMeasuredPeak) {
   if (kSanitized) GTEST_SKIP() << "the sanitizers' allocator changes the resident size";
-  for (const std::string& name : integrators()) {
-    expect_within_2x(name + ", cloth", cloth_scene(50, name), cloth_scene(120, name));
-  }
+  expect_within_2x(GetParam() + ", cloth", cloth_scene(50, GetParam()),
+                   cloth_scene(120, GetParam()));
 }
+
+INSTANTIATE_TEST_SUITE_P(EveryIntegrator, MemoryEstimateOf,
+                         ::testing::Values("explicit_euler", "symplectic_euler", "midpoint", "rk4",
+                                           "xpbd", "arkode_erk", "implicit_euler",
+                                           "projective_dynamics", "arkode_dirk"),
+                         [](const auto& info) { return info.param; });
 
 }  // namespace
 }  // namespace jelly
