@@ -244,6 +244,12 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
             }
           }
         }
+        // A face of fewer than 3 vertices is no polygon: assimp's triangulation aborts on one of
+        // none (an assertion in the Debian build; issue 44, jelly_mesh_fuzzer).
+        if (p.count_size > 0 && e.name == "face" && items < 3) {
+          malformed("element face " + std::to_string(i) + " has a list of " +
+                    std::to_string(items) + " vertices; a face has at least 3");
+        }
         if (ascii) {
           std::string_view word;
           for (long long k = 0; k < items; ++k) {

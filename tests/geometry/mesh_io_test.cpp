@@ -208,6 +208,11 @@ TEST(MeshIo, PlyFilesTheWalkCannotFollowAreRefusedBeforeAssimp) {
               HasSubstr("a list length '2.5', not a whole number"));
   EXPECT_THAT(error("ascii_short.ply", tetrahedron_ply("3 1 2")),
               HasSubstr("it ends inside element face 3 of 4"));
+  // Faces of no vertex: assimp's triangulation aborted (an assertion) on them.
+  EXPECT_THAT(error("empty_face.ply", tetrahedron_ply("0")),
+              HasSubstr("element face 3 has a list of 0 vertices; a face has at least 3"));
+  EXPECT_THAT(error("edge_face.ply", tetrahedron_ply("2 1 2")),
+              HasSubstr("element face 3 has a list of 2 vertices"));
 }
 
 // Text formats hold no control characters: an OBJ file with a NUL byte sent assimp's OBJ reader
