@@ -257,8 +257,10 @@ int run_jelly(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::fprintf(stderr, "error: %s\nRun 'jelly --help' or 'jelly run --help' for usage.\n",
-                 e.what());
+    // The command given (checked above), else run's usage as the example.
+    const std::string command = argc > 1 && argv[1][0] != '-' ? argv[1] : "run";
+    std::fprintf(stderr, "error: %s\nRun 'jelly --help' or 'jelly %s --help' for usage.\n",
+                 e.what(), command.c_str());
     return kExitBadInput;
   }
 
