@@ -197,7 +197,9 @@ TEST(MeshIo, PlyFilesTheWalkCannotFollowAreRefusedBeforeAssimp) {
   EXPECT_THAT(error("damaged.ply", binary + "end_h~ader\n" + body),
               HasSubstr("a well-formed PLY file (no line \"end_header\" ends its header)"));
   EXPECT_THAT(error("short.ply", binary + "end_header\n" + body.substr(0, body.size() - 5)),
-              HasSubstr("it ends inside element face 3 of 4"));
+              HasSubstr("element face 3 has a list of 3 items, more than the 7 bytes left"));
+  EXPECT_THAT(error("short_vertices.ply", binary + "end_header\n" + body.substr(0, 20)),
+              HasSubstr("it ends inside element vertex 1 of 4"));
   EXPECT_THAT(error("line.ply", "ply\nformat ascii 1.0\nfoo\n" + header + "end_header\n"),
               HasSubstr("header line 3 starts with 'foo'"));
   EXPECT_THAT(error("version.ply", "ply\nformat ascii 2.0\n" + header + "end_header\n"),
@@ -227,7 +229,7 @@ TEST(MeshIo, TextMeshFilesWithControlCharactersAreRefusedBeforeAssimp) {
   EXPECT_THAT(error("nul.obj", std::string("\0p 2v\x12", 6) + "0y0forma 0 m"),
               HasSubstr("a text OBJ file (byte 0 is 0x00, a control character"));
   const std::string tetrahedron =
-      "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nv 0 0 1\r\n\tf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+      "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nv 0 0 1\r\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
   EXPECT_EQ(read_mesh(write_text(dir.file("ok.obj"), tetrahedron), field).mesh.num_triangles(), 4);
   EXPECT_THAT(error("bell.obj", "v 0 0 0\x07\n" + tetrahedron), HasSubstr("byte 7 is 0x07"));
   EXPECT_THAT(error("ascii.stl", std::string("solid t\n\0", 9)), HasSubstr("a text STL file"));
