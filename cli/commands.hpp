@@ -6,6 +6,10 @@
 
 namespace jelly::cli {
 
+// The jelly program: parses argv (argv[0] the program's name), runs the command named and
+// returns its exit code (exit_codes.hpp); every error is printed, none escapes.
+int run_jelly(int argc, char** argv);
+
 struct RunArgs {
   std::string scene;       // scene file (JSON)
   std::string output;      // -o: HDF5 file, empty = none

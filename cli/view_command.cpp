@@ -174,9 +174,14 @@ int export_command(const ExportArgs& args) {
     if (!viewer::gltf_available()) viewer::export_gltf(Recording{}, args.gltf);  // says why
     check_new_file("--gltf", args.gltf, args.overwrite, args.recording);
   }
-  if (!args.obj_sequence.empty())
+  if (!args.obj_sequence.empty()) {
     check_new_file("--obj-sequence", args.obj_sequence + "/frame_0000.obj", args.overwrite,
                    args.recording);
+    // Every frame of an earlier sequence there: --overwrite replaces them all (its frames past
+    // the new sequence's last are removed), and none may be the recording.
+    for (const std::string& frame : viewer::obj_sequence_files(args.obj_sequence))
+      check_new_file("--obj-sequence", frame, args.overwrite, args.recording);
+  }
   if (!args.pc2.empty()) {
     check_new_file("--pc2", args.pc2, args.overwrite, args.recording);
     check_new_file("--pc2 (its rest surface)",
@@ -185,7 +190,7 @@ int export_command(const ExportArgs& args) {
   }
   const Recording recording = read_recording(args.recording);
   if (!args.obj_sequence.empty()) {
-    const int files = viewer::export_obj_sequence(recording, args.obj_sequence);
+    const int files = viewer::export_obj_sequence(recording, args.obj_sequence, args.overwrite);
     std::printf("wrote %d OBJ files to %s (frame_0000.obj ...)\n", files,
                 args.obj_sequence.c_str());
   }

@@ -1081,15 +1081,23 @@ std::string write_xdmf_for_recording(const std::string& h5_path, const XdmfOptio
   // are not finite, a dataset claiming more than it stores, a corrupt chunk) is an InputError
   // naming it and the dataset, before a sidecar describes it.
   (void)read_recording(h5_path);
-  h5::Handle file = h5::open_file(h5_path, true);
+  // The views go into a copy of the recording beside it, renamed onto it once written, flushed
+  // and closed: HDF5 writes in place, and a write that failed half way (a full disk) left a
+  // recording no reader could open (issue 44). The copy costs a read and a write of the file.
+  detail::FileReplacement copy(h5_path);
   std::string text;
   try {
+    std::filesystem::copy_file(h5_path, copy.temporary(),
+                               std::filesystem::copy_options::overwrite_existing);
+    h5::Handle file = h5::open_file(copy.temporary(), true);
     text = update_xdmf(file.get(), h5_path, options);
     check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + h5_path);
+    file.reset();
+    copy.commit();
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
-    // A failed write (a full disk), not bad input.
+    // A failed write (a full disk), not bad input; the recording is as it was.
     throw std::runtime_error("cannot write the XDMF views into '" + h5_path + "': " + e.what());
   }
   // Under a temporary name first: a failure leaves the old sidecar (or none), never half of one.

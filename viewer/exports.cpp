@@ -1,7 +1,11 @@
 #include <jelly/viewer/exports.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <stdexcept>
+#include <utility>
 
 #include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/errors.hpp>
@@ -77,7 +81,38 @@ ObjObject placed_terrain(const ExportTerrain& terrain, const Eigen::Isometry3d& 
 
 }  // namespace
 
-int export_obj_sequence(const Recording& recording, const std::string& dir) {
+std::string obj_sequence_name(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%04d.obj", frame);
+  return name;
+}
+
+std::vector<std::string> obj_sequence_files(const std::string& dir) {
+  std::vector<std::pair<long, std::string>> frames;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, error)) {
+    const std::string name = entry.path().filename().string();
+    // frame_<at least 4 digits>.obj, the number written without other leading zeros.
+    if (name.size() < 14 || name.size() > 20 || name.compare(0, 6, "frame_") != 0 ||
+        name.compare(name.size() - 4, 4, ".obj") != 0)
+      continue;
+    const std::string digits = name.substr(6, name.size() - 10);
+    if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const long frame = std::stol(digits);
+    if (frame > std::numeric_limits<int>::max() ||
+        obj_sequence_name(static_cast<int>(frame)) != name)
+      continue;
+    std::error_code status_error;
+    if (!std::filesystem::is_regular_file(entry.symlink_status(status_error))) continue;
+    frames.emplace_back(frame, entry.path().string());
+  }
+  std::sort(frames.begin(), frames.end());
+  std::vector<std::string> files;
+  for (auto& f : frames) files.push_back(std::move(f.second));
+  return files;
+}
+
+int export_obj_sequence(const Recording& recording, const std::string& dir, bool replace) {
   const std::vector<BodySurface> surfaces = surfaces_of(recording);
   std::error_code error;
   std::filesystem::create_directories(dir, error);
@@ -88,9 +123,7 @@ int export_obj_sequence(const Recording& recording, const std::string& dir) {
   std::vector<detail::FileReplacement> files;
   files.reserve(static_cast<size_t>(recording.frames()));
   for (int k = 0; k < recording.frames(); ++k) {
-    char name[32];
-    std::snprintf(name, sizeof name, "frame_%04d.obj", k);
-    files.emplace_back((std::filesystem::path(dir) / name).string());
+    files.emplace_back((std::filesystem::path(dir) / obj_sequence_name(k)).string());
     files.back().write(obj_text(surface_objects(surfaces, recording.position[k])));
   }
   for (const ExportTerrain& terrain : export_terrains(recording)) {
@@ -105,7 +138,22 @@ int export_obj_sequence(const Recording& recording, const std::string& dir) {
           obj_text({placed_terrain(terrain, terrain.poses[static_cast<size_t>(k)])}));
     }
   }
+  // The earlier sequence's frames past this one's last, found before the renames.
+  std::vector<std::string> stale;
+  if (replace) {
+    for (const std::string& f : obj_sequence_files(dir)) {
+      const std::string name = std::filesystem::path(f).filename().string();
+      if (std::stol(name.substr(6, name.size() - 10)) >= recording.frames()) stale.push_back(f);
+    }
+  }
   for (detail::FileReplacement& file : files) file.commit();
+  for (const std::string& f : stale) {
+    std::error_code remove_error;
+    std::filesystem::remove(f, remove_error);
+    if (remove_error)
+      throw std::runtime_error("cannot remove " + f +
+                               ", a frame of an earlier sequence: " + remove_error.message());
+  }
   return recording.frames();
 }
 

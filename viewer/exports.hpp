@@ -28,12 +28,20 @@ struct ExportTerrain {
 // The terrains of the recording's scene (none for a recording without one).
 std::vector<ExportTerrain> export_terrains(const Recording& recording);
 
+// The name of frame k of an OBJ sequence: frame_0000.obj, frame_0001.obj, ... frame_12345.obj.
+std::string obj_sequence_name(int frame);
+// The files of DIR named as an OBJ sequence's frames (exactly as obj_sequence_name names them;
+// regular files only), sorted by frame; empty when there are none or DIR is no folder.
+std::vector<std::string> obj_sequence_files(const std::string& dir);
+
 // Writes DIR/frame_0000.obj, DIR/frame_0001.obj, ... (one per recorded frame, the bodies; DIR is
 // created) and the terrains beside them in world coordinates: DIR/terrain_<name>.obj for one
 // that stays put, DIR/terrain_<name>_0000.obj, ... (one per frame) for one that moves. Returns
-// the number of frame files. Throws InputError for a recording without a surface or a folder
-// that cannot be made.
-int export_obj_sequence(const Recording& recording, const std::string& dir);
+// the number of frame files. With `replace`, the frames of an earlier sequence past this one's
+// last are then removed (only files named as frames: nothing else in DIR is touched), so that
+// DIR holds this sequence's frames alone. Throws InputError for a recording without a surface or
+// a folder that cannot be made.
+int export_obj_sequence(const Recording& recording, const std::string& dir, bool replace = false);
 
 // Writes the PC2 file (one sample per recorded frame, start frame 0, sample rate 1) and the
 // rest surface (the surfaces at the model's rest positions, the vertex order of the cache) as

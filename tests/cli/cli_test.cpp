@@ -231,6 +231,16 @@ TEST(Cli, CommandLineParseErrorsExitTwo) {
   r = jelly("run " + kSmallSlope + " --dt");
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, StartsWith("error: --dt: 1 required H missing"));
+  EXPECT_THAT(r.err, HasSubstr("'jelly run --help'"));
+
+  // The usage named is the command's own (render's errors sent readers to `jelly run --help`;
+  // seen while fuzzing render's command line, issue 44).
+  r = jelly("render missing.h5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("Run 'jelly --help' or 'jelly render --help' for usage."));
+  r = jelly("export --pc2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("'jelly export --help'"));
 }
 
 // CLI11's NonNegativeNumber answered --threads -1 with the range of a double (310 digits).
