@@ -79,19 +79,15 @@ TEST(FitAdjoint, AutoFallsBackToNumericAndSaysWhy) {
     EXPECT_NE(std::string(e.what()).find("gradients = adjoint is invalid"), std::string::npos)
         << e.what();
   }
-  // Wind: the adjoint refuses it at its first pass; auto takes the numeric path.
-  Trajectory windy = implicit_recording(false);
-  ExternalForce wind;
-  wind.kind = ExternalForceKind::kWind;
-  wind.vector = Vec3(1, 0, 0);
-  wind.drag = 0.1;
-  wind.particles = {0, 1};
-  windy.model.external_forces.push_back(wind);
+  // Newton iterations: the adjoint refuses them at its first pass; auto takes the numeric path.
+  Trajectory newton = implicit_recording(false);
+  newton.integrator_options.implicit.newton_iterations = 3;
   options.gradients = FitGradients::kAuto;
   options.max_iterations = 1;
-  const FitResult fallback = fit_recording(windy, options);
+  const FitResult fallback = fit_recording(newton, options);
   EXPECT_EQ(fallback.gradient_path, "numeric") << fallback.report();
-  EXPECT_NE(fallback.gradient_reason.find("the adjoint refused"), std::string::npos)
+  EXPECT_NE(fallback.gradient_reason.find("the adjoint refused: integrator.newton_iterations"),
+            std::string::npos)
       << fallback.report();
 }
 
