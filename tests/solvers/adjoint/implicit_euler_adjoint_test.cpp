@@ -442,7 +442,8 @@ TEST(ImplicitEulerAdjoint, CheckpointsGiveTheStoredRunsGradient) {
 }
 
 // The external forces' parameters (vector, drag, gust of each force) against central
-// differences of runs of the model with that parameter changed.
+// differences of runs of the model with that parameter changed (the gust's step 1e-4: its
+// gradients are small, and the loss is smooth enough in it for the O(step^2) error).
 void check_external_forces(const std::function<AdjointCase(const Model&)>& make_case,
                            const Model& model) {
   const GradientResult g = gradient_of(make_case(model));
@@ -469,7 +470,7 @@ void check_external_forces(const std::function<AdjointCase(const Model&)>& make_
     }
     expect_close(g.force_gust[e],
                  difference(
-                     1e-6, [](ExternalForce& f, Real eps) { f.gust += eps; }, e),
+                     1e-4, [](ExternalForce& f, Real eps) { f.gust += eps; }, e),
                  kTolerance, name + ".gust");
     if (force.kind == ExternalForceKind::kWind) {
       expect_close(g.force_drag[e],
@@ -569,7 +570,9 @@ TEST(ImplicitEulerAdjoint, WindOnAPinnedClothAgreesWithFiniteDifferences) {
     };
     check_external_forces(make_case, model);
     check_every_kind(make_case(model), 0, {SpringType::kStructural});
-    if (cg) EXPECT_EQ(gradient_of(make_case(model)).backward_solver.rfind("cg", 0), 0u);
+    if (cg) {
+      EXPECT_EQ(gradient_of(make_case(model)).backward_solver.rfind("cg", 0), 0u);
+    }
   }
 }
 
