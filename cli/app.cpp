@@ -145,9 +145,14 @@ int run_jelly(int argc, char** argv) {
       ->check(kNonEmpty);
   fit->add_flag("--overwrite", fit_args.overwrite, "Replace an existing --write-scene file");
   fit->add_flag("--no-covariance", fit_args.no_covariance,
-                "No standard deviations: the restart-aware covariance replays every window twice "
-                "per coordinate of its start state (6 x particles replays per window), most of "
-                "the time on a large body");
+                "No standard deviations: on the numeric path the restart-aware covariance "
+                "replays every window twice per coordinate of its start state (6 x particles "
+                "replays per window), most of the time on a large body");
+  fit->add_option("--gradients", fit_args.gradients,
+                  "auto: exact gradients from the adjoint of implicit_euler when it supports the "
+                  "recording, else numeric; adjoint: those or an error; numeric: central "
+                  "differences of replays")
+      ->capture_default_str();
 
   CLI::App* list = app.add_subcommand("list",
                                       "List the integrators, body and terrain kinds, contact "

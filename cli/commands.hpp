@@ -48,6 +48,7 @@ struct FitArgs {
   std::string write_scene;           // --write-scene: the scene with the fitted values
   bool overwrite = false;            // --overwrite: replace an existing --write-scene file
   bool no_covariance = false;        // --no-covariance: estimates without standard deviations
+  std::string gradients = "auto";    // --gradients: auto, adjoint or numeric
 };
 
 // jelly fit RECORDING.h5: the spring and damper coefficients that replay the recording best.
