@@ -6,6 +6,10 @@
 
 namespace jelly::cli {
 
+// The jelly program: parses argv (argv[0] the program's name), runs the command named and
+// returns its exit code (exit_codes.hpp); every error is printed, none escapes.
+int run_jelly(int argc, char** argv);
+
 struct RunArgs {
   std::string scene;       // scene file (JSON)
   std::string output;      // -o: HDF5 file, empty = none
@@ -31,6 +35,7 @@ struct XdmfArgs {
   std::string recording;   // HDF5 file written by `jelly run -o` (or a killed run's)
   bool overwrite = false;  // --overwrite: replace an existing sidecar
   bool no_strain = false;  // --no-strain: no strain cell array (XdmfOptions::strain = false)
+  bool state = false;      // --state: also a ParaView state beside it (write_paraview_state)
 };
 // jelly xdmf FILE.h5: (re)writes the recording's XDMF sidecar for ParaView.
 int xdmf_command(const XdmfArgs& args);
@@ -43,6 +48,7 @@ struct FitArgs {
   std::string write_scene;           // --write-scene: the scene with the fitted values
   bool overwrite = false;            // --overwrite: replace an existing --write-scene file
   bool no_covariance = false;        // --no-covariance: estimates without standard deviations
+  std::string gradients = "auto";    // --gradients: auto, adjoint or numeric
 };
 
 // jelly fit RECORDING.h5: the spring and damper coefficients that replay the recording best.
@@ -63,6 +69,8 @@ struct ViewArgs {
   bool overwrite = false;  // replace an existing --screenshot file
   double speed = 1;
   int samples = 4;
+  bool record = false;           // live: record from the first frame (F9 / the Record button)
+  std::string record_dir = ".";  // where recordings and F12 screenshots are written
 };
 // jelly view SCENE.json | FILE.h5: the live window or the replay.
 int view_command(const ViewArgs& args);
@@ -86,9 +94,10 @@ struct ExportArgs {
   std::string recording;
   std::string obj_sequence;  // folder of one OBJ per frame
   std::string pc2;           // PC2 file (+ the rest surface as .obj beside it)
+  std::string gltf;          // glTF 2.0 binary (.glb), animated
   bool overwrite = false;    // replace existing files
 };
-// jelly export FILE.h5 --obj-sequence DIR | --pc2 out.pc2.
+// jelly export FILE.h5 --obj-sequence DIR | --pc2 out.pc2 | --gltf out.glb.
 int export_command(const ExportArgs& args);
 
 struct MeshArgs {

@@ -75,6 +75,7 @@ int fit_command(const FitArgs& args) {
   options.window = args.window;
   options.max_iterations = args.max_iterations;
   options.compute_covariance = !args.no_covariance;
+  options.gradients = fit_gradients_from_name(args.gradients, "--gradients");
   for (const std::string& assignment : args.initial) {
     const auto [name, value] = parse_initial(assignment);
     bool known = false;

@@ -84,12 +84,22 @@ int view_command(const ViewArgs& args) {
   options.stats = args.stats;
   options.speed = args.speed;
   options.samples = args.samples;
+  options.record = args.record;
+  options.record_dir = args.record_dir;
+  {
+    std::error_code error;
+    if (!std::filesystem::is_directory(args.record_dir, error))
+      throw InputError("--record-dir", args.record_dir, "an existing folder");
+  }
   try {
     std::unique_ptr<viewer::ViewerWindow> window;
     if (is_recording(args.file)) {
       if (!args.sets.empty() || !args.integrator.empty() || !args.dt.empty())
         throw InputError("--set/--integrator/--dt", args.file,
                          "options of a live scene, not of a recording");
+      if (args.record)
+        throw InputError("--record", args.file,
+                         "an option of a live scene (a replay is a recording already)");
       window = viewer::ViewerWindow::replay(args.file, options);
     } else {
       const Scene scene = load_scene(args.file, overrides(args));
@@ -152,11 +162,26 @@ int render_command(const RenderArgs& args) {
 }
 
 int export_command(const ExportArgs& args) {
-  if (args.obj_sequence.empty() && args.pc2.empty())
-    throw InputError("jelly export", args.recording, "--obj-sequence DIR and/or --pc2 FILE.pc2");
-  if (!args.obj_sequence.empty())
+  if (args.obj_sequence.empty() && args.pc2.empty() && args.gltf.empty())
+    throw InputError("jelly export", args.recording,
+                     "one or more of --obj-sequence DIR, --pc2 FILE.pc2, --gltf FILE.glb");
+  if (!args.gltf.empty()) {
+    if (std::filesystem::path(args.gltf).extension() != ".glb")
+      throw InputError("--gltf", args.gltf, "a path ending in .glb (binary glTF 2.0)");
+    std::error_code error;
+    if (std::filesystem::is_directory(args.gltf, error))
+      throw InputError("--gltf", args.gltf, "a file path (it is a folder)");
+    if (!viewer::gltf_available()) viewer::export_gltf(Recording{}, args.gltf);  // says why
+    check_new_file("--gltf", args.gltf, args.overwrite, args.recording);
+  }
+  if (!args.obj_sequence.empty()) {
     check_new_file("--obj-sequence", args.obj_sequence + "/frame_0000.obj", args.overwrite,
                    args.recording);
+    // Every frame of an earlier sequence there: --overwrite replaces them all (its frames past
+    // the new sequence's last are removed), and none may be the recording.
+    for (const std::string& frame : viewer::obj_sequence_files(args.obj_sequence))
+      check_new_file("--obj-sequence", frame, args.overwrite, args.recording);
+  }
   if (!args.pc2.empty()) {
     check_new_file("--pc2", args.pc2, args.overwrite, args.recording);
     check_new_file("--pc2 (its rest surface)",
@@ -165,7 +190,7 @@ int export_command(const ExportArgs& args) {
   }
   const Recording recording = read_recording(args.recording);
   if (!args.obj_sequence.empty()) {
-    const int files = viewer::export_obj_sequence(recording, args.obj_sequence);
+    const int files = viewer::export_obj_sequence(recording, args.obj_sequence, args.overwrite);
     std::printf("wrote %d OBJ files to %s (frame_0000.obj ...)\n", files,
                 args.obj_sequence.c_str());
   }
@@ -173,6 +198,10 @@ int export_command(const ExportArgs& args) {
     const std::string rest = viewer::export_pc2(recording, args.pc2);
     std::printf("wrote %s (%d samples) and its rest surface %s\n", args.pc2.c_str(),
                 recording.frames(), rest.c_str());
+  }
+  if (!args.gltf.empty()) {
+    viewer::export_gltf(recording, args.gltf);
+    std::printf("wrote %s (%d frames)\n", args.gltf.c_str(), recording.frames());
   }
   return kExitOk;
 }

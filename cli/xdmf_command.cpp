@@ -30,12 +30,23 @@ int xdmf_command(const XdmfArgs& args) {
                      "' exists: pass --overwrite to replace it (it is rewritten from the "
                      "recording)");
   }
+  const std::string state = paraview_state_path_for(args.recording);
+  if (args.state && std::filesystem::exists(state, error) && !args.overwrite) {
+    throw InputError("'" + state +
+                     "' exists: pass --overwrite to replace it (it is rewritten from "
+                     "the recording)");
+  }
   XdmfOptions options;
   options.strain = !args.no_strain;
   const std::string written = write_xdmf_for_recording(args.recording, options);
   // With a folder: ParaView's Xdmf3 readers misread a bare file name (docs/output.md).
   const std::string open = written.find('/') == std::string::npos ? "./" + written : written;
   std::printf("wrote %s (open it in ParaView: paraview %s)\n", written.c_str(), open.c_str());
+  if (args.state) {
+    const std::string written_state = write_paraview_state(args.recording);
+    std::printf("wrote %s (open it in ParaView: paraview --state=%s)\n", written_state.c_str(),
+                written_state.c_str());
+  }
   return kExitOk;
 }
 

@@ -8,11 +8,17 @@
 #include <memory>
 #include <sstream>
 
+#include <random>
+#include <stdexcept>
+
 #include <ceres/ceres.h>
 #include <ceres/covariance.h>
+#include <ceres/gradient_problem.h>
+#include <ceres/gradient_problem_solver.h>
 #include <Eigen/Dense>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/fit/detail/window_adjoint.hpp>
 #include <jelly/fit/implicit_euler_ceres.hpp>
 #include <jelly/solvers/simulator.hpp>
 
@@ -196,6 +202,222 @@ RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, co
   return out;
 }
 
+// ---- The exact-gradient path: the adjoint of implicit_euler per window. ----
+
+// dL/d(log k) of each free coefficient from the adjoint's gradient per body and spring type.
+void add_log_gradient(const Model& model, const std::vector<FitParameter>& free,
+                      const double* log_k, const GradientResult& g, double* out) {
+  for (size_t p = 0; p < free.size(); ++p) {
+    const FitParameter& f = free[p];
+    const std::vector<Real>& per = f.quantity == FitParameter::Quantity::kKs ? g.ks : g.kd;
+    Real sum = 0;
+    for (int b = 0; b < model.num_bodies(); ++b) {
+      if (!f.body.empty() && model.bodies[b].name != f.body) continue;
+      for (SpringType t : kTypes)
+        if (f.applies_to(t))
+          sum += per[static_cast<size_t>(kSpringTypeCount) * b + static_cast<int>(t)];
+    }
+    out[p] += std::exp(log_k[p]) * sum;
+  }
+}
+
+Model model_with(const Trajectory& trajectory, const std::vector<FitParameter>& free,
+                 const double* log_k) {
+  Model model = trajectory.model;
+  for (size_t p = 0; p < free.size(); ++p) set_parameter(model, free[p], std::exp(log_k[p]));
+  return model;
+}
+
+// The cost 1/2 sum |x_replay - x_recorded|^2 over the windows and its gradient in the
+// log-coefficients: one adjoint pass per window. A refusal of the adjoint (contact between bodies
+// appearing at some coefficients) is kept in `refused` and fails the evaluation.
+class AdjointCost final : public ceres::FirstOrderFunction {
+ public:
+  AdjointCost(const Trajectory& trajectory, const std::vector<FitParameter>& free,
+              const std::vector<Window>& windows)
+      : trajectory_(&trajectory), free_(&free), windows_(&windows) {}
+
+  int NumParameters() const override { return static_cast<int>(free_->size()); }
+
+  bool Evaluate(const double* log_k, double* cost, double* gradient) const override {
+    const Model model = model_with(*trajectory_, *free_, log_k);
+    *cost = 0;
+    if (gradient != nullptr) std::fill(gradient, gradient + free_->size(), 0.0);
+    for (const Window& w : *windows_) {
+      const WindowFrameLoss loss = [&](int frame, const VecX& x, VecX& dl_dx) {
+        dl_dx = x - trajectory_->positions[frame];
+        return 0.5 * dl_dx.squaredNorm();
+      };
+      GradientResult g;
+      try {
+        ++passes;
+        g = fit_window_gradient(*trajectory_, model, w.first, w.last, trajectory_->state(w.first),
+                                loss);
+      } catch (const InputError& e) {
+        refused = e.what();
+        return false;
+      } catch (const std::runtime_error&) {
+        return false;  // a step or backward solve failed at these coefficients
+      }
+      if (!std::isfinite(g.loss)) return false;
+      *cost += g.loss;
+      if (gradient != nullptr) add_log_gradient(model, *free_, log_k, g, gradient);
+    }
+    return true;
+  }
+
+  mutable std::string refused;
+  mutable long passes = 0;
+
+ private:
+  const Trajectory* trajectory_;
+  const std::vector<FitParameter>* free_;
+  const std::vector<Window>* windows_;
+};
+
+// The weights of Trajectory::state's finite-difference velocity at frame k: v = sum_j w_j
+// positions[c - 1 + j]; returns c - 1 (the first frame used).
+int restart_velocity_weights(const Trajectory& trajectory, int k, Real w[3]) {
+  const int last = trajectory.frames() - 1;
+  const int c = std::clamp(k, 1, last - 1);
+  const std::vector<Real>& times = trajectory.times;
+  const Real t0 = times[c - 1], t1 = times[c], t2 = times[c + 1], t = times[k];
+  w[0] = ((t - t1) + (t - t2)) / ((t0 - t1) * (t0 - t2));
+  w[1] = ((t - t0) + (t - t2)) / ((t1 - t0) * (t1 - t2));
+  w[2] = ((t - t0) + (t - t1)) / ((t2 - t0) * (t2 - t1));
+  return c - 1;
+}
+
+// The number of random probes of the Hutchinson estimate of trace(D D^T) (D: the residuals'
+// derivative with respect to the restart positions), which only the noise variance uses.
+constexpr int kTraceProbes = 16;
+
+// The restart-aware covariance of restart_aware_covariance, with the derivatives of each window
+// with respect to its restart state from the adjoint instead of 2 x 3N replays per window:
+//   J by central differences of replays (2 per coefficient and window),
+//   J_w^T D_w (p x 3N) by p adjoint passes per window (loss = J_w column . residuals),
+//   trace(D D^T) by kTraceProbes adjoint passes per window with Rademacher weights.
+// Returns false with `why` when J^T J is singular.
+bool adjoint_covariance(const Trajectory& trajectory, const std::vector<FitParameter>& free,
+                        const std::vector<Window>& windows, const std::vector<double>& log_k,
+                        Real relative_step, Eigen::MatrixXd& cov, Eigen::MatrixXd& h_inv,
+                        Real& s2_independent, long& replays, long& passes, std::string& why) {
+  const int n = trajectory.model.num_dofs();
+  const int p_count = static_cast<int>(free.size());
+  std::vector<int> offset(windows.size() + 1, 0);
+  for (size_t w = 0; w < windows.size(); ++w)
+    offset[w + 1] = offset[w] + (windows[w].last - windows[w].first) * n;
+  const int rows = offset.back();
+  // J, d(residuals)/d(log k), by central differences as Ceres' numeric path takes them.
+  Eigen::MatrixXd jacobian(rows, p_count);
+  VecX plus(rows), minus(rows), r0(rows);
+  const auto residuals = [&](const std::vector<double>& at, VecX& out) {
+    const Model model = model_with(trajectory, free, at.data());
+    for (size_t w = 0; w < windows.size(); ++w) {
+      ++replays;
+      if (!replay_window(trajectory, model, windows[w], out.data() + offset[w])) return false;
+    }
+    return true;
+  };
+  if (!residuals(log_k, r0)) {
+    why = "a replay failed at the fitted coefficients";
+    return false;
+  }
+  for (int p = 0; p < p_count; ++p) {
+    std::vector<double> at = log_k;
+    const Real step = log_k[p] != 0 ? relative_step * std::abs(log_k[p]) : relative_step;
+    at[p] = log_k[p] + step;
+    const bool ok_plus = residuals(at, plus);
+    at[p] = log_k[p] - step;
+    if (!ok_plus || !residuals(at, minus)) {
+      why = "a replay failed near the fitted coefficients";
+      return false;
+    }
+    jacobian.col(p) = (plus - minus) / (2 * step);
+  }
+  const Eigen::MatrixXd h = jacobian.transpose() * jacobian;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(h);
+  const Real largest = eigen.eigenvalues().maxCoeff(), smallest = eigen.eigenvalues().minCoeff();
+  if (!(largest > 0) || !(smallest > 1e-14 * largest)) {
+    why =
+        "the Jacobian is rank deficient: some coefficient is not identifiable from this recording";
+    return false;
+  }
+  h_inv = h.inverse();
+  s2_independent = r0.squaredNorm() / (rows - p_count);
+  const Model model = model_with(trajectory, free, log_k.data());
+  const bool fd_velocities = !trajectory.has_velocities();
+  // Per window: J_w^T D_w on the restart positions (p x 3N) and on the restart velocities.
+  std::vector<Eigen::MatrixXd> jd_x(windows.size()), jd_v(windows.size());
+  Real trace = rows;  // the compared frames' own noise: -I
+  std::mt19937 random(20261128);
+  std::uniform_int_distribution<int> coin(0, 1);
+  VecX probe(rows);
+  for (size_t w = 0; w < windows.size(); ++w) {
+    const Window& win = windows[w];
+    const State start = trajectory.state(win.first);
+    const auto pass = [&](const double* weights) {
+      const WindowFrameLoss loss = [&](int frame, const VecX& x, VecX& dl_dx) {
+        dl_dx = Eigen::Map<const VecX>(weights + offset[w] + (frame - win.first - 1) * n, n);
+        return dl_dx.dot(x);
+      };
+      ++passes;
+      return fit_window_gradient(trajectory, model, win.first, win.last, start, loss);
+    };
+    jd_x[w].resize(p_count, n);
+    jd_v[w].resize(p_count, n);
+    for (int p = 0; p < p_count; ++p) {
+      const GradientResult g = pass(jacobian.col(p).data());
+      jd_x[w].row(p) = g.initial_position.transpose();
+      jd_v[w].row(p) = g.initial_velocity.transpose();
+    }
+    // trace(D_w D_w^T) over the recorded positions the restart depends on, E |D_w^T y|^2.
+    Real sum = 0;
+    for (int q = 0; q < kTraceProbes; ++q) {
+      for (int i = offset[w]; i < offset[w + 1]; ++i) probe[i] = coin(random) ? 1.0 : -1.0;
+      const GradientResult g = pass(probe.data());
+      if (!fd_velocities) {
+        sum += g.initial_position.squaredNorm();
+        continue;
+      }
+      Real weights[3];
+      const int c0 = restart_velocity_weights(trajectory, win.first, weights);
+      for (int j = 0; j < 3; ++j) {
+        VecX column = weights[j] * g.initial_velocity;
+        if (c0 + j == win.first) column += g.initial_position;
+        sum += column.squaredNorm();
+      }
+    }
+    trace += sum / kTraceProbes;
+  }
+  // sum over the recorded coordinates e of (H^-1 b_e)(H^-1 b_e)^T, b_e = J^T a_e.
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p_count, p_count);
+  Eigen::VectorXd b(p_count);
+  for (int k = 0; k < trajectory.frames(); ++k) {
+    for (int c = 0; c < n; ++c) {
+      b.setZero();
+      for (size_t w = 0; w < windows.size(); ++w) {
+        const Window& win = windows[w];
+        if (k > win.first && k <= win.last)
+          b -= jacobian.row(offset[w] + (k - win.first - 1) * n + c).transpose();
+        if (!fd_velocities) {
+          if (k == win.first) b += jd_x[w].col(c);
+          continue;
+        }
+        Real weights[3];
+        const int c0 = restart_velocity_weights(trajectory, win.first, weights);
+        if (k == win.first) b += jd_x[w].col(c);
+        if (k >= c0 && k < c0 + 3) b += weights[k - c0] * jd_v[w].col(c);
+      }
+      const Eigen::VectorXd shift = h_inv * b;
+      meat += shift * shift.transpose();
+    }
+  }
+  const Real s2 = r0.squaredNorm() / std::max<Real>(trace - p_count, 1);
+  cov = s2 * meat;
+  return true;
+}
+
 Real mean_coefficient(const Model& model, const FitParameter& p) {
   const Springs& s = model.springs;
   Real sum = 0;
@@ -323,6 +545,13 @@ std::string FitResult::report() const {
     out << "restart velocities fitted: " << restart_velocities.size() << " windows x "
         << restart_velocities.front().size() << " unknowns\n";
   }
+  if (gradient_path == "adjoint") {
+    out << "derivatives: adjoint (exact gradients of implicit_euler, " << adjoint_passes
+        << " adjoint window passes; Ceres line search, BFGS)\n";
+  } else {
+    out << "derivatives: numeric (central differences of replays, Levenberg-Marquardt): "
+        << gradient_reason << "\n";
+  }
   out << "covariance: " << (covariance_ok ? "ok" : "failed: " + covariance_message) << "\n";
   out << "ceres: " << brief_report << "\n";
   return out.str();
@@ -338,6 +567,122 @@ Real replay_cost(const Trajectory& trajectory, Real window) {
     cost += 0.5 * r.squaredNorm();
   }
   return cost;
+}
+
+namespace {
+
+// Why the adjoint cannot take this fit before trying it ("" when it may).
+std::string adjoint_refusal(const Trajectory& trajectory, const FitOptions& options) {
+  if (trajectory.integrator != "implicit_euler")
+    return "the recording's integrator is " + trajectory.integrator +
+           " (the adjoint differentiates implicit_euler)";
+  if (options.fit_restart_velocities)
+    return "fit_restart_velocities (the covariance needs the velocities' full Jacobian)";
+  return "";
+}
+
+// The exact-gradient path: Ceres' line search (BFGS) on the log-coefficients with the adjoint's
+// gradient, and the restart-aware covariance from adjoint passes. Returns false, with
+// result.gradient_reason saying why, when the numeric path must take the fit instead (throws
+// InputError for that when options.gradients asks for the adjoint).
+bool fit_with_adjoint(const Trajectory& trajectory, const FitOptions& options,
+                      const std::vector<Window>& windows, std::vector<double>& log_k,
+                      FitResult& result) {
+  if (options.gradients == FitGradients::kNumeric) {
+    result.gradient_reason = "asked for (gradients = numeric)";
+    return false;
+  }
+  const auto refuse = [&](const std::string& why) {
+    if (options.gradients == FitGradients::kAdjoint)
+      throw InputError("gradients", "adjoint", "a fit the adjoint supports: " + why);
+    result.gradient_reason = "the adjoint refused: " + why;
+    return false;
+  };
+  if (std::string why = adjoint_refusal(trajectory, options); !why.empty()) return refuse(why);
+  const std::vector<FitParameter>& free = options.free;
+  const int p_count = static_cast<int>(free.size());
+  auto* function = new AdjointCost(trajectory, free, windows);
+  ceres::GradientProblem problem(function);  // owns it
+  // A probe at the start: what the adjoint refuses shows at once (anchors, wind, ...).
+  {
+    double cost = 0;
+    std::vector<double> gradient(p_count);
+    const bool ok = function->Evaluate(log_k.data(), &cost, gradient.data());
+    if (!function->refused.empty()) return refuse(function->refused);
+    if (!ok) return refuse("a replay failed at the starting values");
+  }
+  ceres::GradientProblemSolver::Options solver;
+  // Few coefficients: dense BFGS builds the curvature from successive exact gradients.
+  solver.line_search_direction_type = ceres::BFGS;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  solver.gradient_tolerance = options.gradient_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
+  solver.minimizer_progress_to_stdout = options.progress_to_stdout;
+  solver.logging_type = options.progress_to_stdout ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  ceres::GradientProblemSolver::Summary summary;
+  ceres::Solve(solver, problem, log_k.data(), &summary);
+  if (!function->refused.empty()) return refuse(function->refused + " (during the fit)");
+  result.gradient_path = "adjoint";
+  result.adjoint_passes = function->passes;
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  result.termination = summary.message;
+  result.brief_report = summary.BriefReport();
+  result.residual_rms = std::sqrt(2 * summary.final_cost / result.residuals);
+  for (int p = 0; p < p_count; ++p) {
+    result.parameters[p].value = std::exp(log_k[p]);
+    result.parameters[p].stddev = std::numeric_limits<Real>::quiet_NaN();
+    result.parameters[p].stddev_independent = std::numeric_limits<Real>::quiet_NaN();
+  }
+  const auto covariance_start = std::chrono::steady_clock::now();
+  if (!options.compute_covariance) {
+    result.covariance_message = "not requested";
+  } else if (result.residuals <= p_count) {
+    result.covariance_message = "fewer residuals than unknowns";
+  } else {
+    Eigen::MatrixXd cov, h_inv;
+    Real s2_independent = 0;
+    long passes = 0;
+    std::string why;
+    if (adjoint_covariance(trajectory, free, windows, log_k, options.relative_step, cov, h_inv,
+                           s2_independent, result.replays, passes, why)) {
+      for (int p = 0; p < p_count; ++p) {
+        FittedParameter& fp = result.parameters[p];
+        fp.stddev = fp.value * std::sqrt(cov(p, p));
+        fp.stddev_independent = fp.value * std::sqrt(s2_independent * h_inv(p, p));
+      }
+      result.covariance_ok = true;
+    } else {
+      result.covariance_message = why;
+    }
+    result.adjoint_passes += passes;
+  }
+  result.covariance_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - covariance_start).count();
+  return true;
+}
+
+}  // namespace
+
+FitGradients fit_gradients_from_name(std::string_view name, std::string_view field) {
+  if (name == "auto") return FitGradients::kAuto;
+  if (name == "adjoint") return FitGradients::kAdjoint;
+  if (name == "numeric") return FitGradients::kNumeric;
+  throw InputError(std::string(field), std::string(name), "one of auto, adjoint, numeric");
+}
+
+std::string_view fit_gradients_name(FitGradients gradients) {
+  switch (gradients) {
+    case FitGradients::kAdjoint:
+      return "adjoint";
+    case FitGradients::kNumeric:
+      return "numeric";
+    default:
+      return "auto";
+  }
 }
 
 FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options) {
@@ -371,6 +716,15 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
 
   const std::vector<Window> windows = make_windows(trajectory, options.window);
   const int n = trajectory.model.num_dofs();
+  for (const Window& w : windows) result.residuals += (w.last - w.first) * n;
+  result.windows = static_cast<int>(windows.size());
+  if (fit_with_adjoint(trajectory, options, windows, log_k, result)) {
+    const auto end = std::chrono::steady_clock::now();
+    result.wall_seconds = std::chrono::duration<double>(end - start).count();
+    return result;
+  }
+  for (int p = 0; p < p_count; ++p) log_k[p] = std::log(result.parameters[p].initial);
+  result.gradient_path = "numeric";
   std::atomic<long> replays{0};
   ceres::Problem problem;
   ceres::NumericDiffOptions diff;
@@ -398,9 +752,7 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
     } else {
       problem.AddResidualBlock(cost, nullptr, log_k.data());
     }
-    result.residuals += (w.last - w.first) * n;
   }
-  result.windows = static_cast<int>(windows.size());
   const int unknowns = p_count + (fit_velocities ? n * result.windows : 0);
 
   ceres::Solver::Options solver;

@@ -38,7 +38,18 @@ struct FitParameter {
 // exist is checked by fit_recording against the trajectory's model.
 std::vector<FitParameter> parse_free_parameters(std::string_view list);
 
+// How fit_recording differentiates the residuals (docs/fitting.md, "Exact gradients").
+enum class FitGradients {
+  kAuto,     // the adjoint when it supports the recording (implicit_euler, ...), else numeric
+  kAdjoint,  // the adjoint of implicit_euler; InputError when it does not support the recording
+  kNumeric,  // central differences of replays (Levenberg-Marquardt), whatever the integrator
+};
+// "auto", "adjoint", "numeric"; throws InputError naming `field` for another name.
+FitGradients fit_gradients_from_name(std::string_view name, std::string_view field);
+std::string_view fit_gradients_name(FitGradients gradients);
+
 struct FitOptions {
+  FitGradients gradients = FitGradients::kAuto;
   std::vector<FitParameter> free = parse_free_parameters("ks,kd");
   // Starting values by parameter name; a parameter not named starts at the mean of its springs'
   // current coefficient in the trajectory's model. Every start must be > 0.
@@ -92,6 +103,11 @@ struct FitResult {
   Real residual_rms = 0;  // sqrt(2 final_cost / residuals) (m)
   int windows = 0;
   int residuals = 0;
+  // "adjoint" (exact gradients, Ceres' line search with BFGS) or "numeric" (central differences,
+  // Levenberg-Marquardt), and why the numeric path was taken when the adjoint was not.
+  std::string gradient_path;
+  std::string gradient_reason;
+  long adjoint_passes = 0;  // window replays differentiated by the adjoint (forward + backward)
   // The fitted initial velocity of each window (fit_restart_velocities), else empty.
   std::vector<VecX> restart_velocities;
   long replays = 0;             // window replays (each one simulation of a window)

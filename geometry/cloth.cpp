@@ -77,6 +77,14 @@ BodyPart ClothShape::build(const Material& material, const std::string& prefix) 
   return part;
 }
 
+long ClothShape::estimated_springs() const {
+  const long u = nu, v = nv;
+  const long structural = (u - 1) * v + u * (v - 1);
+  const long shear = 2 * (u - 1) * (v - 1);
+  const long bending = std::max(u - 2, 0L) * v + u * std::max(v - 2, 0L);
+  return structural + shear + bending;
+}
+
 void ClothShape::write(Json& j) const {
   j["nu"] = nu;
   j["nv"] = nv;

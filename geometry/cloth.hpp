@@ -18,6 +18,8 @@ struct ClothShape final : BodyShapeOf<ClothShape> {
   // Particle (i, j) has index i nv + j. A material density is per area (kg/m^2).
   BodyPart build(const Material& material, const std::string& prefix) const override;
   long estimated_particles() const override { return static_cast<long>(nu) * nv; }
+  // Exactly the springs build() makes (structural, shear and bending along both directions).
+  long estimated_springs() const override;
   void write(Json& object) const override;
   static std::unique_ptr<BodyShape> read(JsonFields& fields);
 };

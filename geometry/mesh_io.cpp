@@ -130,6 +130,8 @@ MeshFile read_mesh(const std::string& path, const std::string& field) {
           "a mesh file ending in .obj, .stl or .ply");
   detail::require_mesh_file(path, field, value);
   if (ext == ".ply") detail::require_ply_counts_fit(path, field, value);
+  if (ext == ".obj") detail::require_text_mesh(path, field, value, "OBJ");
+  if (ext == ".stl") detail::require_text_mesh(path, field, value, "STL");
 
   Assimp::Importer importer;
   // ValidateDataStructure runs first and refuses a face naming a vertex the mesh does not have

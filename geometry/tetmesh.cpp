@@ -238,6 +238,7 @@ BodyPart build_tetmesh(const TetMesh& mesh, const Pose& pose, const Material& ma
 struct TetmeshShape::Cache {
   std::string file;
   TetMesh mesh;
+  long edges = 0;  // tet_edges(mesh.tets).size(): the springs build() makes
 };
 
 const TetMesh& TetmeshShape::mesh(const std::string& prefix) const {
@@ -246,6 +247,7 @@ const TetMesh& TetmeshShape::mesh(const std::string& prefix) const {
     auto fresh = std::make_shared<Cache>();
     fresh->file = file;
     fresh->mesh = read_tet_mesh(file, prefix + "file");
+    fresh->edges = static_cast<long>(tet_edges(fresh->mesh.tets).size());
     cache = fresh;
     std::atomic_store(&cache_, cache);
   }
@@ -265,7 +267,10 @@ BodyPart TetmeshShape::build(const Material& material, const std::string& prefix
 
 long TetmeshShape::estimated_particles() const { return mesh().num_vertices(); }
 
-long TetmeshShape::estimated_springs() const { return 6L * mesh().num_tets(); }
+long TetmeshShape::estimated_springs() const {
+  mesh();  // reads the file and counts its edges on first use
+  return std::atomic_load(&cache_)->edges;
+}
 
 void TetmeshShape::write(Json& j) const {
   j["file"] = file;

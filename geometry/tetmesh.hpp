@@ -61,7 +61,7 @@ struct TetmeshShape final : BodyShapeOf<TetmeshShape> {
   void validate(const std::string& prefix) const override;
   BodyPart build(const Material& material, const std::string& prefix) const override;
   long estimated_particles() const override;
-  long estimated_springs() const override;  // 6 per tet, an upper bound
+  long estimated_springs() const override;  // the mesh's unique edges, exactly
   void write(Json& object) const override;
   static std::unique_ptr<BodyShape> read(JsonFields& fields);
 

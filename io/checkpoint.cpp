@@ -108,6 +108,11 @@ void CheckpointWriter::write(const SimulatorSnapshot& s) {
   write_attribute(group_.get(), "contact_count", static_cast<long>(s.contact_count));
 }
 
+void CheckpointWriter::set_integrator(const std::string& integrator, Real dt) {
+  write_attribute(group_.get(), "integrator", integrator);
+  write_attribute(group_.get(), "dt", dt);
+}
+
 }  // namespace h5
 
 SimulatorSnapshot Checkpoint::snapshot() const {

@@ -1,10 +1,12 @@
 #include <jelly/io/export.hpp>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include <jelly/core/detail/file_replacement.hpp>
 #include <jelly/core/detail/input_file.hpp>
@@ -22,22 +24,91 @@ void put_f32(std::FILE* f, float v) { std::fwrite(&v, 4, 1, f); }
 
 }  // namespace
 
+void vertex_normals(const std::vector<Vec3>& vertices, const std::vector<Triangle>& triangles,
+                    std::vector<Vec3>& normals) {
+  normals.assign(vertices.size(), Vec3::Zero());
+  for (const Triangle& t : triangles) {
+    const Vec3 n = (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]);
+    for (int i : t) normals[i] += n;
+  }
+  for (Vec3& n : normals) {
+    const Real length = n.norm();
+    n = length > 0 ? Vec3(n / length) : Vec3::UnitY();
+  }
+}
+
+ObjObject crease_normals(const std::string& name, const std::vector<Vec3>& vertices,
+                         const std::vector<Triangle>& triangles, double crease_degrees) {
+  const size_t nt = triangles.size();
+  std::vector<Vec3> face(nt);  // twice the area times the unit normal
+  std::vector<std::vector<int>> around(vertices.size());
+  for (size_t f = 0; f < nt; ++f) {
+    const Triangle& t = triangles[f];
+    face[f] = (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]);
+    for (int i : t) around[i].push_back(static_cast<int>(f));
+  }
+  const Real cos_crease = std::cos(crease_degrees * 3.14159265358979323846 / 180);
+  ObjObject out;
+  out.name = name;
+  out.triangles.resize(nt);
+  // Per original vertex, the copies made so far (their normals): corners whose normals agree to
+  // rounding share one.
+  std::vector<std::vector<int>> copies(vertices.size());
+  for (size_t f = 0; f < nt; ++f) {
+    const Vec3 own = face[f].normalized();
+    for (int c = 0; c < 3; ++c) {
+      const int v = triangles[f][c];
+      Vec3 sum = Vec3::Zero();
+      for (int g : around[v])
+        if (face[g].normalized().dot(own) >= cos_crease) sum += face[g];
+      const Vec3 n = sum.norm() > 0 ? Vec3(sum.normalized()) : Vec3::UnitY();
+      int index = -1;
+      for (int k : copies[v])
+        if ((out.normals[k] - n).norm() < 1e-9) index = k;
+      if (index < 0) {
+        index = static_cast<int>(out.vertices.size());
+        out.vertices.push_back(vertices[v]);
+        out.normals.push_back(n);
+        copies[v].push_back(index);
+      }
+      out.triangles[f][c] = index;
+    }
+  }
+  return out;
+}
+
 std::string obj_text(const std::vector<ObjObject>& objects, const std::string& one_object) {
   std::string text = "# jelly render surface\n";
   if (!one_object.empty()) text += "o " + one_object + "\n";
-  char line[128];
-  int base = 1;
+  char line[160];
+  int base = 1, normal_base = 1;
   for (const ObjObject& o : objects) {
     text += (one_object.empty() ? "o " : "g ") + o.name + "\n";
     for (const Vec3& v : o.vertices) {
       std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", v.x(), v.y(), v.z());
       text += line;
     }
+    const bool normals = !o.normals.empty();
+    if (normals && o.normals.size() != o.vertices.size())
+      throw std::logic_error("obj_text: object '" + o.name + "' has " +
+                             std::to_string(o.normals.size()) + " normals for " +
+                             std::to_string(o.vertices.size()) + " vertices");
+    for (const Vec3& n : o.normals) {
+      std::snprintf(line, sizeof line, "vn %.7g %.7g %.7g\n", n.x(), n.y(), n.z());
+      text += line;
+    }
     for (const auto& t : o.triangles) {
-      std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + base, t[1] + base, t[2] + base);
+      if (normals) {
+        const int d = normal_base - base;  // vn index = v index + d
+        std::snprintf(line, sizeof line, "f %d//%d %d//%d %d//%d\n", t[0] + base, t[0] + base + d,
+                      t[1] + base, t[1] + base + d, t[2] + base, t[2] + base + d);
+      } else {
+        std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + base, t[1] + base, t[2] + base);
+      }
       text += line;
     }
     base += static_cast<int>(o.vertices.size());
+    normal_base += static_cast<int>(o.normals.size());
   }
   return text;
 }
@@ -53,9 +124,11 @@ std::vector<ObjObject> read_obj(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError("file", path, "an OBJ file that can be read");
   std::vector<ObjObject> objects;
-  int base = 1;  // index of the current object's first vertex, file-wide
-  int seen = 0;  // vertices so far, file-wide
+  int base = 1;                    // index of the current object's first vertex, file-wide
+  int normal_base = 1;             // and of its first normal
+  int seen = 0, normals_seen = 0;  // vertices and normals so far, file-wide
   std::string line;
+  const auto bad = [&] { return InputError("file", path, "an OBJ file (bad line: " + line + ")"); };
   while (std::getline(in, line)) {
     std::istringstream items(line);
     std::string key;
@@ -65,23 +138,37 @@ std::vector<ObjObject> read_obj(const std::string& path) {
       if (objects.empty() || !objects.back().vertices.empty()) objects.emplace_back();
       items >> objects.back().name;
       base = seen + 1;
-    } else if (key == "v" || key == "f") {
-      if (objects.empty()) {
-        objects.emplace_back();
-        base = 1;
-      }
-      if (key == "v") {
+      normal_base = normals_seen + 1;
+    } else if (key == "v" || key == "vn" || key == "f") {
+      if (objects.empty()) objects.emplace_back();
+      if (key == "v" || key == "vn") {
         Vec3 v;
         items >> v.x() >> v.y() >> v.z();
-        objects.back().vertices.push_back(v);
-        ++seen;
+        if (key == "v") {
+          objects.back().vertices.push_back(v);
+          ++seen;
+        } else {
+          objects.back().normals.push_back(v);
+          ++normals_seen;
+        }
       } else {
         std::array<int, 3> t{};
-        items >> t[0] >> t[1] >> t[2];
-        for (int& i : t) i -= base;
+        for (int& i : t) {
+          std::string corner;
+          if (!(items >> corner)) throw bad();
+          const size_t slashes = corner.find("//");
+          try {
+            i = std::stoi(corner.substr(0, slashes)) - base;
+            if (slashes != std::string::npos &&
+                std::stoi(corner.substr(slashes + 2)) - normal_base != i)
+              throw bad();
+          } catch (const std::logic_error&) {  // stoi: no number
+            throw bad();
+          }
+        }
         objects.back().triangles.push_back(t);
       }
-      if (!items) throw InputError("file", path, "an OBJ file (bad line: " + line + ")");
+      if (!items) throw bad();
     }
   }
   return objects;

@@ -197,6 +197,8 @@ struct H5Recorder::Impl {
   std::vector<BodySeries> bodies;
   std::vector<h5::Series> observables, terrains, terrain_rotations;
   std::unique_ptr<h5::CheckpointWriter> checkpoint;
+  // Set by set_scene(): the scene JSON and integrator name to store at on_finish.
+  std::optional<std::pair<std::string, std::string>> changed_scene;
   long frames_received = 0;
   int block = 1;  // frames per flush block (block_frames)
 
@@ -711,6 +713,12 @@ void H5Recorder::on_finish(const Simulator& sim, const RunReport& report) {
     h5::write_attribute(par, "run_wall_seconds", report.wall_seconds);
     h5::write_attribute(par, "run_force_evaluations", report.force_evaluations);
     h5::write_attribute(par, "total_steps", sim.total_steps());
+    if (m.changed_scene) {
+      h5::write_attribute(par, "scene_json", m.changed_scene->first);
+      h5::write_attribute(par, "integrator", m.changed_scene->second);
+    }
+    if (m.checkpoint)
+      m.checkpoint->set_integrator(std::string(sim.integrator().name()), sim.options().dt);
     for (const auto& [name, value] : report.statistics) {
       h5::write_attribute(par, "statistics." + name, value);
     }
@@ -743,6 +751,10 @@ void H5Recorder::on_finish(const Simulator& sim, const RunReport& report) {
 void disable_hdf5_exit_cleanup() {
   std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
   H5dont_atexit();
+}
+
+void H5Recorder::set_scene(const std::string& scene_json, const std::string& integrator_name) {
+  impl_->changed_scene.emplace(scene_json, integrator_name);
 }
 
 const std::string& H5Recorder::path() const { return impl_->path; }

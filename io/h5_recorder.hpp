@@ -58,6 +58,12 @@ class H5Recorder final : public Observer {
   // terrains than it had then.
   void check_simulator(const Simulator& sim) const override;
 
+  // The scene the run goes on with after a live change (the viewer's panel: integrator, dt,
+  // coefficients, gravity, contact), stored as /parameters scene_json and integrator at the next
+  // on_finish(), so that a restart continues the run as it went on. (on_finish() always stores
+  // the checkpoint's integrator and dt as they are then.)
+  void set_scene(const std::string& scene_json, const std::string& integrator_name);
+
   const std::string& path() const;
   long frames() const;  // frames received so far
 

@@ -7,9 +7,10 @@
 namespace jelly {
 
 // Bytes of memory a simulation of `particles` particles and `springs` springs needs with the
-// named integrator, with a recorder when `recording`. Calibrated on measured peak resident
-// sizes (see the .cpp), linear in the counts: an estimate good to a factor of about 1.5 up to
-// n = 60, used to refuse runs that cannot fit, not to plan tight ones.
+// named integrator (with its default options), with a recorder when `recording`. Calibrated on
+// measured peak resident sizes (see the .cpp): linear in the counts but for projective
+// dynamics' factor; an estimate within a factor of 2 of the peak (tested per integrator), used
+// to refuse runs that cannot fit, not to plan tight ones.
 double estimate_memory_bytes(std::int64_t particles, std::int64_t springs,
                              const std::string& integrator, bool recording);
 

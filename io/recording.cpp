@@ -1,10 +1,12 @@
 #include <jelly/io/recording.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/io/detail/h5.hpp>
@@ -246,6 +248,36 @@ Recording read(hid_t file) {
 }
 
 }  // namespace
+
+std::vector<Real> exact_frame_times(const std::vector<Real>& time, Real dt, Real output_interval) {
+  std::vector<Real> exact(time);
+  if (!(dt > 0) || !std::isfinite(dt)) return exact;
+  const Real tolerance = 1e-3 * dt;
+  // The nearest multiple of `every`, when within the tolerance.
+  const auto snap = [&](Real t, Real every, Real& out) {
+    if (!(every > 0) || !std::isfinite(every)) return false;
+    const Real k = std::round(t / every);
+    if (std::abs(t - k * every) > tolerance) return false;
+    out = k * every;
+    return true;
+  };
+  for (Real& t : exact)
+    if (std::isfinite(t) && !snap(t, output_interval, t)) snap(t, dt, t);
+  return exact;
+}
+
+std::vector<Real> exact_frame_times(const Recording& recording) {
+  const auto number = [&](const char* name) {
+    const auto it = recording.attributes.find(name);
+    if (it == recording.attributes.end()) return 0.0;
+    try {
+      return std::stod(it->second);
+    } catch (const std::logic_error&) {
+      return 0.0;
+    }
+  };
+  return exact_frame_times(recording.time, number("dt"), number("output_interval"));
+}
 
 Recording read_recording(const std::string& path) {
   std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());

@@ -31,6 +31,14 @@ struct Recording {
   int frames() const { return static_cast<int>(time.size()); }
 };
 
+// The exact times of recorded frames. A recorded time is a sum of steps (2.9999999999997806);
+// one within dt / 1000 of a multiple k x output_interval is that product (3), else one within
+// dt / 1000 of a multiple of dt is that product; any other (adaptive steps) stays as recorded.
+// dt <= 0: as recorded.
+std::vector<Real> exact_frame_times(const std::vector<Real>& time, Real dt, Real output_interval);
+// Of a recording, with its /parameters dt and output_interval (as recorded when it has none).
+std::vector<Real> exact_frame_times(const Recording& recording);
+
 // Throws InputError naming the file when it is missing, not HDF5, or not a jelly recording.
 Recording read_recording(const std::string& path);
 // Creator and version, particles, springs per type, frames, time range, integrator, dt, run

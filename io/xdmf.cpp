@@ -8,8 +8,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <vector>
 
@@ -455,6 +457,15 @@ RecordingLayout inspect(hid_t file, const std::string& h5_path) {
   }
 
   r.time.resize(r.frames);
+  // The frames' exact times (k x output_interval, not the sum of the steps): the sidecar's
+  // <Time> values, and what ParaView shows as the time.
+  if (is_group(file, "parameters")) {
+    Handle par = h5::open_group(file, "parameters");
+    const auto number = [&](const char* name) {
+      return h5::has_attribute(par.get(), name) ? h5::read_double_attribute(par.get(), name) : 0.0;
+    };
+    r.time = exact_frame_times(r.time, number("dt"), number("output_interval"));
+  }
   for (TerrainInfo& t : r.terrains) {
     t.position.resize(r.frames);
     t.rotation.resize(r.frames, Eigen::Matrix3d::Identity());
@@ -964,6 +975,41 @@ void terrain_grids(Writer& w, hid_t file, const RecordingLayout& r, const Terrai
   out << "    </Grid>\n";
 }
 
+// The least and the largest speed of a set.
+struct SpeedRange {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  bool empty() const { return !(lo <= hi); }
+};
+
+// The speeds of every particle and surface vertex over every frame (the derived /xdmf arrays,
+// read a block at a time): the colour range that fits the whole run, where ParaView's default
+// takes frame 0's (all zero for a run that starts at rest).
+SpeedRange speed_range(hid_t file, const RecordingLayout& r) {
+  SpeedRange range;
+  const auto add = [&](const std::string& path) {
+    if (!h5::exists(file, path)) return;
+    Handle speed = h5::open_dataset(file, path);
+    const std::vector<hsize_t> dims = h5::dataset_dims(speed.get());
+    const hsize_t frames = std::min<hsize_t>(r.frames, dims.at(0));
+    const hsize_t width = dims.size() > 1 ? dims[1] : 1;
+    const hsize_t pass = frames_per_pass(4 * width);
+    for (hsize_t f0 = 0; f0 < frames; f0 += pass) {
+      const std::vector<float> rows =
+          read_rows<float>(speed.get(), f0, std::min(pass, frames - f0), H5T_NATIVE_FLOAT);
+      for (const float v : rows) {
+        range.lo = std::min<double>(range.lo, v);
+        range.hi = std::max<double>(range.hi, v);
+      }
+    }
+  };
+  for (const RecordedBody& body : r.bodies) {
+    add(body_path(body) + "/speed");
+    if (body.surface) add(surface_path(body) + "/speed");
+  }
+  return range;
+}
+
 }  // namespace
 
 std::string update_xdmf(hid_t file, const std::string& h5_path, const XdmfOptions& options) {
@@ -1011,6 +1057,9 @@ std::string update_xdmf(hid_t file, const std::string& h5_path, const XdmfOption
     if (update_terrain(file, r, t, bounds)) drawn.push_back(&t);
   }
   h5::write_attribute(root.get(), "frames", static_cast<long>(r.frames));
+  const SpeedRange speeds = speed_range(file, r);
+  if (!speeds.empty())
+    h5::write_attribute(root.get(), "speed_range", std::vector<double>{speeds.lo, speeds.hi});
 
   Writer w(r.h5_name);
   w.out() << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n";
@@ -1032,21 +1081,149 @@ std::string write_xdmf_for_recording(const std::string& h5_path, const XdmfOptio
   // are not finite, a dataset claiming more than it stores, a corrupt chunk) is an InputError
   // naming it and the dataset, before a sidecar describes it.
   (void)read_recording(h5_path);
-  h5::Handle file = h5::open_file(h5_path, true);
+  // The views go into a copy of the recording beside it, renamed onto it once written, flushed
+  // and closed: HDF5 writes in place, and a write that failed half way (a full disk) left a
+  // recording no reader could open (issue 44). The copy costs a read and a write of the file.
+  detail::FileReplacement copy(h5_path);
   std::string text;
   try {
+    std::filesystem::copy_file(h5_path, copy.temporary(),
+                               std::filesystem::copy_options::overwrite_existing);
+    h5::Handle file = h5::open_file(copy.temporary(), true);
     text = update_xdmf(file.get(), h5_path, options);
     check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush " + h5_path);
+    file.reset();
+    copy.commit();
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
-    // A failed write (a full disk), not bad input.
+    // A failed write (a full disk), not bad input; the recording is as it was.
     throw std::runtime_error("cannot write the XDMF views into '" + h5_path + "': " + e.what());
   }
   // Under a temporary name first: a failure leaves the old sidecar (or none), never half of one.
   const std::string xdmf_path = xdmf_path_for(h5_path);
   detail::replace_file(xdmf_path, text);
   return xdmf_path;
+}
+
+std::string paraview_state_path_for(const std::string& h5_path) {
+  const std::string xdmf = xdmf_path_for(h5_path);
+  return xdmf.substr(0, xdmf.size() - 5) + ".paraview.py";
+}
+
+namespace {
+
+// A Python string literal of `text` (UTF-8 passes through; quotes, backslashes and control
+// characters are escaped).
+std::string python_string(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", static_cast<unsigned char>(c));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string python_numbers(const std::vector<double>& values) {
+  std::string out = "[";
+  char number[40];
+  for (size_t k = 0; k < values.size(); ++k) {
+    std::snprintf(number, sizeof number, "%.17g", values[k]);
+    out += (k ? ", " : "") + std::string(number);
+  }
+  return out + "]";
+}
+
+}  // namespace
+
+std::string write_paraview_state(const std::string& h5_path) {
+  std::vector<double> bounds, speeds;
+  {
+    std::lock_guard<std::recursive_mutex> lock(h5::library_mutex());
+    h5::QuietErrors quiet;
+    h5::Handle file = h5::open_file(h5_path, false);
+    if (!is_group(file.get(), "xdmf"))
+      throw InputError("'" + h5_path + "' has no sidecar data (/xdmf): run `jelly xdmf " + h5_path +
+                       "` first");
+    Handle root = h5::open_group(file.get(), "xdmf");
+    for (const auto& [key, value] : h5::read_attributes_as_text(root.get())) {
+      std::istringstream text(value);
+      std::vector<double>* into = key == "bounds"        ? &bounds
+                                  : key == "speed_range" ? &speeds
+                                                         : nullptr;
+      for (double v; into != nullptr && text >> v;) into->push_back(v);
+    }
+  }
+  const std::string xdmf = xdmf_path_for(h5_path);
+  const std::string state = paraview_state_path_for(h5_path);
+  const std::string name = xdmf.substr(xdmf.rfind('/') + 1);
+  std::error_code error;
+  const std::string absolute = std::filesystem::absolute(xdmf, error).lexically_normal().string();
+
+  std::ostringstream py;
+  py << "# ParaView state of " << name.substr(0, name.size() - 5)
+     << ".h5, written by `jelly xdmf --state` (jelly writes\n"
+     << "# this file and never runs it). Load it with File > Load State (a Python state file), "
+        "with\n"
+     << "# `paraview --state=" << state.substr(state.rfind('/') + 1)
+     << "`, or run it with pvpython. It opens the XDMF sidecar beside\n"
+     << "# it with ParaView's default reader, colours every block by speed over the range of all\n"
+     << "# frames (not frame 0's), and points the camera at the bodies' bounding box over the "
+        "run.\n"
+     << "import os\n\nfrom paraview import simple\n\n"
+     << "SIDECAR = " << python_string(name) << "  # beside this file\n"
+     << "WRITTEN_AT = " << python_string(absolute) << "  # where it was when this was written\n";
+  // A constant speed (a run at rest) still gets a range ParaView can draw.
+  if (speeds.size() == 2 && !(speeds[1] > speeds[0])) speeds[1] = speeds[0] + 1;
+  py << "SPEED_RANGE = " << (speeds.size() == 2 ? python_numbers(speeds) : "None")
+     << "  # m/s, every particle and surface vertex over every frame\n"
+     << "BOUNDS = " << (bounds.size() == 6 ? python_numbers(bounds) : "None")
+     << "  # m: lo x, y, z, hi x, y, z of the bodies over the run\n\n"
+     << "try:\n"
+     << "    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), SIDECAR)\n"
+     << "except NameError:  # run where __file__ is not set\n"
+     << "    path = WRITTEN_AT\n"
+     << "if not os.path.exists(path):\n"
+     << "    path = WRITTEN_AT\n"
+     << "reader = simple.OpenDataFile(path)\n"
+     << "view = simple.GetActiveViewOrCreate(\"RenderView\")\n"
+     << "display = simple.Show(reader, view)\n"
+     << "simple.ColorBy(display, (\"POINTS\", \"speed\"))\n"
+     << "lut = simple.GetColorTransferFunction(\"speed\")\n"
+     << "if SPEED_RANGE is not None:\n"
+     << "    lut.AutomaticRescaleRangeMode = \"Never\"\n"
+     << "    lut.RescaleTransferFunction(SPEED_RANGE[0], SPEED_RANGE[1])\n"
+     << "    simple.GetOpacityTransferFunction(\"speed\").RescaleTransferFunction(SPEED_RANGE[0], "
+        "SPEED_RANGE[1])\n"
+     << "display.SetScalarBarVisibility(view, True)\n"
+     << "simple.GetScalarBar(lut, view).Title = \"speed (m/s)\"\n"
+     << "simple.GetAnimationScene().UpdateAnimationUsingDataTimeSteps()\n"
+     << "simple.Render(view)  # the first render resets the camera: it is set after\n"
+     << "if BOUNDS is not None:\n"
+     << "    # The box's centre, seen from the front, right and above, at the distance where its\n"
+     << "    # bounding sphere fills the 30-degree view angle.\n"
+     << "    centre = [0.5 * (BOUNDS[i] + BOUNDS[i + 3]) for i in range(3)]\n"
+     << "    radius = max(0.05, 0.5 * sum((BOUNDS[i + 3] - BOUNDS[i]) ** 2 for i in range(3)) ** "
+        "0.5)\n"
+     << "    distance = 1.05 * radius / 0.25881904510252074  # sin(15 degrees)\n"
+     << "    direction = [0.5, 0.4, 1.0]\n"
+     << "    norm = sum(d * d for d in direction) ** 0.5\n"
+     << "    view.CameraFocalPoint = centre\n"
+     << "    view.CameraPosition = [c + distance * d / norm for c, d in zip(centre, direction)]\n"
+     << "    view.CameraViewUp = [0.0, 1.0, 0.0]\n"
+     << "    view.CameraViewAngle = 30.0\n"
+     << "    view.CenterOfRotation = centre\n"
+     << "    simple.Render(view)\n";
+  detail::replace_file(state, py.str());
+  return state;
 }
 
 }  // namespace jelly

@@ -33,4 +33,15 @@ struct XdmfOptions {
 // path. Throws InputError for a missing or invalid file or options.
 std::string write_xdmf_for_recording(const std::string& h5_path, const XdmfOptions& options = {});
 
+// Where write_paraview_state puts the state of the recording at h5_path: <path without .h5>
+// .paraview.py beside it.
+std::string paraview_state_path_for(const std::string& h5_path);
+// Writes a ParaView Python state beside the recording whose sidecar was written (File > Load
+// State, `paraview --state=FILE`, or pvpython FILE): it opens the sidecar with ParaView's default
+// reader, colours by speed over the range of every frame (/xdmf attribute speed_range) and points
+// the camera at the bodies' bounding box over the whole run (/xdmf attribute bounds). The file is
+// data: jelly writes it and never runs it. Returns its path. Throws InputError when the
+// recording has no sidecar data (/xdmf) yet.
+std::string write_paraview_state(const std::string& h5_path);
+
 }  // namespace jelly

@@ -31,6 +31,9 @@ packages=(
   python3-build python3-venv
   # jelly.dlpack: arrays handed to torch/JAX without copies (DLPack's header only)
   libdlpack-dev
+  # `jelly export --gltf`: tinygltf builds and writes the glTF 2.0 file (its header and a small
+  # shared library; it reads JSON with nlohmann-json3-dev and images with libstb-dev, both above)
+  libtinygltf-dev
 )
 # `make docs` (scripts/build_docs.py): the site (mkdocs, its material theme), the C++ API
 # reference (doxygen), and the test that opens pages in headless Chromium (chromium, about

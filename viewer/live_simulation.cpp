@@ -6,9 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/io/h5_recorder.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly::viewer {
@@ -80,6 +82,7 @@ LiveSimulation::~LiveSimulation() {
   }
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
+  finish_recording();
 }
 
 void LiveSimulation::set_playing(bool playing) {
@@ -149,6 +152,69 @@ void LiveSimulation::set_drag(std::optional<AnchorSpring> drag) {
   wake_.notify_all();
 }
 
+void LiveSimulation::start_recording(const std::string& path) {
+  std::error_code error;
+  for (const std::string& p : {path, xdmf_path_for(path)})
+    if (std::filesystem::exists(p, error))
+      throw InputError("recording", p,
+                       "a file that does not exist yet (a recording never replaces a file)");
+  recording_ = true;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.record_to = path;
+    pending_.recording_request = ++recording_requests_;
+  }
+  wake_.notify_all();
+}
+
+void LiveSimulation::stop_recording() {
+  recording_ = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.record_to.reset();
+    pending_.stop_recording = true;
+    pending_.recording_request = ++recording_requests_;
+  }
+  wake_.notify_all();
+}
+
+void LiveSimulation::record_if_due() {
+  if (!recorder_) return;
+  const Real t = sim_->state().t, dt = sim_->options().dt;
+  if (t < record_next_ - 1e-9 * dt) return;
+  const Real interval = sim_scene_.output_interval > 0 ? sim_scene_.output_interval : 1.0 / 60;
+  try {
+    // The simulator's own output clock (which only run_until() moves) set to this frame, so
+    // that the checkpoints the recorder takes say when the next frame is due, as a run's do.
+    sim_->set_output_interval(interval);
+    recorder_->on_frame(*sim_);
+    ++record_frames_;
+  } catch (const std::exception& e) {
+    record_error_ = e.what();
+    finish_recording();
+    return;
+  }
+  while (record_next_ <= t + 1e-9 * dt) record_next_ += interval;
+}
+
+void LiveSimulation::finish_recording() {
+  if (!recorder_) return;
+  try {
+    if (record_scene_changed_)
+      recorder_->set_scene(scene_to_json(sim_scene_), sim_scene_.integrator.name);
+    RunReport report;
+    report.status = status_;
+    report.reason = message_;
+    report.t = sim_->state().t;
+    report.steps = steps_;
+    recorder_->on_finish(*sim_, report);
+  } catch (const std::exception& e) {
+    record_error_ = e.what();
+  }
+  recorder_.reset();
+  record_scene_changed_ = false;
+}
+
 void LiveSimulation::rebuild(const Scene& scene, bool keep_state) {
   State state;
   if (keep_state && sim_) state = sim_->state();
@@ -190,6 +256,13 @@ bool LiveSimulation::take_commands() {
   }
   bool changed = false;
   if (c.speed) speed_ = *c.speed;
+  if (c.recording_request > 0) {
+    record_request_ = c.recording_request;
+    changed = true;
+  }
+  // A recording is one run of one model: a stop, a reset or a new scene ends it (before the
+  // new scene or settings replace the ones it stores).
+  if (c.stop_recording || c.reset || c.scene) finish_recording();
   if (c.scene) {
     sim_scene_ = std::move(*c.scene);
     sim_settings_ = LiveSettings::of(sim_scene_);
@@ -207,6 +280,7 @@ bool LiveSimulation::take_commands() {
     // The running simulator takes the new settings and goes on from the current state; a reset
     // rebuilds it from the scene with them.
     sim_scene_ = c.settings->applied_to(std::move(sim_scene_));
+    if (recorder_) record_scene_changed_ = true;
     if (!c.reset) apply_live(*c.settings);
     sim_settings_ = *c.settings;
     changed = true;
@@ -222,6 +296,23 @@ bool LiveSimulation::take_commands() {
   if (c.playing) {
     sim_playing_ = *c.playing && !stopped_;
     changed = true;
+  }
+  if (c.record_to) {
+    finish_recording();
+    record_error_.clear();
+    record_frames_ = 0;
+    record_path_ = *c.record_to;
+    try {
+      RecorderOptions options;
+      options.scene_json = scene_to_json(sim_scene_);
+      options.integrator_name = sim_scene_.integrator.name;
+      recorder_ = std::make_unique<H5Recorder>(record_path_, *sim_, options);
+      record_next_ = sim_->state().t;
+      record_if_due();
+    } catch (const std::exception& e) {
+      record_error_ = e.what();
+      recorder_.reset();
+    }
   }
   if (c.step && !stopped_) {
     step();
@@ -252,9 +343,11 @@ bool LiveSimulation::step() {
   if (status_ != RunStatus::kCompleted) {
     stopped_ = true;
     sim_playing_ = false;
+    finish_recording();  // with the guard's reason as the run's
     return false;
   }
   ++steps_;
+  record_if_due();
   return true;
 }
 
@@ -296,6 +389,11 @@ void LiveSimulation::publish() {
   f.playing = sim_playing_;
   f.status = status_;
   f.message = message_;
+  f.recording = recorder_ != nullptr;
+  f.recording_path = record_path_;
+  f.recorded_frames = record_frames_;
+  f.recording_error = record_error_;
+  f.recording_request = record_request_;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     std::swap(back_, middle_);
@@ -311,7 +409,10 @@ bool LiveSimulation::refresh() {
     std::swap(front_, middle_);
     fresh_ = false;
   }
-  if (!frames_[front_].playing && frames_[front_].generation == generation_) playing_ = false;
+  const LiveFrame& f = frames_[front_];
+  if (!f.playing && f.generation == generation_) playing_ = false;
+  // The simulation ended the recording itself (a reset, a stop, a failed write).
+  if (f.recording_request == recording_requests_ && !f.recording) recording_ = false;
   return true;
 }
 

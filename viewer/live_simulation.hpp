@@ -19,6 +19,10 @@
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/run_report.hpp>
 
+namespace jelly {
+class H5Recorder;
+}
+
 namespace jelly::viewer {
 
 // What the panel edits; a change is applied to the running simulator through its live setters
@@ -52,6 +56,13 @@ struct LiveFrame {
   bool playing = false;
   RunStatus status = RunStatus::kCompleted;  // kDiverged or kSolverFailed stop the simulation
   std::string message;                       // the divergence guard's or solver's reason
+  // The recording of the live run (start_recording): its file while it records, else the last
+  // one finished; its frames; why it could not be made or written.
+  bool recording = false;
+  std::string recording_path;
+  long recorded_frames = 0;
+  std::string recording_error;
+  long recording_request = 0;  // the last start_recording() or stop_recording() taken
 };
 
 class LiveSimulation {
@@ -77,6 +88,18 @@ class LiveSimulation {
   void apply(const LiveSettings& settings);
   // The mouse drag (an anchor spring), or none.
   void set_drag(std::optional<AnchorSpring> drag);
+
+  // Records the run from its current state on to `path`, as `jelly run -o` records (io/
+  // h5_recorder.hpp, with its XDMF sidecar): a frame now and one every output interval of
+  // simulated time, drags and panel changes included; the scene as it goes on (after panel
+  // changes) is stored at the end, so the file replays and restarts like any recording.
+  // Throws InputError when `path` (or its sidecar) exists: a recording never replaces a file.
+  // A reset, a new scene, stop_recording() or the end of the simulation finishes the file; a
+  // failure to create or write it shows in LiveFrame::recording_error.
+  void start_recording(const std::string& path);
+  void stop_recording();
+  // UI side: whether a recording was asked for and not stopped since.
+  bool recording() const { return recording_; }
 
   // Lockstep (not threaded): steps until the time reaches t_end (within dt / 2, as
   // Simulator::run_until) unless stopped, then publishes.
@@ -104,6 +127,9 @@ class LiveSimulation {
     bool drag_changed = false;
     std::optional<AnchorSpring> drag;
     std::optional<double> speed;
+    std::optional<std::string> record_to;  // start recording to this path
+    bool stop_recording = false;
+    long recording_request = 0;  // 0: no recording command
   };
   void loop();
   // Applies pending commands on the simulation side; true if anything changed.
@@ -115,12 +141,17 @@ class LiveSimulation {
   // One step with the divergence check; false when the simulation stopped.
   bool step();
   void publish();
+  // Simulation side: the recorder's frame when one is due, and the end of the recording.
+  void record_if_due();
+  void finish_recording();
 
   // UI side.
   Scene scene_;
   LiveSettings settings_;
   unsigned long generation_ = 1;
   bool playing_ = false;
+  bool recording_ = false;
+  long recording_requests_ = 0;
 
   // Shared, under mutex_.
   std::mutex mutex_;
@@ -143,6 +174,12 @@ class LiveSimulation {
   std::string message_;
   double speed_ = 1;
   std::optional<AnchorSpring> drag_;
+  std::unique_ptr<H5Recorder> recorder_;
+  Real record_next_ = 0;  // simulated time of the next recorded frame
+  std::string record_path_, record_error_;
+  long record_frames_ = 0;
+  long record_request_ = 0;
+  bool record_scene_changed_ = false;  // the panel changed the run's settings while recording
   // Rate measurement: steps and simulated time at the start of the window.
   double rate_wall_ = 0;
   long rate_steps_ = 0;

@@ -53,8 +53,27 @@ void RecordingView::update(int k, RenderScene& scene) const {
   builder_->update(recording_.position[k], recording_.time[k], scene);
 }
 
+namespace {
+
+// The frames a camera's sight lines are checked at: at most eight, evenly through `frames`.
+std::vector<int> sight_frames(const std::vector<int>& frames) {
+  std::vector<int> out;
+  const size_t count = std::min<size_t>(8, frames.size());
+  for (size_t i = 0; i < count; ++i)
+    out.push_back(frames[i * (frames.size() - 1) / std::max<size_t>(count - 1, 1)]);
+  return out;
+}
+
+}  // namespace
+
 Camera RecordingView::default_camera(float aspect) const {
-  return framing_camera(lo_, hi_, builder_->terrains(), recording_.time.front(), aspect);
+  std::vector<int> all(static_cast<size_t>(frames()));
+  for (int k = 0; k < frames(); ++k) all[static_cast<size_t>(k)] = k;
+  Sight sight;
+  for (const int k : sight_frames(all))
+    add_sight_points(recording_.position[static_cast<size_t>(k)], builder_->terrains(),
+                     recording_.time[static_cast<size_t>(k)], 24, sight.points);
+  return framing_camera(lo_, hi_, builder_->terrains(), recording_.time.front(), aspect, {sight});
 }
 
 RecordingView::Follow::Follow(const RecordingView& view, const std::vector<int>& frames,
@@ -71,8 +90,20 @@ RecordingView::Follow::Follow(const RecordingView& view, const std::vector<int>&
   Vec3 lo, hi;
   bounds_of(position[static_cast<size_t>(first)], lo, hi);
   const Vec3 centre = 0.5 * (lo + hi);
+  // The bodies seen where the camera will be at a few of the frames.
+  std::vector<Sight> sights;
+  for (const int k : sight_frames(frames)) {
+    const VecX& x = position[static_cast<size_t>(k)];
+    Vec3 a, b;
+    bounds_of(x, a, b);
+    Sight sight;
+    sight.shift = (0.5 * (a + b) - centre).cast<float>();
+    add_sight_points(x, view.builder().terrains(), view.recording().time[static_cast<size_t>(k)],
+                     24, sight.points);
+    sights.push_back(std::move(sight));
+  }
   base_ = framing_camera(centre - 0.5 * extent, centre + 0.5 * extent, view.builder().terrains(),
-                         view.recording().time[static_cast<size_t>(first)], aspect);
+                         view.recording().time[static_cast<size_t>(first)], aspect, sights, false);
   offset_ = base_.target - centre.cast<float>();
 }
 
@@ -82,26 +113,6 @@ Camera RecordingView::Follow::at(int k) const {
   Camera camera = base_;
   camera.target = (0.5 * (lo + hi)).cast<float>() + offset_;
   return camera;
-}
-
-Camera framing_camera(const Vec3& lo, const Vec3& hi, const Terrains& terrains, Real t,
-                      float aspect) {
-  Vec3 a = lo, b = hi;
-  const Vec3 centre = 0.5 * (lo + hi);
-  // The highest terrain surface below the centre: y where signed_distance vanishes, along -y.
-  Real ground = -std::numeric_limits<Real>::infinity();
-  for (const auto& terrain : terrains) {
-    const Vec3 n = terrain->normal(centre, t);
-    if (n.y() < 0.1) continue;
-    const Real y = centre.y() - terrain->signed_distance(centre, t) / n.y();
-    const Vec3 foot(centre.x(), y, centre.z());
-    if (y <= centre.y() && terrain->can_contact(foot, t)) ground = std::max(ground, y);
-  }
-  if (std::isfinite(ground)) {
-    a.y() = std::min(a.y(), ground);
-    b.y() = std::max(b.y(), ground);
-  }
-  return frame_box(a.cast<float>(), b.cast<float>(), aspect, -20, 18);
 }
 
 }  // namespace jelly::viewer

@@ -8,6 +8,7 @@
 
 #include <jelly/io/recording.hpp>
 #include <jelly/viewer/camera.hpp>
+#include <jelly/viewer/framing.hpp>
 #include <jelly/viewer/scene_builder.hpp>
 
 namespace jelly::viewer {
@@ -37,7 +38,8 @@ class RecordingView {
   Camera default_camera(float aspect) const;
   // A camera that follows the bodies over `frames` (a video's): follow_camera(k) frames the
   // bodies at frame k at the size of their largest extent over `frames`, from the default
-  // direction; its target moves with the centre of their bounds, so they stay large.
+  // direction (not the ground below them: they fill more of the picture); its target moves with
+  // the centre of their bounds, so they stay large.
   class Follow {
    public:
     Follow(const RecordingView& view, const std::vector<int>& frames, float aspect);
@@ -54,10 +56,5 @@ class RecordingView {
   std::unique_ptr<SceneBuilder> builder_;
   Vec3 lo_, hi_;
 };
-
-// The camera that frames particles in [lo, hi] and the ground below their centre (the first
-// terrain surface straight down), from the viewer's default direction.
-Camera framing_camera(const Vec3& lo, const Vec3& hi, const Terrains& terrains, Real t,
-                      float aspect);
 
 }  // namespace jelly::viewer

@@ -31,7 +31,9 @@ struct TerrainView {
   std::vector<std::array<int, 3>> triangles;
   Mat4f pose = Mat4f::Identity();
   Vec3f color{0.63f, 0.65f, 0.67f};
-  bool casts_shadow = false;  // finite obstacles do; the ground does not
+  // Finite obstacles (a sphere, a bowl, the elevator) cast shadows and are drawn plainly
+  // shaded; the ground (planes) casts none and carries the grid.
+  bool casts_shadow = false;
 };
 
 enum class SpringColoring { kType, kStrain };

@@ -79,17 +79,26 @@ void RenderTarget::resolve() {
 }
 
 void RenderTarget::read_rgb(std::vector<std::uint8_t>& out) {
-  const size_t row = static_cast<size_t>(width_) * 3;
+  // Read as RGBA, the framebuffer's own format (a plain copy in Mesa, where RGB takes a
+  // per-pixel conversion path), then dropped to RGB while the rows are turned top-down.
+  const size_t row = static_cast<size_t>(width_) * 3, row4 = static_cast<size_t>(width_) * 4;
   const size_t size = row * static_cast<size_t>(height_);
-  if (rows_.size() != size) rows_.resize(size);
+  if (rows_.size() != row4 * static_cast<size_t>(height_))
+    rows_.resize(row4 * static_cast<size_t>(height_));
   if (out.size() != size) out.resize(size);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, width_, height_, GL_RGB, GL_UNSIGNED_BYTE, rows_.data());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, rows_.data());
   glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
-  for (int y = 0; y < height_; ++y)
-    std::memcpy(out.data() + row * static_cast<size_t>(y),
-                rows_.data() + row * static_cast<size_t>(height_ - 1 - y), row);
+  for (int y = 0; y < height_; ++y) {
+    const std::uint8_t* from = rows_.data() + row4 * static_cast<size_t>(height_ - 1 - y);
+    std::uint8_t* to = out.data() + row * static_cast<size_t>(y);
+    for (int x = 0; x < width_; ++x, from += 4, to += 3) {
+      to[0] = from[0];
+      to[1] = from[1];
+      to[2] = from[2];
+    }
+  }
 }
 
 void RenderTarget::blit_to(unsigned target) {

@@ -38,7 +38,7 @@ class RenderTarget {
   int width_ = 0, height_ = 0, samples_ = 1;
   unsigned draw_fbo_ = 0, color_rbo_ = 0, depth_rbo_ = 0;
   unsigned resolve_fbo_ = 0, resolve_rbo_ = 0;
-  std::vector<std::uint8_t> rows_;  // bottom-up scratch
+  std::vector<std::uint8_t> rows_;  // bottom-up RGBA scratch
 };
 
 }  // namespace jelly::viewer

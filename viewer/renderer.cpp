@@ -425,6 +425,7 @@ struct Renderer::Gpu {
 
   unsigned long topology = ~0ul;
   std::vector<MeshBuffers> bodies, terrains;
+  std::vector<Eigen::AlignedBox3f> terrain_bounds;  // each terrain's mesh in its own frame
   MeshBuffers floor;
   GLuint particle_vao = 0, particle_vbo = 0, particle_tbo = 0;
   GLsizei particle_count = 0;
@@ -463,6 +464,7 @@ struct Renderer::Gpu {
     for (MeshBuffers& m : terrains) m.destroy();
     bodies.clear();
     terrains.clear();
+    terrain_bounds.clear();
     glDeleteVertexArrays(1, &particle_vao);
     glDeleteBuffers(1, &particle_vbo);
     glDeleteTextures(1, &particle_tbo);
@@ -484,6 +486,10 @@ struct Renderer::Gpu {
       MeshBuffers& m = terrains.back();
       m.create(static_cast<int>(terrain.vertices.size() / 3), terrain.triangles, false);
       m.update(terrain.vertices.data(), terrain.triangles);
+      Eigen::AlignedBox3f box;
+      for (size_t v = 0; v + 2 < terrain.vertices.size(); v += 3)
+        box.extend(Vec3f(terrain.vertices[v], terrain.vertices[v + 1], terrain.vertices[v + 2]));
+      terrain_bounds.push_back(box);
     }
     // Particles: one buffer, read as vertices (points) and as a texture buffer (springs).
     particle_count = static_cast<GLsizei>(scene.particles.size() / 3);
@@ -621,6 +627,19 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
     Vec3f lo, hi;
     scene.particle_bounds(lo, hi);
     if (!(lo.x() <= hi.x())) lo = hi = Vec3f::Zero();
+    // The obstacles' shadows whole too (not cut where the map would end), at their poses.
+    for (size_t t = 0; t < g.terrains.size(); ++t) {
+      const Eigen::AlignedBox3f& box = g.terrain_bounds[t];
+      if (!scene.terrains[t].casts_shadow || box.isEmpty()) continue;
+      for (int corner = 0; corner < 8; ++corner) {
+        const Vec3f local((corner & 1) ? box.max().x() : box.min().x(),
+                          (corner & 2) ? box.max().y() : box.min().y(),
+                          (corner & 4) ? box.max().z() : box.min().z());
+        const Vec3f p = (scene.terrains[t].pose * local.homogeneous()).head<3>();
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+    }
     const Vec3f centre = 0.5f * (lo + hi);
     const float size = (hi - lo).norm();
     const float reach = std::min(12.0f, std::max(2.0f, 2.0f * size));  // how far below
@@ -708,8 +727,10 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
     set(p.extent, scene.ground_extent);
     return p;
   };
+  // The ground (planes and the floor) with its grid; obstacles apart, plainly shaded.
   const auto draw_ground = [&](Program& p) {
     for (size_t t = 0; t < g.terrains.size(); ++t) {
+      if (scene.terrains[t].casts_shadow) continue;
       set(p.model, scene.terrains[t].pose);
       set(p.color, linear(scene.terrains[t].color));
       g.terrains[t].draw();
@@ -726,26 +747,54 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
       g.floor.draw();
     }
   };
-  if (!g.terrains.empty() || scene.floor) {
-    draw_ground(use_mesh(false, options_.grid, false));
-    if (shadows && shadow_rect[2] > shadow_rect[0] && shadow_rect[3] > shadow_rect[1]) {
-      // The same triangles again, shadowed, where shadows can fall (same depth: gl_Position is
-      // invariant).
-      glEnable(GL_SCISSOR_TEST);
-      glScissor(shadow_rect[0], shadow_rect[1], shadow_rect[2] - shadow_rect[0],
-                shadow_rect[3] - shadow_rect[1]);
-      glDepthFunc(GL_LEQUAL);
-      draw_ground(use_mesh(true, options_.grid, false));
-      glDepthFunc(GL_LESS);
-      glDisable(GL_SCISSOR_TEST);
-    }
-  }
+  // Front to back, roughly: the bodies, the obstacles, then the ground, so that the ground's
+  // pixels the others cover fail the depth test before its shader runs (early depth test; the
+  // ground is most of the picture and llvmpipe's cost is per shaded pixel).
   if (scene.show_surfaces && !g.bodies.empty()) {
     Program& p = use_mesh(shadows, false, true);
     set(p.model, Mat4f(Mat4f::Identity()));
     for (size_t b = 0; b < g.bodies.size(); ++b) {
       set(p.color, linear(scene.bodies[b].color));
       g.bodies[b].draw();
+    }
+  }
+  bool obstacles = false;
+  for (const TerrainView& t : scene.terrains) obstacles = obstacles || t.casts_shadow;
+  if (obstacles) {
+    Program& p = use_mesh(shadows, false, true);
+    for (size_t t = 0; t < g.terrains.size(); ++t) {
+      if (!scene.terrains[t].casts_shadow) continue;
+      set(p.model, scene.terrains[t].pose);
+      set(p.color, linear(scene.terrains[t].color));
+      g.terrains[t].draw();
+    }
+  }
+  // The ground and the sky without multisampling: one coverage and depth sample per pixel for
+  // most of the picture (multisampled rasterization is most of llvmpipe's cost); their own
+  // edges meet at the faded horizon, and the bodies' edges over them stay smooth (their samples
+  // were written first).
+  glDisable(GL_MULTISAMPLE);
+  if (!g.terrains.empty() || scene.floor) {
+    const auto [x0, y0, x1, y1] = shadow_rect;
+    if (shadows && x1 > x0 && y1 > y0) {
+      // Each pixel of the ground shaded once: with shadows inside the rectangle they can fall
+      // in, without them in the (up to four) bands around it.
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(x0, y0, x1 - x0, y1 - y0);
+      draw_ground(use_mesh(true, options_.grid, false));
+      Program& plain = use_mesh(false, options_.grid, false);
+      const std::array<std::array<int, 4>, 4> bands{{{0, 0, width, y0},
+                                                     {0, y1, width, height - y1},
+                                                     {0, y0, x0, y1 - y0},
+                                                     {x1, y0, width - x1, y1 - y0}}};
+      for (const auto& b : bands) {
+        if (b[2] <= 0 || b[3] <= 0) continue;
+        glScissor(b[0], b[1], b[2], b[3]);
+        draw_ground(plain);
+      }
+      glDisable(GL_SCISSOR_TEST);
+    } else {
+      draw_ground(use_mesh(false, options_.grid, false));
     }
   }
 
@@ -759,6 +808,7 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDepthMask(GL_TRUE);
   glDepthFunc(GL_LESS);
+  glEnable(GL_MULTISAMPLE);
 
   // Springs, read from the particle buffer as a texture.
   if (scene.show_springs && g.spring_vertices > 0) {

@@ -1,6 +1,7 @@
 #pragma once
 // Draws a RenderScene seen by a Camera into whatever framebuffer is bound: lit surfaces with
-// shadows from a directional light (a shadow map fitted to the bodies), terrains with a grid,
+// shadows from a directional light (a shadow map fitted to the bodies and the obstacles), the
+// ground with a grid, obstacles in a plain shaded material,
 // particles as shaded spheres, springs coloured by type or strain, the drag line and a sky
 // gradient. The live window, the screenshot and `jelly render` share it. Needs a current
 // OpenGL 3.3 core context; GPU buffers are made when the scene's topology changes and only
@@ -15,7 +16,7 @@ namespace jelly::viewer {
 struct RenderOptions {
   bool shadows = true;
   int shadow_map_size = 1024;
-  bool grid = true;                                   // grid lines on terrains and the floor
+  bool grid = true;  // grid lines on the ground (planes, the floor); never on obstacles
   Vec3f light_direction = Vec3f(0.35f, 1.0f, 0.25f);  // towards the light
   Vec3f sky_top{0.50f, 0.64f, 0.80f};
   Vec3f sky_bottom{0.86f, 0.89f, 0.93f};

@@ -29,6 +29,13 @@ BodySurface all_particles(const Model& model) {
 
 }  // namespace
 
+Vec3 palette_color(int index) {
+  static const Vec3 kColors[] = {
+      {0.85, 0.13, 0.22}, {0.16, 0.45, 0.85}, {0.95, 0.62, 0.10}, {0.20, 0.66, 0.34}};
+  const int n = static_cast<int>(sizeof kColors / sizeof kColors[0]);
+  return kColors[((index % n) + n) % n];
+}
+
 void BodySurface::vertices(const VecX& x, float* out) const {
   const int count = num_vertices();
   for (int v = 0; v < count; ++v) {

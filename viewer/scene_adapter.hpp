@@ -32,6 +32,10 @@ struct BodySurface : Surface {
   void vertices(const VecX& x, double* out) const;
 };
 
+// The colour (sRGB in [0, 1]) of the body at `index` when it has none of its own: a palette of
+// four, the seed jelly's raspberry red first.
+Vec3 palette_color(int index);
+
 // Every body of `model` with its render surface (empty for a body without one).
 std::vector<BodySurface> body_surfaces(const Model& model);
 // The bodies of a recording: its model's; for a file that holds none, those of the scene it was

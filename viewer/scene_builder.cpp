@@ -14,10 +14,6 @@ unsigned long next_topology() {
   return ++counter;
 }
 
-// Body colours: the seed jelly's raspberry red first.
-const Vec3f kBodyColors[] = {
-    {0.85f, 0.13f, 0.22f}, {0.16f, 0.45f, 0.85f}, {0.95f, 0.62f, 0.10f}, {0.20f, 0.66f, 0.34f}};
-
 }  // namespace
 
 void bounds_of(const VecX& x, Vec3& lo, Vec3& hi) {
@@ -83,8 +79,8 @@ RenderScene SceneBuilder::make_scene(const VecX& x, Real t) const {
     body.name = surfaces_[b].name;
     body.triangles = surfaces_[b].triangles;
     body.positions.assign(static_cast<size_t>(3 * surfaces_[b].num_vertices()), 0.0f);
-    body.color = surfaces_[b].color ? Vec3f(surfaces_[b].color->cast<float>())
-                                    : kBodyColors[b % (sizeof kBodyColors / sizeof kBodyColors[0])];
+    body.color = (surfaces_[b].color ? *surfaces_[b].color : palette_color(static_cast<int>(b)))
+                     .cast<float>();
     body.first_particle = surfaces_[b].first_particle;
     body.num_particles = surfaces_[b].num_particles;
     scene.bodies.push_back(std::move(body));

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -22,6 +23,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
+#include <jelly/viewer/detail/ray_triangle.hpp>
 #include <jelly/viewer/image_io.hpp>
 #include <jelly/viewer/recording_view.hpp>
 #include <jelly/viewer/render_target.hpp>
@@ -129,21 +131,7 @@ void plot(const char* id, const std::vector<const History*>& series,
   }
 }
 
-// Möller-Trumbore: the ray parameter of the hit with triangle (a, b, c), or a negative value.
-float ray_triangle(const Vec3f& o, const Vec3f& d, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
-  const Vec3f e1 = b - a, e2 = c - a;
-  const Vec3f p = d.cross(e2);
-  const float det = e1.dot(p);
-  if (std::abs(det) < 1e-12f) return -1;
-  const float inv = 1.0f / det;
-  const Vec3f s = o - a;
-  const float u = s.dot(p) * inv;
-  if (u < 0 || u > 1) return -1;
-  const Vec3f q = s.cross(e1);
-  const float v = d.dot(q) * inv;
-  if (v < 0 || u + v > 1) return -1;
-  return e2.dot(q) * inv;
-}
+using detail::ray_triangle;
 
 std::vector<std::string> scenes_beside(const std::string& path) {
   std::vector<std::string> out;
@@ -155,6 +143,26 @@ std::vector<std::string> scenes_beside(const std::string& path) {
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+// A new file in `folder`: jelly-<local date>-<time><extension>, with -2, -3, ... before the
+// extension when that name (or, for a recording, its XDMF sidecar) is taken.
+std::string new_file_name(const std::string& folder, const std::string& extension) {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "jelly-%Y%m%d-%H%M%S", &local);
+  std::error_code error;
+  for (int k = 1;; ++k) {
+    const std::string name = std::string(stamp) + (k > 1 ? "-" + std::to_string(k) : "");
+    const std::filesystem::path path = std::filesystem::path(folder) / (name + extension);
+    if (std::filesystem::exists(path, error)) continue;
+    if (extension == ".h5" &&
+        std::filesystem::exists(std::filesystem::path(folder) / (name + ".xdmf"), error))
+      continue;
+    return path.string();
+  }
 }
 
 constexpr ImU32 kRed = IM_COL32(235, 90, 80, 255), kGreen = IM_COL32(110, 200, 110, 255),
@@ -207,6 +215,9 @@ struct ViewerWindow::Impl {
   std::optional<PanelRect> banner_rect;    // the divergence banner, last frame
   PanelRect panel_rect;                    // the panel, last frame (empty when hidden)
   bool follow = false;  // the camera's target follows the bodies (default without --camera)
+  // Recording (live) and screenshots (F12): the current or last files, the last failure.
+  std::string record_path, screenshot_path, record_message;
+  bool screenshot_pending = false;
 
   // Mouse.
   enum class Drag { kNone, kOrbit, kPan, kParticle } drag = Drag::kNone;
@@ -355,9 +366,13 @@ struct ViewerWindow::Impl {
     } else {
       Vec3 lo, hi;
       bounds_of(positions, lo, hi);
-      camera = framing_camera(lo, hi, builder->terrains(), 0, aspect());
+      // The bodies and where they will land seen (not hidden in a bowl).
+      Sight sight;
+      add_sight_points(positions, builder->terrains(), 0, 48, sight.points);
+      camera = framing_camera(lo, hi, builder->terrains(), 0, aspect(), {sight});
     }
     follow = options.camera.empty();  // a camera of the user's own stays where it was put
+    if (options.record) toggle_recording();
     if (!options.paused && !options.lockstep) live->set_playing(true);
   }
 
@@ -613,11 +628,61 @@ struct ViewerWindow::Impl {
       case GLFW_KEY_L:
         scene.show_springs = !scene.show_springs;
         break;
+      case GLFW_KEY_F9:
+        toggle_recording();
+        break;
+      case GLFW_KEY_F12:
+        screenshot_pending = true;  // taken when this frame is drawn
+        break;
       case GLFW_KEY_ESCAPE:
         glfwSetWindowShouldClose(window, GLFW_TRUE);
         break;
       default:
         break;
+    }
+  }
+
+  void toggle_recording() {
+    if (!live) return;
+    if (live->recording()) {
+      live->stop_recording();
+      return;
+    }
+    try {
+      const std::string path = new_file_name(options.record_dir, ".h5");
+      live->start_recording(path);
+      record_path = path;
+      record_message.clear();
+    } catch (const InputError& e) {
+      record_message = e.what();
+    }
+  }
+
+  // The Record button, the screenshot button and what they wrote.
+  void record_lines() {
+    if (live) {
+      if (ImGui::Button(live->recording() ? "Stop recording" : "Record")) toggle_recording();
+      ImGui::SameLine();
+    }
+    if (ImGui::Button("Screenshot")) screenshot_pending = true;
+    ImGui::SameLine();
+    ImGui::TextDisabled(live ? "F9, F12" : "F12");
+    if (live) {
+      const LiveFrame& f = live->front();
+      if (live->recording() || f.recording) {
+        ImGui::TextColored(ImVec4(1, 0.3f, 0.25f, 1), "REC %s: %ld frames", record_path.c_str(),
+                           f.recorded_frames);
+      } else if (!f.recording_path.empty() && f.recording_error.empty()) {
+        ImGui::TextDisabled("recorded %s (%ld frames)", f.recording_path.c_str(),
+                            f.recorded_frames);
+      }
+      if (!f.recording_error.empty()) record_message = f.recording_error;
+    }
+    if (!screenshot_path.empty()) ImGui::TextDisabled("screenshot %s", screenshot_path.c_str());
+    if (!record_message.empty()) {
+      ImGui::PushTextWrapPos(0);
+      ImGui::TextColored(ImVec4(1, 0.6f, 0.2f, 1), "%s", record_message.c_str());
+      ImGui::PopTextWrapPos();
     }
   }
 
@@ -694,6 +759,7 @@ struct ViewerWindow::Impl {
                 f.sim_seconds_per_second);
     ImGui::Text("step %.3f ms", f.step_milliseconds);
     timing_lines();
+    record_lines();
     if (f.status != RunStatus::kCompleted) {
       ImGui::PushTextWrapPos(0);
       ImGui::TextColored(ImVec4(1, 0.35f, 0.3f, 1), "Stopped: %s. Reset to go on.",
@@ -860,6 +926,7 @@ struct ViewerWindow::Impl {
     ImGui::SliderFloat("speed", &replay_speed, 0.05f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic);
     ImGui::Text("t = %.4f s, step %ld", r.time[replay_frame], r.step[replay_frame]);
     timing_lines();
+    record_lines();
     display_section();
     if (!series.empty() && ImGui::CollapsingHeader("Observables", ImGuiTreeNodeFlags_DefaultOpen)) {
       for (const auto& [name, values] : series) {
@@ -1012,6 +1079,16 @@ struct ViewerWindow::Impl {
 
     const bool last = options.frames >= 0 && frames_shown >= options.frames;
     if (last && !options.screenshot.empty()) save_screenshot(options.screenshot);
+    if (screenshot_pending) {
+      screenshot_pending = false;
+      const std::string path = new_file_name(options.record_dir, ".png");
+      try {
+        save_screenshot(path);
+        screenshot_path = path;
+      } catch (const std::exception& e) {
+        record_message = e.what();
+      }
+    }
     glfwSwapBuffers(window);
     if (frames_shown > 0) frame_cpu_sum += thread_cpu_seconds() - frame_cpu_start;
     ++frames_shown;
@@ -1099,6 +1176,15 @@ void ViewerWindow::mouse_button(int button, bool press, double x, double y, int 
 }
 void ViewerWindow::cursor(double x, double y) { impl_->cursor(x, y); }
 void ViewerWindow::scroll(double dy) { impl_->scroll(dy); }
+void ViewerWindow::key(int glfw_key) { impl_->key(glfw_key); }
+void ViewerWindow::toggle_recording() { impl_->toggle_recording(); }
+std::string ViewerWindow::recording_path() const { return impl_->record_path; }
+std::string ViewerWindow::last_screenshot() const { return impl_->screenshot_path; }
+std::string ViewerWindow::recording_error() const {
+  if (impl_->live && !impl_->live->front().recording_error.empty())
+    return impl_->live->front().recording_error;
+  return impl_->record_message;
+}
 void ViewerWindow::request_close() { glfwSetWindowShouldClose(impl_->window, GLFW_TRUE); }
 Camera& ViewerWindow::camera() { return impl_->camera; }
 int ViewerWindow::width() const { return impl_->fb_width; }

@@ -4,7 +4,7 @@
 // shared Renderer through a RenderTarget. Mouse: left drag on a body drags the particle under
 // the cursor with a spring (live), elsewhere orbits; right or middle drag (or shift + left) pans;
 // the wheel zooms. Keys: space play/pause, S step, R reset, H hide the panel, P particles,
-// L springs, Esc close.
+// L springs, F9 record on/off (live), F12 screenshot, Esc close.
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -32,6 +32,11 @@ struct ViewOptions {
   // window's thread (deterministic screenshots); set when a screenshot is asked for.
   bool lockstep = false;
   bool stats = false;  // print frame, render and simulation timings at exit
+  // Live: record from the first frame (as F9 or the Record button do later). Recordings and
+  // F12 screenshots go to record_dir, named jelly-<date>-<time>[-k].{h5,png}; none replaces a
+  // file.
+  bool record = false;
+  std::string record_dir = ".";
 };
 
 // No display, or no OpenGL 3.3 context on it: the CLI says so and exits 2.
@@ -69,6 +74,8 @@ class ViewerWindow {
   void mouse_button(int button, bool press, double x, double y, int mods = 0);
   void cursor(double x, double y);
   void scroll(double dy);
+  // A key press (a GLFW key code), as the key callback delivers it.
+  void key(int glfw_key);
   // What the close button does.
   void request_close();
 
@@ -88,6 +95,13 @@ class ViewerWindow {
   const std::vector<std::string>& clipped_panel_items() const;
   // Writes the last drawn frame (with the panel, unless hidden) as PNG.
   void save_screenshot(const std::string& path);
+  // Live: starts or stops recording (the Record button, F9); the file of the current or last
+  // recording, and of the last F12 screenshot (empty: none yet).
+  void toggle_recording();
+  std::string recording_path() const;
+  std::string last_screenshot() const;
+  // A message about the last recording or screenshot that failed, empty when none did.
+  std::string recording_error() const;
 
  private:
   struct Impl;

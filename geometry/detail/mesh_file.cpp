@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -42,6 +44,31 @@ void require_mesh_file(const std::string& path, const std::string& field,
   require(!ec && bytes <= kMaxMeshFileBytes, field, value,
           "a mesh file of at most 1 GiB (this one has " + std::to_string(bytes) + " bytes)");
   require(static_cast<bool>(std::ifstream(path)), field, value, "a readable file");
+}
+
+void require_text_mesh(const std::string& path, const std::string& field, const std::string& value,
+                       const std::string& format) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (format == "STL") {
+    // A binary STL file (which may begin with "solid" too) has exactly 84 + 50 n bytes.
+    if (text.compare(0, 5, "solid") != 0) return;
+    if (text.size() >= 84) {
+      std::uint32_t n = 0;
+      for (int k = 3; k >= 0; --k) n = n << 8 | static_cast<unsigned char>(text[80 + k]);
+      if (text.size() == 84 + 50 * static_cast<std::uint64_t>(n)) return;
+    }
+  }
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r') {
+      char byte[8];
+      std::snprintf(byte, sizeof byte, "0x%02x", c);
+      throw InputError(field, value,
+                       "a text " + format + " file (byte " + std::to_string(i) + " is " + byte +
+                           ", a control character no " + format + " file holds)");
+    }
+  }
 }
 
 namespace {
@@ -100,21 +127,38 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
   const auto fail = [&](const std::string& why) {
     throw InputError(field, value, "a PLY file whose counts fit in it (" + why + ")");
   };
+  // What the walk cannot follow is refused here: assimp's PLY reader reads past its buffer on
+  // a header it misparses (issue 44, found by jelly_mesh_fuzzer).
+  const auto malformed = [&](const std::string& why) {
+    throw InputError(field, value, "a well-formed PLY file (" + why + ")");
+  };
 
-  // The header.
-  const std::size_t header_end = text.find("end_header");
-  if (text.compare(0, 3, "ply") != 0 || header_end == std::string::npos) {
-    return;  // not PLY at all: assimp says so
+  // The header: lines up to the line "end_header".
+  std::size_t pos = 0;
+  std::vector<std::string> lines;
+  bool ended = false;
+  while (pos < text.size() && !ended) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(pos, end - pos);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    pos = std::min(end + 1, text.size());
+    ended = line == "end_header";
+    if (!ended) lines.push_back(std::move(line));
   }
-  std::istringstream header(text.substr(0, header_end));
-  std::string line, format;
+  if (lines.empty() || lines[0] != "ply") malformed("the first line is not \"ply\"");
+  if (!ended) malformed("no line \"end_header\" ends its header");
+  std::string format;
   std::vector<Element> elements;
-  while (std::getline(header, line)) {
+  for (std::size_t l = 1; l < lines.size(); ++l) {
+    const std::string& line = lines[l];
     std::istringstream words(line);
     std::string key;
     words >> key;
     if (key == "format") {
-      words >> format;
+      std::string version;
+      words >> format >> version;
+      if (version != "1.0") malformed("format version '" + version + "', not 1.0");
     } else if (key == "element") {
       Element e;
       std::string count;
@@ -144,21 +188,28 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
         if (p.size == 0) fail("a property of unknown type '" + type + "'");
       }
       elements.back().properties.push_back(p);
+    } else if (key != "comment" && key != "obj_info" && !key.empty()) {
+      malformed("header line " + std::to_string(l + 1) + " starts with '" + key +
+                "', not format, element, property, comment or obj_info");
     }
   }
-  std::size_t pos = text.find('\n', header_end);
-  pos = pos == std::string::npos ? text.size() : pos + 1;
 
   // The body: each list's length against what is left.
   const bool ascii = format == "ascii";
   const bool big_endian = format == "binary_big_endian";
-  if (!ascii && !big_endian && format != "binary_little_endian") return;  // assimp refuses it
+  if (!ascii && !big_endian && format != "binary_little_endian") {
+    malformed("format '" + format + "', not ascii, binary_little_endian or binary_big_endian");
+  }
   const auto next_word = [&](std::string_view* word) {
     while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
     const std::size_t start = pos;
     while (pos < text.size() && !std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
     *word = std::string_view(text).substr(start, pos - start);
     return !word->empty();
+  };
+  const auto truncated = [&](const Element& e, long long i) {
+    malformed("it ends inside element " + e.name + " " + std::to_string(i) + " of " +
+              std::to_string(e.count));
   };
   for (const Element& e : elements) {
     for (long long i = 0; i < e.count; ++i) {
@@ -167,11 +218,15 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
         if (p.count_size > 0) {
           if (ascii) {
             std::string_view word;
-            if (!next_word(&word)) return;  // truncated: assimp says so
+            if (!next_word(&word)) truncated(e, i);
             double length = 0;
             const auto [end, error] =
                 std::from_chars(word.data(), word.data() + word.size(), length);
-            if (error != std::errc() || end != word.data() + word.size()) return;
+            if (error != std::errc() || end != word.data() + word.size() ||
+                length != std::floor(length)) {
+              malformed("element " + e.name + " " + std::to_string(i) + " has a list length '" +
+                        std::string(word) + "', not a whole number");
+            }
             if (!(length >= 0 && length <= static_cast<double>(text.size() - pos) / 2 + 1)) {
               fail("element " + e.name + " " + std::to_string(i) + " has a list of " +
                    std::string(word) + " items, more than the " +
@@ -179,7 +234,7 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
             }
             items = static_cast<long long>(length);
           } else {
-            if (pos + p.count_size > text.size()) return;
+            if (pos + p.count_size > text.size()) truncated(e, i);
             items = read_count(text.data() + pos, p.count_size, p.count_signed, big_endian);
             pos += p.count_size;
             if (items < 0 || static_cast<unsigned long long>(items) * p.size > text.size() - pos) {
@@ -189,14 +244,20 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
             }
           }
         }
+        // A face of fewer than 3 vertices is no polygon: assimp's triangulation aborts on one of
+        // none (an assertion in the Debian build; issue 44, jelly_mesh_fuzzer).
+        if (p.count_size > 0 && e.name == "face" && items < 3) {
+          malformed("element face " + std::to_string(i) + " has a list of " +
+                    std::to_string(items) + " vertices; a face has at least 3");
+        }
         if (ascii) {
           std::string_view word;
           for (long long k = 0; k < items; ++k) {
-            if (!next_word(&word)) return;
+            if (!next_word(&word)) truncated(e, i);
           }
         } else {
+          if (static_cast<unsigned long long>(items) * p.size > text.size() - pos) truncated(e, i);
           pos += static_cast<std::size_t>(items) * p.size;
-          if (pos > text.size()) return;
         }
       }
     }

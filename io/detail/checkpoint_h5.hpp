@@ -15,6 +15,9 @@ class CheckpointWriter {
  public:
   CheckpointWriter(hid_t file, int num_particles, const std::string& integrator, Real dt);
   void write(const SimulatorSnapshot& snapshot);
+  // The integrator and step the last written snapshot belongs to (a live change of either, as
+  // the viewer's panel makes, after the writer was made).
+  void set_integrator(const std::string& integrator, Real dt);
 
  private:
   Handle group_, position_, velocity_, seed_particle_, seed_normal_, seed_friction_,

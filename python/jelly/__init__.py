@@ -27,7 +27,7 @@ from ._rollout import rollout
 from ._sweep import sweep, sweep_points
 from ._gradient import gradient
 
-_FIT_KEYWORDS = ("free", "window", "initial", "max_iterations", "function_tolerance",
+_FIT_KEYWORDS = ("free", "gradients", "window", "initial", "max_iterations", "function_tolerance",
                  "gradient_tolerance", "parameter_tolerance", "fit_restart_velocities",
                  "relative_step", "num_threads", "compute_covariance", "progress_to_stdout")
 

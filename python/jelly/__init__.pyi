@@ -608,6 +608,7 @@ def check_same_scene(checkpoint: Checkpoint, scene: Scene, source: str = "checkp
 
 class FitOptions:
     free: str
+    gradients: str
     initial: dict[str, float]
     window: float
     max_iterations: int
@@ -661,6 +662,12 @@ class FitResult:
     def residuals(self) -> int: ...
     @property
     def replays(self) -> int: ...
+    @property
+    def gradient_path(self) -> str: ...
+    @property
+    def gradient_reason(self) -> str: ...
+    @property
+    def adjoint_passes(self) -> int: ...
     @property
     def wall_seconds(self) -> float: ...
     @property

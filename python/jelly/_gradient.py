@@ -33,7 +33,10 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
       "bodies[i].springs.<structural|shear|bending>.<ks|kd>" (a 0-d array), "gravity" (3,),
       "bodies[i].mass" (the particle mass of body i, 0-d), "bodies[i].velocity" and
       "bodies[i].position" (3,: every particle moved together), "bodies[i].velocities" and
-      "bodies[i].positions" ((N_i, 3): each particle's initial state), "pin_targets" (K, P, 3).
+      "bodies[i].positions" ((N_i, 3): each particle's initial state), "pin_targets" (K, P, 3),
+      "bodies[i].forces[k].force" (constant and point forces) or ".velocity" (wind's air
+      velocity) (3,), "bodies[i].forces[k].drag" (wind, 0-d), "bodies[i].forces[k].gust" (0-d):
+      the body's k-th external force as the scene lists it.
     pins / pin_targets: pinned particles (global indices) driven by a control sequence: before
     step k pin p moves in a straight line to pin_targets[k, p] (K x P x 3), where it ends the step.
     checkpoint_every: 0 keeps every step's state (9N doubles per step); S > 0 keeps a snapshot
@@ -74,7 +77,9 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
                           "gradient there is approximate (docs/gradients.md)", stacklevel=2)
     out = {}
     for path, (body, what) in zip(wrt, requests):
-        if what == "gravity":
+        if isinstance(what, tuple) and what[0] == "force":
+            out[path] = _force_gradient(raw, path, body, what[1], what[2])
+        elif what == "gravity":
             out[path] = raw["gravity"].copy()
         elif what == "pin_targets":
             out[path] = raw["pin_targets"].reshape(steps, len(pins), 3)
@@ -92,10 +97,32 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
     return raw["loss"], out
 
 
+_FORCE = re.compile(r"^forces\[(\d+)\]\.(force|velocity|drag|gust)$")
+
+
+def _force_gradient(raw, path: str, body: int, k: int, field: str):
+    """The gradient of body `body`'s k-th external force's `field` from the raw result."""
+    indices = [e for e, b in enumerate(raw["force_body"]) if b == body]
+    if k >= len(indices):
+        raise _jelly.InputError(f"wrt: '{path}' is not allowed; allowed: a force index below "
+                                f"{len(indices)} (the forces of body {body})")
+    e = indices[k]
+    kind = raw["force_kind"][e]
+    fields = {"constant": ("force", "gust"), "point": ("force", "gust"),
+              "wind": ("velocity", "drag", "gust")}[kind]
+    if field not in fields:
+        raise _jelly.InputError(f"wrt: '{path}' is not allowed; allowed: for a {kind} force, "
+                                + ", ".join(fields))
+    if field in ("force", "velocity"):
+        return raw["force_vector"][e].copy()
+    return numpy.array(raw["force_drag" if field == "drag" else "force_gust"][e])
+
+
 def _parse(path: str, bodies: int):
     allowed = ("'gravity', 'pin_targets', 'bodies[i].springs.<structural|shear|bending>."
                "<ks|kd>', 'bodies[i].mass', 'bodies[i].velocity', 'bodies[i].position', "
-               "'bodies[i].velocities', 'bodies[i].positions'")
+               "'bodies[i].velocities', 'bodies[i].positions', "
+               "'bodies[i].forces[k].<force|velocity|drag|gust>'")
     if path in ("gravity", "pin_targets"):
         return None, path
     match = _PATH.match(path)
@@ -106,6 +133,9 @@ def _parse(path: str, bodies: int):
         raise _jelly.InputError(f"wrt: '{path}' is not allowed; allowed: a body index below "
                                 f"{bodies}")
     rest = match.group(2)
+    force = _FORCE.match(rest)
+    if force is not None:
+        return body, ("force", int(force.group(1)), force.group(2))
     if rest in ("mass", "particle_mass", "velocity", "position", "velocities", "positions"):
         return body, "mass" if rest == "particle_mass" else rest
     parts = rest.split(".")

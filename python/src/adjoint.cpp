@@ -1,5 +1,7 @@
 // jelly._gradient: the discrete adjoint of implicit_euler (solvers/adjoint/) for
 // jelly.gradient, which maps its arrays to scene paths (python/jelly/__init__.py).
+#include <jelly/core/external_force.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/solvers/adjoint/implicit_euler_adjoint.hpp>
 #include <jelly/solvers/simulator.hpp>
 
@@ -61,6 +63,30 @@ void bind_adjoint(py::module_& m) {
         for (size_t k = 0; k < g.pin_targets.size(); ++k)
           for (int d = 0; d < 3; ++d) pt.mutable_data()[3 * k + d] = g.pin_targets[k][d];
         out["pin_targets"] = pt;
+        // The external forces' gradients, with each force's body (all its particles are one
+        // body's) and kind, for the scene paths bodies[i].forces[k].<field>.
+        const Model& model = sim.model();
+        const auto forces = static_cast<py::ssize_t>(g.force_vector.size());
+        py::array_t<double> fv({forces, py::ssize_t{3}});
+        py::list force_body, force_kind;
+        for (py::ssize_t e = 0; e < forces; ++e) {
+          for (int d = 0; d < 3; ++d) fv.mutable_data()[3 * e + d] = g.force_vector[e][d];
+          const ExternalForce& force = model.external_forces[e];
+          int body = -1;
+          for (int b = 0; b < model.num_bodies(); ++b) {
+            const Body& range = model.bodies[b];
+            if (force.particles.front() >= range.first_particle &&
+                force.particles.front() < range.end_particle())
+              body = b;
+          }
+          force_body.append(body);
+          force_kind.append(std::string(external_force_kind_name(force.kind)));
+        }
+        out["force_vector"] = fv;
+        out["force_drag"] = py::array_t<double>(forces, g.force_drag.data());
+        out["force_gust"] = py::array_t<double>(forces, g.force_gust.data());
+        out["force_body"] = force_body;
+        out["force_kind"] = force_kind;
         out["contact_steps"] = g.contact_steps;
         out["slide_steps"] = g.slide_steps;
         out["bounce_steps"] = g.bounce_steps;

@@ -25,6 +25,14 @@ void bind_fit(py::module_& m) {
           "free", [](const FitOptions& o) { return free_names(o.free); },
           [](FitOptions& o, const std::string& list) { o.free = parse_free_parameters(list); },
           "The free coefficients, comma-separated: 'ks,kd', 'ks.structural,ks.shear,kd', ...")
+      .def_property(
+          "gradients",
+          [](const FitOptions& o) { return std::string(fit_gradients_name(o.gradients)); },
+          [](FitOptions& o, const std::string& name) {
+            o.gradients = fit_gradients_from_name(name, "gradients");
+          },
+          "'auto' (the adjoint of implicit_euler when it supports the recording, else numeric), "
+          "'adjoint' or 'numeric' (docs/fitting.md).")
       .def_readwrite("initial", &FitOptions::initial,
                      "Starting values by parameter name ({'ks': 1400}); others start at the "
                      "recording's own coefficients.")
@@ -79,6 +87,11 @@ void bind_fit(py::module_& m) {
       .def_readonly("windows", &FitResult::windows, "Shooting windows.")
       .def_readonly("residuals", &FitResult::residuals, "Residuals.")
       .def_readonly("replays", &FitResult::replays, "Window replays.")
+      .def_readonly("gradient_path", &FitResult::gradient_path, "'adjoint' or 'numeric'.")
+      .def_readonly("gradient_reason", &FitResult::gradient_reason,
+                    "Why the numeric path was taken (empty on the adjoint path).")
+      .def_readonly("adjoint_passes", &FitResult::adjoint_passes,
+                    "Window replays differentiated by the adjoint.")
       .def_readonly("wall_seconds", &FitResult::wall_seconds, "Wall time of the whole call (s).")
       .def_readonly("covariance_seconds", &FitResult::covariance_seconds,
                     "Of which the covariance (s).")

@@ -12,6 +12,7 @@
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
@@ -134,6 +135,7 @@ struct MatrixFreeBackward {
 
 // What one forward step leaves for the backward pass.
 struct StepRecord {
+  Real t = 0;     // the time at the start of the step
   VecX x, v, dv;  // the state at the start of the step, and its velocity change
   std::vector<Constraint> constraints;
 };
@@ -142,9 +144,6 @@ void adjoint_check_supported(const Simulator& sim, const ImplicitEuler& ie) {
   const ImplicitEulerOptions& o = ie.options();
   require(o.newton_iterations == 1, "integrator.newton_iterations", o.newton_iterations,
           "1 for gradients (the adjoint differentiates the linearized step)");
-  const Model& model = sim.model();
-  require(model.external_forces.empty(), "external_forces", model.external_forces.size(),
-          "none for gradients (wind is not differentiated yet)");
   require(sim.forces().empty(), "added forces", sim.forces().size(),
           "none for gradients (forces' parameters are not differentiated yet)");
   require(sim.anchors().empty(), "anchors", sim.anchors().size(), "none for gradients");
@@ -209,6 +208,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   };
   // Step k of the run, recorded into r.
   const auto forward_step = [&](int k, StepRecord& r) {
+    r.t = sim.state().t;
     r.x = sim.state().x;
     r.v = sim.state().v;
     for (int p = 0; p < pins; ++p) {
@@ -283,6 +283,10 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     Real cbar, value;
   };
   std::vector<PendingViscosity> pending;
+  out.force_vector.assign(model.external_forces.size(), Vec3::Zero());
+  out.force_drag.assign(model.external_forces.size(), 0.0);
+  out.force_gust.assign(model.external_forces.size(), 0.0);
+  VecX damping(np);
   VecX e_vec = VecX::Zero(n), a_e(n);
   VecX xb = VecX::Zero(n), vb = VecX::Zero(n), x0b(n), v0b(n), dvb(n), mu = VecX::Zero(n),
        lambda(n), a_lambda(n), kw(n);
@@ -334,6 +338,19 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
           throw std::runtime_error("gradient: a spring collapsed at step " + std::to_string(k));
       } else {
         jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
+      }
+      // The forces (and the wind's drag in A) are taken at the end of the step, t + h.
+      const Real t1 = r.t + h;
+      if (!model.external_forces.empty()) {
+        damping.setZero();
+        add_external_damping(model.external_forces, t1, damping);
+        for (int i = 0; i < np; ++i) {
+          if (damping[i] == 0) continue;
+          if (free)
+            free->band.add_diagonal(i, h * damping[i]);
+          else
+            for (int d = 0; d < 3; ++d) jacobian->add_to_diagonal(a, 3 * i + d, h * damping[i]);
+        }
       }
       // The next step's friction viscosities that this step's final solve set (ImplicitContact::
       // update): a sliding contact's c = mu p_n / |(v1 - u)_t|, a sticking one's switch to sliding
@@ -484,6 +501,46 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         const Vec3 l = particle(lambda, i);
         out.particle_mass[particle_body[i]] += l.dot(h * model.gravity - particle(r.dv, i));
         out.gravity += (h * model.mass[i]) * l;
+      }
+      // External forces at t1 (b = h (f + ...)); wind's drag also in A = M + h drag - ...:
+      //   phi_i = h lambda_i . f_i - h drag lambda_i . dv_i on a wind particle.
+      for (size_t e = 0; e < model.external_forces.size(); ++e) {
+        const ExternalForce& force = model.external_forces[e];
+        if (t1 < force.start || t1 >= force.end) continue;
+        const Real wave = std::sin(2 * M_PI * force.gust_frequency * t1);
+        const Real factor = 1 + force.gust * wave;
+        const Vec3 w = force.vector * factor;
+        Vec3 sum = Vec3::Zero();  // d(phi)/d(w)
+        switch (force.kind) {
+          case ExternalForceKind::kConstant: {
+            // f_i = (m_i / total) w; a body's masses all change together: d(m_i / total) =
+            // [i in body] / total - m_i (its particles among the force's) / total^2.
+            Real total = 0;
+            for (int i : force.particles) total += model.mass[i];
+            Real weighted = 0;  // sum_i m_i lambda_i . w / total^2
+            for (int i : force.particles) {
+              const Vec3 l = particle(lambda, i);
+              sum += (h * model.mass[i] / total) * l;
+              out.particle_mass[particle_body[i]] += h * l.dot(w) / total;
+              weighted += h * model.mass[i] * l.dot(w) / (total * total);
+            }
+            for (int i : force.particles) out.particle_mass[particle_body[i]] -= weighted;
+            break;
+          }
+          case ExternalForceKind::kWind:
+            for (int i : force.particles) {
+              const Vec3 l = particle(lambda, i);
+              sum += (h * force.drag) * l;
+              out.force_drag[e] += h * l.dot(w - particle(r.v, i) - particle(r.dv, i));
+              particle(v0b, i) -= (h * force.drag) * l;
+            }
+            break;
+          case ExternalForceKind::kPoint:
+            for (int i : force.particles) sum += h * particle(lambda, i);
+            break;
+        }
+        out.force_vector[e] += factor * sum;
+        out.force_gust[e] += wave * sum.dot(force.vector);
       }
       // Springs, per spring with d = xa - xb, L = |d|, u = d / L, w = va - vb, and the differences
       // l, e of lambda and dv at its ends (q = w + e):

@@ -4,7 +4,7 @@
 // fixed. One forward run stores every step's state, velocity change and constraint set; one
 // backward pass solves each step's (filtered) system again, transposed, and gathers the gradient
 // of a loss on the states with respect to the springs' coefficients, the particle masses,
-// gravity, the initial state and the targets of driven pins.
+// gravity, the external forces' parameters, the initial state and the targets of driven pins.
 #include <functional>
 #include <string>
 #include <vector>
@@ -48,6 +48,10 @@ struct GradientResult {
   // Per body: dL/d(the mass of each of its particles), all changed together.
   std::vector<Real> particle_mass;
   std::vector<Vec3> pin_targets;  // [K * P] as GradientProblem::pin_targets
+  // Per external force e of the model (model.external_forces[e]): dL/d(its `vector`, the force in
+  // N or the wind's air velocity in m/s), dL/d(drag) (wind; zero for the others) and dL/d(gust).
+  std::vector<Vec3> force_vector;
+  std::vector<Real> force_drag, force_gust;
   // What the backward pass held fixed: constrained particle-steps (terrain contacts, pins not
   // counted), of which sliding (the friction viscosity, which the forward step takes from the
   // previous solve's impulse, is held) and bouncing (restitution's velocity change is not
@@ -64,7 +68,7 @@ struct GradientResult {
 // of the run. The forward states are kept in memory (9N doubles per step: x, v, dv), or
 // recomputed from checkpoints (GradientProblem::checkpoint_every).
 // Throws InputError for what the adjoint does not differentiate: another integrator, Newton
-// iterations, contact models other than coulomb inside the solve, contact between bodies, wind,
+// iterations, contact models other than coulomb inside the solve, contact between bodies,
 // added forces, anchor springs, or a malformed problem; std::runtime_error when a step or a
 // backward solve fails.
 GradientResult implicit_euler_gradient(Simulator& simulator, const GradientProblem& problem);

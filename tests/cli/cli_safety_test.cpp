@@ -222,11 +222,61 @@ TEST(DataLoss, AFailedExportLeavesTheOldFilesAsTheyWere) {
   EXPECT_EQ(read_file(pc2), "precious cache");
   EXPECT_EQ(read_file(rest), "precious surface");
   EXPECT_EQ(partial_files(), 0);
+  const std::string glb = temp_path(".glb");
+  std::ofstream(glb) << "precious scene";
+  r = jelly("export " + quoted(file) + " --gltf " + quoted(glb) + " --overwrite", kFullDisk);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(read_file(glb), "precious scene");
+  EXPECT_EQ(partial_files(), 0);
   r = jelly("export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --pc2 " +
-            quoted(pc2) + " --overwrite");
+            quoted(pc2) + " --gltf " + quoted(glb) + " --overwrite");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(read_file(frame), StartsWith("# jelly render surface"));
   EXPECT_THAT(read_file(pc2), StartsWith("POINTCACHE2"));
+  EXPECT_THAT(read_file(glb), StartsWith("glTF"));
+}
+
+// An OBJ sequence written over a longer one leaves no frame of the old one behind (issue 44):
+// with --overwrite the old frames past the new last are removed, and only files named as frames
+// are; without it any earlier frame (not only frame_0000) is refused.
+TEST(DataLoss, AnObjSequenceOverALongerOneLeavesNoOldFrame) {
+  const std::string file = temp_path(".h5");
+  record(file);  // 0.1 s: a few frames
+  const std::string folder = temp_path("");
+  std::filesystem::create_directory(folder);
+  std::ofstream(folder + "/frame_0030.obj") << "an earlier sequence";
+  Result r = jelly("export " + quoted(file) + " --obj-sequence " + quoted(folder));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr("frame_0030.obj exists"), HasSubstr("--overwrite")));
+  EXPECT_FALSE(exists(folder + "/frame_0000.obj"));
+
+  for (int k = 0; k < 40; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%04d.obj", k);
+    std::ofstream(folder + name) << "an earlier sequence";
+  }
+  // Not frames of a sequence: kept.
+  const std::vector<std::string> others = {"/frame_7.obj", "/frame_00001.obj", "/frame_0050.OBJ",
+                                           "/frame_0051.obj.txt", "/notes.txt"};
+  for (const std::string& name : others) std::ofstream(folder + name) << "keep";
+  std::filesystem::create_directory(folder + "/frame_0060.obj");
+  r = jelly("export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --overwrite");
+  ASSERT_EQ(r.code, 0) << r.err;
+  int frames = 0;
+  ASSERT_EQ(std::sscanf(r.out.c_str(), "wrote %d OBJ files", &frames), 1) << r.out;
+  ASSERT_GT(frames, 1);
+  ASSERT_LT(frames, 40);
+  for (int k = 0; k < 40; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%04d.obj", k);
+    if (k < frames) {
+      EXPECT_THAT(read_file(folder + name), StartsWith("# jelly render surface")) << name;
+    } else {
+      EXPECT_FALSE(exists(folder + name)) << name << " of the earlier sequence was left";
+    }
+  }
+  for (const std::string& name : others) EXPECT_EQ(read_file(folder + name), "keep") << name;
+  EXPECT_TRUE(std::filesystem::is_directory(folder + "/frame_0060.obj"));
 }
 
 // The scene of `jelly fit --write-scene` and the sidecar of `jelly xdmf` go through the same
@@ -241,6 +291,55 @@ TEST(DataLoss, AFailedSceneOrSidecarWriteLeavesTheOldFileAsItWas) {
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_EQ(read_file(sidecar), before);
   EXPECT_EQ(partial_files(), 0);
+}
+
+// `jelly xdmf` writes the sidecar beside the recording and its views (virtual datasets and
+// derived arrays, group /xdmf) into the recording: without --overwrite an existing sidecar is
+// refused and the recording is left byte for byte; with it the views are brought up to date and
+// the sidecar replaced. The views are written into a copy renamed onto the recording: written in
+// place, a rebuild that failed on a full disk left a recording no reader could open ("bad heap
+// free list"; issue 44). Now the recording is as it was and the next call completes the views.
+TEST(DataLoss, XdmfUpdatesTheRecordingsViewsAndAFailureLeavesItAsItWas) {
+  const std::string file = temp_path(".h5");
+  record(file);
+  const std::string sidecar = file.substr(0, file.size() - 3) + ".xdmf";
+  const std::string recording = read_file(file);
+  const auto frames_line = [&] {
+    const Result r = jelly("info " + quoted(file));
+    EXPECT_EQ(r.code, 0) << r.err;
+    const std::size_t at = r.out.find("frames:");
+    return at == std::string::npos ? r.out : r.out.substr(at, r.out.find('\n', at) - at);
+  };
+  const std::string frames = frames_line();
+  ASSERT_THAT(frames, StartsWith("frames:"));
+  Result r = jelly("xdmf " + quoted(file));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("exists: pass --overwrite"));
+  EXPECT_EQ(read_file(file), recording);
+
+  // The views removed (as in a recording of a run killed before it wrote them): a rebuild that
+  // cannot write.
+  const hid_t h5 = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(h5, 0);
+  ASSERT_GE(H5Ldelete(h5, "/xdmf", H5P_DEFAULT), 0);
+  H5Fclose(h5);
+  std::filesystem::remove(sidecar);
+  const std::string without_views = read_file(file);
+  r = jelly("xdmf " + quoted(file), kFullDisk);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_FALSE(exists(sidecar));
+  EXPECT_EQ(read_file(file), without_views);
+  EXPECT_EQ(frames_line(), frames);
+  EXPECT_EQ(partial_files(), 0);
+
+  r = jelly("xdmf " + quoted(file));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(read_file(sidecar), HasSubstr("<Xdmf"));
+  r = jelly("xdmf " + quoted(file) + " --overwrite");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(frames_line(), frames);
+  r = jelly("export " + quoted(file) + " --pc2 " + quoted(temp_path(".pc2")));
+  EXPECT_EQ(r.code, 0) << r.err;
 }
 
 // Issue 44, item 9: an output that is an input of the command, also through a hard or a
@@ -265,12 +364,15 @@ TEST(DataLoss, AnOutputThatIsTheInputIsRefusedNamingBoth) {
   std::filesystem::create_symlink(file, pc2);
   const std::string scene = temp_path(".json");
   std::filesystem::create_symlink(file, scene);
+  const std::string glb = temp_path(".glb");
+  ASSERT_EQ(link(file.c_str(), glb.c_str()), 0);
   const std::string sidecar = file.substr(0, file.size() - 3) + ".xdmf";
   std::remove(sidecar.c_str());
   ASSERT_EQ(link(file.c_str(), sidecar.c_str()), 0);
   for (const std::string& command :
        {"export " + quoted(file) + " --obj-sequence " + quoted(folder) + " --overwrite",
         "export " + quoted(file) + " --pc2 " + quoted(pc2) + " --overwrite",
+        "export " + quoted(file) + " --gltf " + quoted(glb) + " --overwrite",
         "fit " + quoted(file) + " --write-scene " + quoted(scene) + " --overwrite",
         "xdmf " + quoted(file) + " --overwrite"}) {
     r = jelly(command);

@@ -231,6 +231,16 @@ TEST(Cli, CommandLineParseErrorsExitTwo) {
   r = jelly("run " + kSmallSlope + " --dt");
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, StartsWith("error: --dt: 1 required H missing"));
+  EXPECT_THAT(r.err, HasSubstr("'jelly run --help'"));
+
+  // The usage named is the command's own (render's errors sent readers to `jelly run --help`;
+  // seen while fuzzing render's command line, issue 44).
+  r = jelly("render missing.h5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("Run 'jelly --help' or 'jelly render --help' for usage."));
+  r = jelly("export --pc2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("'jelly export --help'"));
 }
 
 // CLI11's NonNegativeNumber answered --threads -1 with the range of a double (310 digits).
@@ -364,6 +374,33 @@ TEST(Cli, FitRecoversTheCoefficientsOfARecording) {
   EXPECT_THAT(r.out, HasSubstr("ks = "));
 }
 
+// An implicit_euler recording: jelly fit takes the adjoint path by default, says so, and
+// recovers the coefficients; --gradients numeric takes the other path and says why.
+TEST(Cli, FitTakesTheAdjointPathForImplicitEuler) {
+  const std::string file = temp_path(".h5");
+  Result r = jelly("run " + kFitScene +
+                   " --set integrator.name=implicit_euler --set integrator.dt=0.005 --duration 0.5"
+                   " -o '" +
+                   file + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string fitted = temp_path(".json");
+  r = jelly("fit '" + file + "' --initial ks=1400 --initial kd=30 --no-covariance --write-scene '" +
+            fitted + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("derivatives: adjoint (exact gradients of implicit_euler"));
+  const Scene s = load_scene(fitted);
+  for (const SpringCoefficients& c : s.cube().springs) {
+    EXPECT_NEAR(c.ks, 1000, 10) << r.out;  // within 1 %
+    EXPECT_NEAR(c.kd, 20, 0.2) << r.out;
+  }
+  r = jelly("fit '" + file +
+            "' --initial ks=1400 --initial kd=30 --no-covariance --gradients "
+            "numeric --max-iterations 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("derivatives: numeric (central differences of replays, "
+                               "Levenberg-Marquardt): asked for (gradients = numeric)"));
+}
+
 TEST(Cli, FitErrorsExitTwo) {
   Result r = jelly("fit /nonexistent/run.h5");
   EXPECT_EQ(r.code, 2);
@@ -376,6 +413,15 @@ TEST(Cli, FitErrorsExitTwo) {
   r = jelly("fit '" + file + "' --initial kq=3");
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, StartsWith("error: --initial = kq=3 is invalid"));
+  r = jelly("fit '" + file + "' --gradients exact");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: --gradients = exact is invalid: one of auto, adjoint, "
+                                "numeric"));
+  // The recording's integrator (kFitScene's) has no adjoint: --gradients adjoint says so.
+  r = jelly("fit '" + file + "' --gradients adjoint --max-iterations 1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, StartsWith("error: gradients = adjoint is invalid: a fit the adjoint "
+                                "supports: the recording's integrator is"));
   const std::string short_file = temp_path(".h5");
   ASSERT_EQ(jelly("run " + kFitScene + " --duration 0.001 -o '" + short_file + "'").code, 0);
   r = jelly("fit '" + short_file + "'");

@@ -124,6 +124,14 @@ TEST(ClothShape, SpringCountsAndSurface) {
   EXPECT_EQ(part.springs.count(SpringType::kShear), 2 * (nu - 1) * (nv - 1));
   EXPECT_EQ(part.springs.count(SpringType::kBending), (nu - 2) * nv + nu * (nv - 2));
   EXPECT_EQ(part.surface.num_triangles(), 2 * (nu - 1) * (nv - 1));
+  // The memory estimate's count is the built one (not the lattice's 13 per particle).
+  EXPECT_EQ(cloth.estimated_springs(), static_cast<long>(part.springs.size()));
+  cloth.nu = 2;
+  cloth.nv = 3;
+  EXPECT_EQ(cloth.estimated_springs(),
+            static_cast<long>(cloth.build(Material{}, "cloth.").springs.size()));
+  cloth.nu = 6;
+  cloth.nv = 4;
   // Rotated 90 degrees about x: the sheet is vertical, its +y side now faces +z.
   const Surface& s = part.surface;
   const Triangle& t = s.triangles[0];

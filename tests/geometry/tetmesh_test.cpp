@@ -150,6 +150,19 @@ TEST(Tetmesh, ATinyElementSizeIsRefusedBeforeGmshStarts) {
   EXPECT_NO_THROW(tetrahedralize(sphere, 0.5, "IN", "ball", "--size"));
 }
 
+// The memory estimate counts the springs a tetmesh body will have: its unique edges, not an
+// upper bound of 6 per tet (five times too many on a regular mesh; issue 44).
+TEST(Tetmesh, EstimatedSpringsAreTheMeshEdges) {
+  TempDir dir;
+  write_msh(dir.file("cube.msh"), cube_in_6_tets());
+  TetmeshShape shape;
+  shape.file = dir.file("cube.msh");
+  const BodyPart part = shape.build(Material{}, "bodies[0].");
+  EXPECT_EQ(shape.estimated_springs(), static_cast<long>(part.springs.size()));
+  EXPECT_EQ(shape.estimated_springs(), 19);
+  EXPECT_EQ(shape.estimated_particles(), 8);
+}
+
 TEST(Tetmesh, MshAndTetgenFilesReadBack) {
   TempDir dir;
   const TetMesh cube = cube_in_6_tets();

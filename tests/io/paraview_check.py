@@ -13,7 +13,9 @@ For each RECORDING.xdmf (its .h5 beside it):
     the weighted sums of the particles, its triangles and speed) against values computed from
     the HDF5 file;
   * Xdmf3ReaderT and the XDMF Reader: time steps, blocks, points and cells of three frames.
-With --screenshot PNG: shows the first recording as ParaView shows it by default (colour by speed
+With --state FILE: runs the first recording's ParaView state (`jelly xdmf --state`) and checks
+its colour range (all frames) and camera (on the bodies). With --screenshot PNG: shows the first
+recording as ParaView shows it by default (colour by speed
 is checked) at its frame of largest elastic energy and saves a screenshot (needs a display:
 xvfb-run). For the last recording, Plot Global Variables Over Time gives the observables.
 
@@ -43,6 +45,23 @@ def check(ok, message):
     return ok
 
 
+def exact_times(recorded, dt, interval):
+    """The frames' exact times as the sidecar must give them (exact_frame_times, io/recording.hpp):
+    a recorded time (a sum of steps) within dt / 1000 of k x interval is that product, else within
+    dt / 1000 of n x dt that product, else as recorded."""
+    out = []
+    for t in recorded:
+        t = float(t)
+        for every in (interval, dt):
+            if every > 0 and dt > 0:
+                k = round(t / every)
+                if abs(t - k * every) <= 1e-3 * dt:
+                    t = k * every
+                    break
+        out.append(t)
+    return np.asarray(out)
+
+
 class Recording:
     """What the HDF5 file holds, read with h5py."""
 
@@ -64,7 +83,13 @@ class Recording:
                     body["first"] = next_first
                 next_first = body["first"] + len(body["mass"])
             self.bodies = sorted(bodies, key=lambda b: b["first"])
-            self.time = f[f"particles/{self.bodies[0]['name']}/position/time"][:]
+            self.recorded_time = f[f"particles/{self.bodies[0]['name']}/position/time"][:]
+            par = f["parameters"].attrs
+            self.time = exact_times(self.recorded_time, float(par.get("dt", 0)),
+                                    float(par.get("output_interval", 0)))
+            xdmf = f.get("xdmf")
+            self.speed_range = xdmf.attrs.get("speed_range") if xdmf is not None else None
+            self.bounds = xdmf.attrs.get("bounds") if xdmf is not None else None
             c = f["connectivity"]
             springs, rest, ks, kd, kind = (c["springs"][:], c["rest_length"][:], c["ks"][:],
                                            c["kd"][:], c["type"][:])
@@ -264,6 +289,9 @@ def check_recording(xdmf):
     times = np.asarray(reader.TimestepValues)
     check(np.array_equal(times, rec.time[:rec.frames]),
           f"{label}: {len(times)} time steps, {rec.frames} recorded frames (or other times)")
+    # Exact (rec.time: products, not the sums of steps the run recorded).
+    summed = int(np.count_nonzero(rec.recorded_time[:rec.frames] != rec.time[:rec.frames]))
+    say(f"{label}: {summed} of {rec.frames} recorded times were sums of steps off their exact time")
     algorithm = reader.GetClientSideObject()
     for k in range(min(len(times), rec.frames)):
         algorithm.UpdateTimeStep(times[k])
@@ -358,13 +386,56 @@ def screenshot(xdmf, rec, png):
         simple.Delete(proxy)
 
 
+def check_state(state, xdmf, rec):
+    """Loads the state written by `jelly xdmf --state` as ParaView's Load State runs a Python
+    state: the colour range must be the speed range over every frame (not frame 0's) and the
+    camera must look at the bodies' box over the run from a distance that shows all of it."""
+    import runpy
+    label = os.path.basename(state)
+    for proxy in list(simple.GetSources().values()):
+        simple.Delete(proxy)
+    runpy.run_path(state, run_name="__main__")
+    sources = list(simple.GetSources().values())
+    check(len(sources) == 1 and os.path.samefile(sources[0].FileName[0], xdmf),
+          f"{label}: opened {[s.FileName for s in sources]}, not {xdmf}")
+    top = max(max(np.linalg.norm(b["v"][:rec.frames], axis=2).max() for b in rec.bodies),
+              0.0)
+    lut = simple.GetColorTransferFunction("speed")
+    points = lut.RGBPoints
+    lo, hi = points[0], points[-4]
+    check(rec.speed_range is not None and abs(hi - top) <= 1e-6 * max(1.0, top) and
+          lo == rec.speed_range[0] and hi == rec.speed_range[1],
+          f"{label}: colour range [{lo}, {hi}], the largest speed over all frames is {top}")
+    check(lut.AutomaticRescaleRangeMode == "Never", f"{label}: the range is rescaled while playing")
+    x = np.concatenate([b["x"][:rec.frames].reshape(-1, 3) for b in rec.bodies])
+    lo3, hi3 = x.min(axis=0), x.max(axis=0)
+    view = simple.GetActiveView()
+    focal = np.asarray(view.CameraFocalPoint)
+    check(np.allclose(focal, 0.5 * (lo3 + hi3), atol=1e-9 * (1 + np.abs(focal).max())),
+          f"{label}: the camera looks at {focal}, not the bodies' box centre {0.5 * (lo3 + hi3)}")
+    distance = np.linalg.norm(np.asarray(view.CameraPosition) - focal)
+    radius = 0.5 * np.linalg.norm(hi3 - lo3)
+    fits = radius / np.sin(np.radians(view.CameraViewAngle / 2))
+    check(fits <= distance <= 1.5 * fits,
+          f"{label}: camera distance {distance:.3g} m for a box of radius {radius:.3g} m")
+    say(f"{label}: colour range [{lo:.3g}, {hi:.3g}] m/s (largest speed {top:.3g}), camera on "
+        f"the box centre at {distance:.3g} m (radius {radius:.3g} m)")
+    for proxy in list(simple.GetSources().values()):
+        simple.Delete(proxy)
+    # A render view still open when sys.exit() runs makes the X server report GLXBadContext.
+    simple.Delete(view)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("xdmf", nargs="+")
     parser.add_argument("--screenshot", help="PNG of the first recording")
+    parser.add_argument("--state", help="the first recording's state (jelly xdmf --state)")
     args = parser.parse_args()
     recordings = [check_recording(x) for x in args.xdmf]
     check_global_variables(args.xdmf[-1], recordings[-1])  # every frame again: the last one only
+    if args.state:
+        check_state(args.state, args.xdmf[0], recordings[0])
     if args.screenshot:
         screenshot(args.xdmf[0], recordings[0], args.screenshot)
     say("all checks passed" if not failures else f"{len(failures)} checks failed")

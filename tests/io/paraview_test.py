@@ -64,10 +64,14 @@ def main():
                            stdout=subprocess.DEVNULL)
             # Relative to the working directory below: the sidecar must find its .h5 by itself.
             xdmfs.append(os.path.join("..", scene + ".xdmf"))
+        # The first recording's ParaView state (the sidecar is rewritten with it).
+        first = os.path.join(tmp, RUNS[0][0] + ".h5")
+        subprocess.run([args.jelly, "xdmf", first, "--state", "--overwrite"], check=True,
+                       stdout=subprocess.DEVNULL)
         elsewhere = os.path.join(tmp, "elsewhere")
         os.mkdir(elsewhere)
         command = [pvpython, "--force-offscreen-rendering", os.path.join(HERE, "paraview_check.py")]
-        command += xdmfs
+        command += xdmfs + ["--state", os.path.join("..", RUNS[0][0] + ".paraview.py")]
         xvfb_run = shutil.which("xvfb-run") if args.screenshot else None
         if args.screenshot:
             if xvfb_run is None and not os.environ.get("DISPLAY"):

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <vector>
@@ -408,6 +410,93 @@ TEST(Xdmf, WithoutStrain) {
   const hid_t file = H5Fopen(dir.file("run.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   EXPECT_EQ(H5Lexists(file, "/xdmf/particles/jelly/strain", H5P_DEFAULT), 0);
   H5Fclose(file);
+}
+
+double double_attribute(hid_t file, const char* object, const char* name, int index = 0) {
+  const hid_t a = H5Aopen_by_name(file, object, name, H5P_DEFAULT, H5P_DEFAULT);
+  EXPECT_GE(a, 0) << object << " " << name;
+  if (a < 0) return NAN;
+  const hid_t space = H5Aget_space(a);
+  std::vector<double> values(static_cast<size_t>(H5Sget_simple_extent_npoints(space)));
+  H5Sclose(space);
+  EXPECT_GE(H5Aread(a, H5T_NATIVE_DOUBLE, values.data()), 0);
+  H5Aclose(a);
+  return values.at(static_cast<size_t>(index));
+}
+
+// Every <Time> is k x output_interval to 17 digits (not the recorded sum of steps), /xdmf holds
+// the speed range over every frame, and the ParaView state written beside it carries that range
+// and the bodies' box.
+TEST(Xdmf, ExactTimesSpeedRangeAndParaviewState) {
+  TempDir dir;
+  const std::string path = dir.file("run.h5");
+  record(path);
+  const std::string text = read_text(dir.file("run.xdmf"));
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const double interval = double_attribute(file, "/parameters", "output_interval");
+  const double dt = double_attribute(file, "/parameters", "dt");
+  ASSERT_GT(interval, 0);
+  ASSERT_NEAR(std::remainder(interval, dt), 0, 1e-12);  // frames fall on multiples of both
+  const std::vector<double> recorded = read(file, "/particles/jelly/position/time");
+  const std::regex time(R"re(<Time Value="([^"]+)"/>)re");
+  std::vector<std::string> times;
+  for (std::sregex_iterator it(text.begin(), text.end(), time), end; it != end; ++it)
+    times.push_back((*it)[1]);
+  ASSERT_EQ(times.size(), 3 * recorded.size());  // the body, its surface, the plane
+  int sums = 0;
+  for (size_t g = 0; g < 3; ++g)
+    for (size_t k = 0; k < recorded.size(); ++k) {
+      char expected[40];
+      std::snprintf(expected, sizeof expected, "%.17g", static_cast<double>(k) * interval);
+      EXPECT_EQ(times[g * recorded.size() + k], expected) << "grid " << g << " frame " << k;
+      sums += recorded[k] != static_cast<double>(k) * interval;
+    }
+  std::printf("%d of %zu recorded times differ from k x output_interval\n", sums / 3,
+              recorded.size());
+
+  double lo = 1e300, hi = -1e300;
+  for (const char* speeds : {"/xdmf/particles/jelly/speed", "/xdmf/particles/jelly/surface/speed"})
+    for (double s : read(file, speeds)) {
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+  EXPECT_EQ(double_attribute(file, "/xdmf", "speed_range", 0), lo);
+  EXPECT_EQ(double_attribute(file, "/xdmf", "speed_range", 1), hi);
+  EXPECT_EQ(lo, 0);  // the cube starts at rest
+  EXPECT_GT(hi, 1);  // and slides
+  double fastest = 0;
+  const std::vector<double> v = read(file, "/particles/jelly/velocity/value");
+  for (size_t i = 0; i + 2 < v.size(); i += 3)
+    fastest = std::max(fastest, std::sqrt(v[i] * v[i] + v[i + 1] * v[i + 1] + v[i + 2] * v[i + 2]));
+  EXPECT_NEAR(hi, fastest, 1e-6 * fastest);
+  std::array<double, 6> bounds{};
+  for (int c = 0; c < 6; ++c) bounds[c] = double_attribute(file, "/xdmf", "bounds", c);
+  H5Fclose(file);
+
+  const std::string state = write_paraview_state(path);
+  EXPECT_EQ(state, dir.file("run.paraview.py"));
+  const std::string script = read_text(state);
+  char line[200];
+  std::snprintf(line, sizeof line, "SPEED_RANGE = [%.17g, %.17g]", lo, hi);
+  EXPECT_NE(script.find(line), std::string::npos) << script;
+  std::snprintf(line, sizeof line, "BOUNDS = [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g]", bounds[0],
+                bounds[1], bounds[2], bounds[3], bounds[4], bounds[5]);
+  EXPECT_NE(script.find(line), std::string::npos) << script;
+  EXPECT_NE(script.find("SIDECAR = \"run.xdmf\""), std::string::npos);
+  if (testing::python_has("ast")) {
+    const std::string parse =
+        "/usr/bin/python3 -c \"import ast, sys; ast.parse(open(sys.argv[1]).read())\" '" + state +
+        "'";
+    EXPECT_EQ(std::system(parse.c_str()), 0);
+  }
+
+  // Without sidecar data there is nothing to set the state from.
+  RecorderOptions none;
+  none.write_xdmf = false;
+  record(dir.file("bare.h5"), none);
+  EXPECT_THROW(write_paraview_state(dir.file("bare.h5")), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bare.paraview.py")));
 }
 
 TEST(Xdmf, ErrorsNameTheFileOrOption) {

@@ -75,3 +75,28 @@ def test_write_scene_is_never_the_recording(scenes, tmp_path):
             with pytest.raises(jelly.InputError, match=r"is the recording .*run\.h5.*same file"):
                 jelly.fit_recording(recording, write_scene=target, max_iterations=1)
     assert (tmp_path / "run.h5").read_bytes() == before
+
+
+def test_fit_takes_the_adjoint_path_for_implicit_euler(scenes, tmp_path):
+    """An implicit_euler recording: the exact gradients by default, the path named; numeric on
+    request, with the reason; a bad name for gradients is an InputError."""
+    scene = jelly.load_scene(scenes / "drop_coulomb.json", {
+        "cube.n": 3, "cube.origin": [-1, 0.3, -1], "integrator.name": "implicit_euler",
+        "integrator.dt": 0.005, "output_interval": 0.01, "duration": 0.5,
+        "springs.structural": {"ks": 1000, "kd": 20}, "springs.shear": {"ks": 1000, "kd": 20},
+        "springs.bending": {"ks": 1000, "kd": 20}})
+    sim = jelly.Simulator(scene)
+    with jelly.H5Recorder(str(tmp_path / "ie.h5"), sim, scene) as recorder:
+        sim.add_observer(recorder)
+        assert sim.run_until(scene.duration).ok
+    result = jelly.fit_recording(tmp_path / "ie.h5", initial={"ks": 1400, "kd": 30},
+                                 compute_covariance=False)
+    assert result.gradient_path == "adjoint" and result.adjoint_passes > 0
+    assert "derivatives: adjoint" in str(result)
+    assert result.at("ks").value == pytest.approx(1000, rel=1e-2)
+    numeric = jelly.fit_recording(tmp_path / "ie.h5", initial={"ks": 1400, "kd": 30},
+                                  compute_covariance=False, gradients="numeric", max_iterations=1)
+    assert numeric.gradient_path == "numeric"
+    assert numeric.gradient_reason == "asked for (gradients = numeric)"
+    with pytest.raises(jelly.InputError, match="gradients = exact is invalid"):
+        jelly.fit_recording(tmp_path / "ie.h5", gradients="exact")

@@ -105,3 +105,51 @@ def test_bad_paths_and_shapes_are_named():
     rk4 = cloth_scene({"integrator.name": "rk4", "integrator.dt": 0.001})
     with pytest.raises(jelly.InputError, match="implicit_euler"):
         jelly.gradient(rk4, 0.01, loss, ["gravity"])
+
+
+def forced_scene(push=(0.2, 0.1, -0.3), air=(1.0, 0.2, 2.0), drag=0.02, gust=0.4):
+    scene = {
+        "bodies": [{
+            "kind": "cloth", "name": "cloth", "nu": 5, "nv": 5, "size_u": 1, "size_v": 1,
+            "position": [0, 2, 0], "particle_mass": 0.05,
+            "springs": {"structural": {"ks": 300, "kd": 2}, "shear": {"ks": 150, "kd": 1},
+                        "bending": {"ks": 40, "kd": 0.5}},
+            "velocity": [0.3, 0, -0.2],
+            "pins": [{"group": "corner_00"}, {"group": "corner_10"}],
+            "forces": [{"kind": "constant", "force": list(push)},
+                       {"kind": "wind", "velocity": list(air), "drag": drag, "gust": gust,
+                        "gust_frequency": 2}]}],
+        "gravity": [0, -9.8, 0],
+        "terrains": [],
+        "integrator": {"name": "implicit_euler", "dt": DT},
+        "duration": STEPS * DT,
+    }
+    return jelly.Scene(scene, {})
+
+
+def test_external_force_parameters_agree_with_finite_differences():
+    wrt = ["bodies[0].forces[0].force", "bodies[0].forces[0].gust", "bodies[0].forces[1].velocity",
+           "bodies[0].forces[1].drag", "bodies[0].forces[1].gust"]
+    L, grads = jelly.gradient(forced_scene(), STEPS * DT, loss, wrt)
+    assert grads["bodies[0].forces[0].force"].shape == (3,)
+
+    def fd(make, eps):
+        return (jelly.gradient(make(eps), STEPS * DT, loss, [])[0] -
+                jelly.gradient(make(-eps), STEPS * DT, loss, [])[0]) / (2 * eps)
+
+    for d in range(3):
+        unit = np.eye(3)[d]
+        push = fd(lambda e: forced_scene(push=np.array([0.2, 0.1, -0.3]) + e * unit), 1e-6)
+        assert abs(grads["bodies[0].forces[0].force"][d] - push) <= 1e-5 * abs(push), (d, push)
+        air = fd(lambda e: forced_scene(air=np.array([1.0, 0.2, 2.0]) + e * unit), 1e-6)
+        assert abs(grads["bodies[0].forces[1].velocity"][d] - air) <= 1e-5 * abs(air), (d, air)
+    drag = fd(lambda e: forced_scene(drag=0.02 + e), 1e-7)
+    assert abs(float(grads["bodies[0].forces[1].drag"]) - drag) <= 1e-5 * abs(drag)
+    gust = fd(lambda e: forced_scene(gust=0.4 + e), 1e-6)
+    assert abs(float(grads["bodies[0].forces[1].gust"]) - gust) <= 1e-5 * abs(gust)
+    # The constant force has no gust: its gradient is that of a (zero) amplitude, still defined.
+    assert np.isfinite(float(grads["bodies[0].forces[0].gust"]))
+    with pytest.raises(jelly.InputError, match="for a constant force, force, gust"):
+        jelly.gradient(forced_scene(), STEPS * DT, loss, ["bodies[0].forces[0].drag"])
+    with pytest.raises(jelly.InputError, match="a force index below 2"):
+        jelly.gradient(forced_scene(), STEPS * DT, loss, ["bodies[0].forces[2].gust"])

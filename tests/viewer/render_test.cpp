@@ -3,6 +3,7 @@
 // and `jelly render` writes the frames ffprobe counts.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
@@ -181,6 +182,122 @@ TEST_F(Offscreen, PngRoundTrip) {
   EXPECT_EQ(image.rgb, rgb);
 }
 
+// Pixels inside the sphere's picture (its middle 70 % by radius) where the brightness bends
+// sharply: a grid line or a seam, not smooth shading (second differences over 10 grey levels).
+double sharp_fraction(const std::vector<std::uint8_t>& rgb, int w, int h, const Eigen::Vector2f& c,
+                      float radius) {
+  const auto grey = [&](int x, int y) {
+    const std::uint8_t* p = rgb.data() + 3 * (static_cast<size_t>(y) * w + x);
+    return (p[0] + p[1] + p[2]) / 3.0f;
+  };
+  long inside = 0, sharp = 0;
+  for (int y = 1; y + 1 < h; ++y)
+    for (int x = 1; x + 1 < w; ++x) {
+      if ((Eigen::Vector2f(x + 0.5f, y + 0.5f) - c).norm() > 0.7f * radius) continue;
+      ++inside;
+      const float g = grey(x, y);
+      const float dx = std::abs(grey(x - 1, y) + grey(x + 1, y) - 2 * g);
+      const float dy = std::abs(grey(x, y - 1) + grey(x, y + 1) - 2 * g);
+      sharp += std::max(dx, dy) > 10;
+    }
+  return inside > 0 ? static_cast<double>(sharp) / static_cast<double>(inside) : 1.0;
+}
+
+// Obstacles have their own plain material: no ground grid on cloth_on_sphere's sphere (issue
+// 40, item 6: its grid lines and seams looked like cracks). The same sphere drawn as ground
+// shows the grid, so the measure sees grid lines when they are there.
+TEST_F(Offscreen, ObstaclesAreDrawnWithoutTheGroundsGrid) {
+  const Scene scene = load_scene(JELLY_SCENES_DIR "/cloth_on_sphere.json");
+  const Model model = make_model(scene);
+  Terrains terrains;
+  for (const auto& t : scene.terrains) terrains.push_back(t->make());
+  Vec3 lo, hi;
+  viewer::bounds_of(model.rest_position, lo, hi);
+  const viewer::SceneBuilder builder(model, std::move(terrains), lo, hi);
+  viewer::RenderScene view = builder.make_scene(model.rest_position, 0);
+  view.show_surfaces = false;  // the sphere alone (the cloth hangs above it)
+  ASSERT_EQ(view.terrains.front().name, "sphere");
+  ASSERT_TRUE(view.terrains.front().casts_shadow);
+  const int w = 400, h = 300;
+  viewer::Camera camera;
+  camera.parse("-20,25,2.2,0,0.6,0");
+  const Eigen::Vector2f centre = *camera.project(Eigen::Vector3f(0, 0.6f, 0), w, h);
+  const float radius =
+      (*camera.project(Eigen::Vector3f(0, 0.6f, 0) + 0.5f * camera.up(), w, h) - centre).norm();
+  ASSERT_GT(radius, 60);
+  viewer::Renderer renderer;
+  const double plain = sharp_fraction(draw(renderer, view, camera, w, h), w, h, centre, radius);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  EXPECT_LT(plain, 0.002);
+  view.terrains.front().casts_shadow = false;  // drawn as the ground is
+  const double grid = sharp_fraction(draw(renderer, view, camera, w, h), w, h, centre, radius);
+  EXPECT_GT(grid, 0.01) << "the measure does not see the grid";
+}
+
+// An obstacle's shadow is whole wherever the bodies are: bear_in_bowl's bowl casts its shadow
+// on the floor with the bears 8 m away (issue 40, item 6: the shadow map covered the bodies
+// only, and the bowl's shadow ended along a straight line). Floor points just outside the rim
+// away from the light are in its shadow, points as far out across that direction are lit.
+TEST_F(Offscreen, AnObstaclesShadowIsWholeAwayFromTheBodies) {
+  const Scene scene = load_scene(JELLY_SCENES_DIR "/bear_in_bowl.json");
+  const Model model = make_model(scene);
+  Terrains terrains;
+  for (const auto& t : scene.terrains) terrains.push_back(t->make());
+  VecX x = model.rest_position;
+  for (Eigen::Index i = 0; i < x.size(); i += 3) x[i] += 8;
+  Vec3 lo, hi;
+  viewer::bounds_of(x, lo, hi);
+  const viewer::SceneBuilder builder(model, std::move(terrains), lo, hi);
+  const viewer::RenderScene view = builder.make_scene(x, 0);
+  viewer::Renderer renderer;
+  const Eigen::Vector3f light = renderer.options().light_direction;
+  const Eigen::Vector3f away = Eigen::Vector3f(-light.x(), 0, -light.z()).normalized();
+  const Eigen::Vector3f across(-away.z(), 0, away.x());
+  // Seen from the side the shadow falls on, so that those floor points are not behind the bowl.
+  viewer::Camera camera;
+  camera.yaw_degrees = std::atan2(away.x(), away.z()) * 180 / 3.14159265f;
+  camera.pitch_degrees = 50;
+  camera.distance = 10;
+  const int w = 400, h = 300;
+  const std::vector<std::uint8_t> rgb = draw(renderer, view, camera, w, h);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  const auto grey = [&](const Eigen::Vector3f& p) {
+    const Eigen::Vector2f q = *camera.project(p, w, h);
+    float sum = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int px = static_cast<int>(q.x()) + dx, py = static_cast<int>(q.y()) + dy;
+        const std::uint8_t* c = rgb.data() + 3 * (static_cast<size_t>(py) * w + px);
+        sum += (c[0] + c[1] + c[2]) / 3.0f;
+      }
+    return sum / 9;
+  };
+  const float radius = 1.85f;  // the rim is at 1.6 m, 1.6 m high
+  const float shadow = grey(radius * away);
+  const float lit = std::min(grey(radius * across), grey(-radius * across));
+  EXPECT_LT(shadow, 0.8f * lit) << "shadow " << shadow << ", lit " << lit;
+}
+
+// bear_in_bowl from the default camera, following the bodies: the bears are seen in the bowl at
+// 1, 2 and 4 s, not hidden by its wall (issue 40, item 4: frames 60, 120 and 240 showed an
+// empty bowl).
+TEST(RenderCli, BearsInTheBowlAreSeen) {
+  TempDir dir;
+  const std::string jelly = std::string("'") + JELLY_CLI + "' ";
+  testing::Result r = testing::run(
+      jelly + "run '" JELLY_SCENES_DIR "/bear_in_bowl.json' --quiet -o '" + dir.file("r.h5") + "'",
+      dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(jelly + "render '" + dir.file("r.h5") + "' -o '" + dir.file("f%03d.png") +
+                       "' --width 320 --height 180 --samples 1",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  if (r.err.find("no offscreen") != std::string::npos) GTEST_SKIP() << r.err;
+  for (const std::string frame : {"f060.png", "f120.png", "f240.png"}) {
+    EXPECT_GT(testing::bear_fraction(viewer::read_png(dir.file(frame)).rgb), 0.01) << frame;
+  }
+}
+
 // A recording keeps its bodies' colours: `jelly render` draws the green body green.
 TEST(RenderCli, KeepsTheBodiesColours) {
   TempDir dir;
@@ -209,7 +326,8 @@ TEST(RenderCli, KeepsTheBodiesColours) {
 
 // Without --camera, `jelly render` follows the bodies and keeps them large: the seed jelly,
 // 4 s down the slope, fills a good part of the picture at the end of the video (issue 40,
-// item 3: the camera framed the whole motion and the jelly filled under 5 %).
+// items 3 and 9: the camera framed the whole motion and the jelly filled under 5 %; framed
+// with the ground below its start, 5.6 %; now about 12 %).
 TEST(RenderCli, FollowsTheBodies) {
   TempDir dir;
   const std::string jelly = std::string("'") + JELLY_CLI + "' ";
@@ -227,7 +345,7 @@ TEST(RenderCli, FollowsTheBodies) {
     const viewer::Image image = viewer::read_png(dir.file(frame));
     long red = 0;
     for (size_t i = 0; i + 2 < image.rgb.size(); i += 3) red += testing::is_jelly(&image.rgb[i]);
-    EXPECT_GT(static_cast<double>(red) / (image.width * image.height), 0.05) << frame;
+    EXPECT_GT(static_cast<double>(red) / (image.width * image.height), 0.09) << frame;
   }
 }
 

@@ -48,6 +48,19 @@ inline bool is_jelly(const std::uint8_t* p) {
   return p[0] > 60 && p[0] > p[1] + 40 && p[0] > p[2] + 30;
 }
 
+// The share of an RGB image in the colours of bear_in_bowl's bears: red (the jelly's), green,
+// yellow; the bowl, ground and sky are grey or pale blue.
+inline double bear_fraction(const std::vector<std::uint8_t>& rgb) {
+  long bear = 0;
+  for (size_t i = 0; i + 2 < rgb.size(); i += 3) {
+    const std::uint8_t* p = &rgb[i];
+    const bool green = p[1] > 60 && p[1] > p[0] + 40 && p[1] > p[2] + 30;
+    const bool yellow = p[0] > 120 && p[1] > 90 && p[0] > p[2] + 70 && p[1] > p[2] + 50;
+    bear += is_jelly(p) || green || yellow;
+  }
+  return rgb.empty() ? 0.0 : 3.0 * static_cast<double>(bear) / static_cast<double>(rgb.size());
+}
+
 struct Box {
   float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
   void add(float x, float y) {

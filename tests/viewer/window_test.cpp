@@ -5,6 +5,10 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>  // key codes only
 
 #include <jelly/geometry/cube.hpp>
 #include <jelly/io/recording.hpp>
@@ -280,6 +284,145 @@ TEST(Window, AFailedScreenshotKeepsTheOldFile) {
     EXPECT_EQ(entry.path().filename().string().find(".partial-"), std::string::npos)
         << entry.path();
   }
+}
+
+// The one file of `dir` whose name ends with `extension`, or "" (none, or several).
+std::string only_file(const TempDir& dir, const std::string& extension) {
+  std::string found;
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    const std::string name = entry.path().string();
+    if (name.size() >= extension.size() &&
+        name.compare(name.size() - extension.size(), extension.size(), extension) == 0) {
+      found = name;
+      ++count;
+    }
+  }
+  return count == 1 ? found : "";
+}
+
+// `jelly view --record` (the Record button from the first frame) writes the live run as `jelly
+// run -o` would: the same frames at the same times, bit for bit; `jelly info` reads it and a
+// restart from it continues the run as if it had never stopped (issue 40, deliver 4).
+TEST(Window, RecordsTheLiveRunAndARestartContinuesIt) {
+  TempDir dir;
+  const std::string slope = "'" + kSlope + "' --set cube.n=4";
+  testing::Result r = testing::run(
+      jelly() + "view " + slope + " --frames 30 --record --record-dir '" + dir.path().string() +
+          "' --screenshot '" + dir.file("s.png") + "'" + view_args(),
+      dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string h5 = only_file(dir, ".h5");
+  ASSERT_FALSE(h5.empty()) << "no single recording in " << dir.path();
+  EXPECT_NE(h5.find("jelly-"), std::string::npos) << h5;
+  const Recording live = read_recording(h5);
+  ASSERT_EQ(live.frames(), 31);  // t = 0, 1/60, ..., 30/60: one per window frame
+  r = testing::run(jelly() + "info '" + h5 + "'", dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+
+  r = testing::run(
+      jelly() + "run " + slope + " --duration 0.5 --quiet -o '" + dir.file("run.h5") + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Recording run = read_recording(dir.file("run.h5"));
+  ASSERT_EQ(run.frames(), live.frames());
+  for (int k = 0; k < run.frames(); ++k) {
+    EXPECT_EQ(live.time[k], run.time[k]) << "frame " << k;
+    EXPECT_EQ((live.position[k] - run.position[k]).cwiseAbs().maxCoeff(), 0.0) << "frame " << k;
+  }
+
+  // Restarted from the live recording's checkpoint, to 1 s: where a run straight to 1 s is.
+  r = testing::run(jelly() + "run " + slope + " --restart '" + h5 + "' --duration 1 --quiet -o '" +
+                       dir.file("more.h5") + "'",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(
+      jelly() + "run " + slope + " --duration 1 --quiet -o '" + dir.file("one.h5") + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Recording more = read_recording(dir.file("more.h5"));
+  const Recording one = read_recording(dir.file("one.h5"));
+  ASSERT_GT(more.frames(), 1);
+  EXPECT_NEAR(more.time.front(), 0.5, 1e-9);
+  EXPECT_NEAR(more.time.back(), one.time.back(), 1e-9);
+  EXPECT_LT((more.position.back() - one.position.back()).cwiseAbs().maxCoeff(), 1e-9);
+
+  // Recording again never replaces the file: a second one gets its own name.
+  r = testing::run(jelly() + "view " + slope + " --frames 2 --record --record-dir '" +
+                       dir.path().string() + "' --screenshot '" + dir.file("s.png") + "'" +
+                       view_args(),
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  int recordings = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
+    recordings += entry.path().filename().string().rfind("jelly-", 0) == 0 &&
+                  entry.path().extension() == ".h5";
+  EXPECT_EQ(recordings, 2);
+  EXPECT_EQ(read_recording(h5).frames(), 31);
+  r = testing::run(jelly() + "view " + slope + " --record-dir '" + dir.file("missing") + "'", dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--record-dir"), std::string::npos) << r.err;
+}
+
+// The Record button (F9) in the window: drags and panel changes go into the recording, and the
+// file stores the scene as the run went on, so a restart continues with the changed gravity and
+// a restart of the unchanged scene is refused naming it. F12 writes a screenshot beside it.
+TEST(Window, RecordKeyTakesPanelChangesAndF12WritesAScreenshot) {
+  TempDir dir;
+  Scene scene = load_scene(kSlope, {"cube.n=4"});
+  viewer::ViewOptions options;
+  options.width = kWidth;
+  options.height = kHeight;
+  options.lockstep = true;
+  options.samples = 1;
+  options.record_dir = dir.path().string();
+  auto window = viewer::ViewerWindow::live(scene, kSlope, options);
+  ASSERT_TRUE(window->frame());
+  window->key(GLFW_KEY_F9);
+  EXPECT_TRUE(window->simulation()->recording());
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(window->frame());
+  viewer::LiveSettings settings = window->simulation()->settings();
+  settings.gravity = Vec3(0, -5, 0);
+  window->simulation()->apply(settings);
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(window->frame());
+  window->key(GLFW_KEY_F12);
+  ASSERT_TRUE(window->frame());
+  window->key(GLFW_KEY_F9);
+  ASSERT_TRUE(window->frame());
+  EXPECT_FALSE(window->simulation()->recording());
+  EXPECT_TRUE(window->recording_error().empty()) << window->recording_error();
+  const std::string h5 = window->recording_path(), png = window->last_screenshot();
+  window.reset();
+  ASSERT_FALSE(h5.empty());
+  ASSERT_FALSE(png.empty());
+  EXPECT_EQ(std::filesystem::path(png).parent_path(), std::filesystem::path(h5).parent_path());
+  const viewer::Image image = viewer::read_png(png);
+  EXPECT_EQ(image.width, kWidth);
+  const Recording rec = read_recording(h5);
+  EXPECT_GE(rec.frames(), 21);
+  testing::Result r = testing::run(
+      jelly() + "run '" + kSlope + "' --set cube.n=4 --set 'gravity=[0,-5,0]' --restart '" + h5 +
+          "' --duration 1 --quiet -o '" + dir.file("more.h5") + "'",
+      dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  r = testing::run(jelly() + "run '" + kSlope + "' --set cube.n=4 --restart '" + h5 +
+                       "' --duration 1 --quiet -o '" + dir.file("refused.h5") + "'",
+                   dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("gravity"), std::string::npos) << r.err;
+}
+
+// bear_in_bowl live from the default camera: after 1 s the bears are seen in the bowl, not
+// hidden by its wall (issue 40, item 4).
+TEST(Window, BearsInTheBowlAreSeenLive) {
+  TempDir dir;
+  const testing::Result r =
+      testing::run(jelly() +
+                       "view '" JELLY_SCENES_DIR
+                       "/bear_in_bowl.json' --frames 60 --hide-panel --samples 1 "
+                       "--width 320 --height 180 --screenshot '" +
+                       dir.file("s.png") + "'",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(testing::bear_fraction(viewer::read_png(dir.file("s.png")).rgb), 0.01);
 }
 
 }  // namespace

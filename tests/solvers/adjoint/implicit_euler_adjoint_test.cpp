@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/external_force.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
@@ -437,6 +438,141 @@ TEST(ImplicitEulerAdjoint, CheckpointsGiveTheStoredRunsGradient) {
     EXPECT_EQ(checkpointed.pin_targets, stored.pin_targets);
     EXPECT_EQ(sim.state().x, stored_sim.state().x);
     EXPECT_EQ(sim.state().t, stored_sim.state().t);
+  }
+}
+
+// The external forces' parameters (vector, drag, gust of each force) against central
+// differences of runs of the model with that parameter changed (the gust's step 1e-4: its
+// gradients are small, and the loss is smooth enough in it for the O(step^2) error).
+void check_external_forces(const std::function<AdjointCase(const Model&)>& make_case,
+                           const Model& model) {
+  const GradientResult g = gradient_of(make_case(model));
+  ASSERT_EQ(g.force_vector.size(), model.external_forces.size());
+  const auto difference = [&](Real eps, const std::function<void(ExternalForce&, Real)>& edit,
+                              size_t e) {
+    Model plus = model, minus = model;
+    edit(plus.external_forces[e], eps);
+    edit(minus.external_forces[e], -eps);
+    const auto loss = [](const AdjointCase& c) {
+      return run_loss(c, [](Simulator&, GradientProblem&) {});
+    };
+    return (loss(make_case(plus)) - loss(make_case(minus))) / (2 * eps);
+  };
+  for (size_t e = 0; e < model.external_forces.size(); ++e) {
+    const ExternalForce& force = model.external_forces[e];
+    const std::string name = "external_forces[" + std::to_string(e) + "] (" +
+                             std::string(external_force_kind_name(force.kind)) + ")";
+    for (int d = 0; d < 3; ++d) {
+      expect_close(g.force_vector[e][d],
+                   difference(
+                       1e-6, [d](ExternalForce& f, Real eps) { f.vector[d] += eps; }, e),
+                   kTolerance, name + ".vector[" + std::to_string(d) + "]");
+    }
+    expect_close(g.force_gust[e],
+                 difference(
+                     1e-4, [](ExternalForce& f, Real eps) { f.gust += eps; }, e),
+                 kTolerance, name + ".gust");
+    if (force.kind == ExternalForceKind::kWind) {
+      expect_close(g.force_drag[e],
+                   difference(
+                       1e-6, [](ExternalForce& f, Real eps) { f.drag += eps; }, e),
+                   kTolerance, name + ".drag");
+    } else {
+      EXPECT_EQ(g.force_drag[e], 0) << name;
+    }
+  }
+}
+
+// The cube on the coulomb slope with the model's external forces.
+AdjointCase forced_cube_on_slope(const Model& model) {
+  AdjointCase c = cube_on_slope();
+  const State s0 = jittered(testing::cube_on_slope(model, 20), 1e-4, 0.005);
+  c.make = [model, s0] {
+    Simulator sim = testing::make_sim(model, s0, "implicit_euler", 1.0 / 100);
+    ContactParams contact;
+    contact.friction = 3;
+    contact.static_friction = 3;
+    contact.restitution = 0;
+    sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), contact)));
+    return sim;
+  };
+  return c;
+}
+
+// A constant force (spread by mass, over particles of unequal masses), wind and point forces,
+// gusting, on the cube resting on the slope: every force parameter, and the others through them
+// (masses through the spread, initial velocities through the drag).
+TEST(ImplicitEulerAdjoint, ExternalForcesOnASlopeAgreeWithFiniteDifferences) {
+  Model model = build_cube(testing::small_cube(3, 0.6));
+  model.mass.setConstant(0.2);
+  for (int t = 0; t < kSpringTypeCount; ++t)
+    model.springs.set_coefficients(static_cast<SpringType>(t), {400.0 + 100 * t, 4.0 + t});
+  ExternalForce push;
+  push.kind = ExternalForceKind::kConstant;
+  push.particles = {0, 1, 2, 5, 9, 13, 26};
+  push.vector = Vec3(0.3, -0.2, 0.4);
+  push.gust = 0.3;
+  push.gust_frequency = 2;
+  ExternalForce wind;
+  wind.kind = ExternalForceKind::kWind;
+  wind.particles = {18, 19, 20, 21, 22, 23, 24, 25, 26};
+  wind.vector = Vec3(2, 0.5, -1);
+  wind.drag = 0.05;
+  wind.gust = 0.2;
+  wind.gust_frequency = 3;
+  ExternalForce point;
+  point.kind = ExternalForceKind::kPoint;
+  point.particles = {4, 22};
+  point.vector = Vec3(-0.1, 0.2, 0.05);
+  point.gust = -0.4;
+  point.gust_frequency = 5;
+  model.external_forces = {push, wind, point};
+  check_external_forces(forced_cube_on_slope, model);
+  const AdjointCase c = forced_cube_on_slope(model);
+  check_every_kind(c, 0, {SpringType::kShear});
+  // The spread by mass: the gradient of a body's mass when the pushed particles' masses differ.
+  Model uneven = model;
+  uneven.mass[0] = 0.35;
+  uneven.mass[9] = 0.1;
+  check_external_forces(forced_cube_on_slope, uneven);
+}
+
+// Wind on a pinned cloth whose gust starts inside the run (start = 0.05 s): the CG backward pass
+// (matrix-free, the drag on its diagonal) against central differences, every kind included.
+TEST(ImplicitEulerAdjoint, WindOnAPinnedClothAgreesWithFiniteDifferences) {
+  const AdjointCase base = pinned_cloth();
+  Simulator probe = base.make();
+  Model model = probe.model();
+  ExternalForce wind;
+  wind.kind = ExternalForceKind::kWind;
+  for (int i = 0; i < model.num_particles(); ++i) wind.particles.push_back(i);
+  wind.vector = Vec3(0.5, 0.1, 2);
+  wind.drag = 0.02;
+  wind.gust = 0.5;
+  wind.gust_frequency = 1.5;
+  wind.start = 0.05;
+  model.external_forces = {wind};
+  const State s0 = probe.state();
+  for (const bool cg : {false, true}) {
+    const auto make_case = [&base, s0, cg](const Model& m) {
+      AdjointCase c = base;
+      c.make = [m, s0, cg] {
+        Simulator sim = testing::make_sim(m, s0, "implicit_euler", 1.0 / 60);
+        if (cg) {
+          ImplicitEulerOptions o;
+          o.linear_solver = ImplicitLinearSolver::kCg;
+          o.cg_tolerance = 1e-13;
+          sim.set_integrator(std::make_unique<ImplicitEuler>(o));
+        }
+        return sim;
+      };
+      return c;
+    };
+    check_external_forces(make_case, model);
+    check_every_kind(make_case(model), 0, {SpringType::kStructural});
+    if (cg) {
+      EXPECT_EQ(gradient_of(make_case(model)).backward_solver.rfind("cg", 0), 0u);
+    }
   }
 }
 
