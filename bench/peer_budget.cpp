@@ -142,10 +142,12 @@ Table run_peer_budget(const PeerBudgetOptions& o, const std::vector<PeerSetup>& 
               "wall time of one frame (median/mean/max over all frames of all rounds), "
               "time_ratio = median over rounds of mean frame time / the reference's; "
               "penetration_max (m), stretch_max ((L - l0) / l0 over all springs and frames), "
-              "stretch_end (last frame), volume_ratio_min and inverted_cells_max (cube)",
+              "stretch_end (last frame), volume_ratio_min/_end and inverted_cells_max/_end "
+              "(cube: worst frame, last frame)",
               {"scene:s", "setup:s", "engine:s", "particles", "springs", "status:s", "frames",
                "frame_ms_median", "frame_ms_mean", "frame_ms_max", "time_ratio", "penetration_max",
-               "stretch_max", "stretch_end", "volume_ratio_min", "inverted_cells_max", "reason:s"});
+               "stretch_max", "stretch_end", "volume_ratio_min", "volume_ratio_end",
+               "inverted_cells_max", "inverted_cells_end", "reason:s"});
   const int frames = static_cast<int>(std::lround(o.duration / o.frame));
   for (const std::string& name : o.scenes) {
     const Scene scene = peer_scene(name, o.scenes_dir);
@@ -156,7 +158,8 @@ Table run_peer_budget(const PeerBudgetOptions& o, const std::vector<PeerSetup>& 
     struct Result {
       std::vector<Real> times, round_means;
       FrameMeasures worst;
-      Real stretch_end = NAN;
+      Real stretch_end = NAN, volume_end = NAN;
+      int inverted_end = 0;
       int done = 0;
       std::string status = "completed", reason;
     };
@@ -187,6 +190,8 @@ Table run_peer_budget(const PeerBudgetOptions& o, const std::vector<PeerSetup>& 
           r.worst.inverted_cells = std::max(r.worst.inverted_cells, m.inverted_cells);
           if (lattice) r.worst.volume_ratio = std::min(r.worst.volume_ratio, m.volume_ratio);
           r.stretch_end = m.stretch;
+          r.volume_end = m.volume_ratio;
+          r.inverted_end = m.inverted_cells;
         }
         r.done = f;
         r.round_means.push_back(f > 0 ? sum / f : NAN);
@@ -215,12 +220,14 @@ Table run_peer_budget(const PeerBudgetOptions& o, const std::vector<PeerSetup>& 
         mean += t / r.times.size();
         worst = std::max(worst, t);
       }
-      table.add_row(
-          {name, setups[k].label, setups[k].engine, static_cast<double>(model.num_particles()),
-           static_cast<double>(model.springs.size()), r.status, static_cast<double>(r.done),
-           1e3 * median_of(r.times), 1e3 * mean, 1e3 * worst, ratio, r.worst.penetration,
-           r.worst.stretch, r.stretch_end, lattice ? r.worst.volume_ratio : NAN,
-           lattice ? static_cast<double>(r.worst.inverted_cells) : NAN, r.reason});
+      table.add_row({name, setups[k].label, setups[k].engine,
+                     static_cast<double>(model.num_particles()),
+                     static_cast<double>(model.springs.size()), r.status,
+                     static_cast<double>(r.done), 1e3 * median_of(r.times), 1e3 * mean, 1e3 * worst,
+                     ratio, r.worst.penetration, r.worst.stretch, r.stretch_end,
+                     lattice ? r.worst.volume_ratio : NAN, lattice ? r.volume_end : NAN,
+                     lattice ? static_cast<double>(r.worst.inverted_cells) : NAN,
+                     lattice ? static_cast<double>(r.inverted_end) : NAN, r.reason});
     }
   }
   return table;

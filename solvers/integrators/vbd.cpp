@@ -37,6 +37,17 @@ void Vbd::prepare(const Model& model) {
     pinned_.assign(n, 0);
     anchor_first_.assign(n, -1);
   }
+  // The springs' coefficients in the graph's order (they may change between steps).
+  const size_t ends = graph_.spring.size();
+  edge_rest_.resize(ends);
+  edge_ks_.resize(ends);
+  edge_kd_.resize(ends);
+  for (size_t e = 0; e < ends; ++e) {
+    const int k = graph_.spring[e];
+    edge_rest_[e] = model.springs.rest_length[k];
+    edge_ks_[e] = model.springs.ks[k];
+    edge_kd_[e] = model.springs.kd[k];
+  }
   std::fill(pinned_.begin(), pinned_.end(), 0);
   for (int i : model.pins.particles) pinned_[i] = 1;
 }
@@ -50,41 +61,79 @@ void Vbd::update_particle(const Model& model, const AnchorSprings* anchors, Real
   // The block of G at x_i: gradient -f (f the force on i) and Hessian H.
   const Real inertia = model.mass[i] * inv_h * inv_h;
   Vec3 f = -inertia * (xi - Vec3(particle(y_, i)));
-  Eigen::Matrix3d hess = inertia * Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d elastic = Eigen::Matrix3d::Zero();  // the springs' part, for Rayleigh damping
+  // H = diag I + sum of c u u^T over the springs, accumulated as 6 numbers (symmetric).
+  Real diag = inertia, h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0;
+  // The springs' elastic part alone (ks u u^T + clamped transverse term), for Rayleigh damping.
+  Real e_diag = 0, e00 = 0, e01 = 0, e02 = 0, e11 = 0, e12 = 0, e22 = 0;
+  const bool rayleigh = options_.damping > 0;
+  const Real* px = x.data();
+  const Real* p0 = x0_.data();
   for (int e = graph_.spring_start[i]; e < graph_.spring_start[i + 1]; ++e) {
-    const int k = graph_.spring[e], j = graph_.other[e];
-    const Vec3 xj(particle(x, j));
-    const Vec3 d = xi - xj;
-    const Real length = d.norm();
-    const Real rest = s.rest_length[k];
-    Vec3 u;
+    const int j = graph_.other[e];
+    const Real* xj = px + 3 * j;
+    const Real d0 = xi[0] - xj[0], d1 = xi[1] - xj[1], d2 = xi[2] - xj[2];
+    const Real length = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+    const Real rest = edge_rest_[e];
+    Real u0, u1, u2;
+    Real inv_length = 0;  // 0 for a collapsed spring: no transverse terms
     if (length >= kDegenerateLength * rest && length > 0) {
-      u = d / length;
-    } else {  // collapsed: the direction at rest, as xpbd
-      const int sign = s.a[k] == i ? 1 : -1;
-      u = sign * (Vec3(particle(model.rest_position, s.a[k])) -
-                  Vec3(particle(model.rest_position, s.b[k])));
-      const Real r = u.norm();
-      if (!(r > 0)) continue;
-      u /= r;
+      inv_length = 1.0 / length;
+      u0 = d0 * inv_length;
+      u1 = d1 * inv_length;
+      u2 = d2 * inv_length;
+    } else {  // collapsed: the direction at rest (i's end minus j's), as xpbd
+      const int k = graph_.spring[e];
+      const Real sign = s.a[k] == i ? 1 : -1;
+      const Vec3 r = sign * (Vec3(particle(model.rest_position, s.a[k])) -
+                             Vec3(particle(model.rest_position, s.b[k])));
+      const Real r_length = r.norm();
+      if (!(r_length > 0)) continue;
+      u0 = r[0] / r_length;
+      u1 = r[1] / r_length;
+      u2 = r[2] / r_length;
     }
     // Spring force -ks (L - l0) u and damper force -kd ((v_i - v_j) . u) u, with the
     // velocities of the step's backward-Euler v = (x - x^t) / h.
-    const Real rate = (moved_i - (xj - Vec3(particle(x0_, j)))).dot(u) * inv_h;
-    const Real ks = s.ks[k], kd = s.kd[k];
-    f -= (ks * (length - rest) + kd * rate) * u;
+    const Real* x0j = p0 + 3 * j;
+    const Real rate = ((moved_i[0] - (xj[0] - x0j[0])) * u0 + (moved_i[1] - (xj[1] - x0j[1])) * u1 +
+                       (moved_i[2] - (xj[2] - x0j[2])) * u2) *
+                      inv_h;
+    const Real ks = edge_ks_[e], kd = edge_kd_[e];
+    const Real magnitude = ks * (length - rest) + kd * rate;
+    f[0] -= magnitude * u0;
+    f[1] -= magnitude * u1;
+    f[2] -= magnitude * u2;
     // -df_i/dx_i = ks u u^T + (ks (1 - l0/L) + kd c/L) P (P = I - u u^T) + (kd / h) u u^T,
-    // each transverse term clamped at >= 0 (Choi and Ko 2002, implicit_euler's default).
-    const Real transverse_elastic = length > 0 ? std::max<Real>(0, ks * (1 - rest / length)) : 0;
-    const Real transverse_damper = length > 0 ? std::max<Real>(0, kd * rate / length) : 0;
-    const Eigen::Matrix3d uu = u * u.transpose();
-    const Eigen::Matrix3d p = Eigen::Matrix3d::Identity() - uu;
-    const Eigen::Matrix3d spring_hess = ks * uu + transverse_elastic * p;
-    elastic += spring_hess;
-    hess += spring_hess + (kd * inv_h) * uu + transverse_damper * p;
+    // each transverse term clamped at >= 0 (Choi and Ko 2002, implicit_euler's default):
+    // = b I + (a - b) u u^T with a = ks + kd / h, b the clamped transverse terms.
+    const Real transverse_elastic =
+        inv_length > 0 ? std::max<Real>(0, ks * (1 - rest * inv_length)) : 0;
+    const Real transverse_damper = std::max<Real>(0, kd * rate * inv_length);
+    const Real b = transverse_elastic + transverse_damper;
+    const Real c = ks + kd * inv_h - b;
+    diag += b;
+    h00 += c * u0 * u0;
+    h01 += c * u0 * u1;
+    h02 += c * u0 * u2;
+    h11 += c * u1 * u1;
+    h12 += c * u1 * u2;
+    h22 += c * u2 * u2;
+    if (rayleigh) {
+      const Real ce = ks - transverse_elastic;
+      e_diag += transverse_elastic;
+      e00 += ce * u0 * u0;
+      e01 += ce * u0 * u1;
+      e02 += ce * u0 * u2;
+      e11 += ce * u1 * u1;
+      e12 += ce * u1 * u2;
+      e22 += ce * u2 * u2;
+    }
   }
-  if (options_.damping > 0) {  // Chen et al. 2024, eq. 14
+  Eigen::Matrix3d hess;
+  hess << diag + h00, h01, h02, h01, diag + h11, h12, h02, h12, diag + h22;
+  if (rayleigh) {  // Chen et al. 2024, eq. 14: -(damping / h) H_elastic (x_i - x_i^t)
+    Eigen::Matrix3d elastic;
+    elastic << e_diag + e00, e01, e02, e01, e_diag + e11, e12, e02, e12, e_diag + e22;
     const Real c = options_.damping * inv_h;
     f -= c * (elastic * moved_i);
     hess += c * elastic;

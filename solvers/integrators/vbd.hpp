@@ -5,9 +5,9 @@
 // vertex graph (detail/vertex_colouring.hpp), each particle takes one Newton step on its own
 // 3x3 block (its inertia, springs, dampers and anchor springs; the springs' Hessians made
 // definite as implicit_euler's clamp does), with the particles of one colour in parallel;
-// optionally Chebyshev-accelerated; v = (x - x^t) / h. The coulomb terrains enter each block as
-// penalty energies (VbdOptions::contact_hardness); friction, restitution and the contact between
-// bodies are the Simulator's after the step (the explicit integrators' split, docs/contact.md).
+// optionally Chebyshev-accelerated; v = (x - x^t) / h. Contact with terrains and between bodies
+// is the Simulator's after the step (the explicit integrators' split, docs/contact.md); the
+// coulomb terrains can also enter each block as penalty energies (VbdOptions::contact_hardness).
 #include <vector>
 
 #include <jelly/solvers/integrators/detail/vertex_colouring.hpp>
@@ -48,8 +48,9 @@ class Vbd final : public Integrator {
 
   VbdOptions options_;
   VertexColouring graph_;
-  std::vector<int> spring_a_, spring_b_;          // the topology graph_ was built for
-  std::vector<char> pinned_;                      // [N]
+  std::vector<int> spring_a_, spring_b_;             // the topology graph_ was built for
+  std::vector<char> pinned_;                         // [N]
+  std::vector<Real> edge_rest_, edge_ks_, edge_kd_;  // [2M]: per graph entry, its spring's
   std::vector<int> anchor_first_;                 // [N]: first anchor spring of a particle, or -1
   std::vector<int> anchor_next_;                  // [A]: the particle's next anchor spring, or -1
   std::vector<const Terrain*> penalty_terrains_;  // the coulomb terrains of this step

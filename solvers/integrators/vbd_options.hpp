@@ -17,12 +17,13 @@ struct VbdOptions {
   // -(damping / h) H_i (x_i - x_i^t), H_i its springs' local Hessian; seconds, >= 0. Added to
   // the springs' own dampers (kd), which enter every sweep exactly.
   Real damping = 0;
-  // Coulomb terrains inside the sweeps: a particle below a surface at the step's end has the
-  // penalty energy k d^2 / 2 (d its signed distance, < 0), k = contact_hardness m_i / h^2, in its
-  // block (gradient and Hessian k n n^T), so that the springs answer the contact within the
-  // step; the Simulator's contact after the step then adds friction and restitution and removes
-  // what penetration is left. 0 = contact only after the step. >= 0.
-  Real contact_hardness = 100;
+  // Coulomb terrains inside the sweeps (experimental): a particle below a surface at the step's
+  // end has the penalty energy k d^2 / 2 (d its signed distance, < 0), k = contact_hardness
+  // m_i / h^2, in its block (gradient and Hessian k n n^T), so that the springs answer the
+  // contact within the step; the Simulator's contact after the step then sees no approach, so
+  // that restitution and friction are lost (docs/realtime.md). 0 (default) = the Simulator's
+  // contact after the step only. In [0, 1e8].
+  Real contact_hardness = 0;
 
   // Throws InputError "<prefix><field> = <value> is invalid: <allowed>" for the first invalid
   // field (prefix e.g. "integrator.options.").

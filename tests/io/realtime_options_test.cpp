@@ -40,12 +40,12 @@ TEST(SceneRealtimeOptions, RoundTrip) {
   const Scene vbd = parse_scene(
       kScene, {"integrator.name=vbd", "integrator.options.iterations=15",
                "integrator.options.chebyshev_rho=0.8", "integrator.options.damping=0.01",
-               "integrator.options.contact_hardness=0"});
+               "integrator.options.contact_hardness=50"});
   const Scene vbd_again = parse_scene(scene_to_json(vbd));
   EXPECT_EQ(vbd_again.integrator.options.vbd.iterations, 15);
   EXPECT_EQ(vbd_again.integrator.options.vbd.chebyshev_rho, 0.8);
   EXPECT_EQ(vbd_again.integrator.options.vbd.damping, 0.01);
-  EXPECT_EQ(vbd_again.integrator.options.vbd.contact_hardness, 0);
+  EXPECT_EQ(vbd_again.integrator.options.vbd.contact_hardness, 50);
   EXPECT_NO_THROW(make_simulator(vbd));
 }
 
