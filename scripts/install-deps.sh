@@ -50,6 +50,9 @@ elif [ "${1:-}" = "--tests" ]; then
   # libFuzzer (libclang-rt-dev), OpenMP for clang (libomp-dev), llvm-symbolizer for the reports'
   # stack traces (llvm)
   packages+=(clang libclang-rt-dev libomp-dev llvm)
+  # jelly-bench-bullet (bench/bullet_peer.cpp, built only when Bullet is found): the frame budget
+  # against Bullet's classic soft body (docs/performance.md). About 10 MB to download.
+  packages+=(libbullet-dev)
 elif [ $# -gt 0 ]; then
   echo "usage: $0 [--tests | --docs]" >&2
   exit 2

@@ -4,6 +4,7 @@
 #include <jelly/solvers/arkode/arkode_options.hpp>
 #include <jelly/solvers/integrators/implicit_euler_options.hpp>
 #include <jelly/solvers/integrators/projective_dynamics_options.hpp>
+#include <jelly/solvers/integrators/vbd_options.hpp>
 #include <jelly/solvers/integrators/xpbd_options.hpp>
 
 namespace jelly {
@@ -13,6 +14,7 @@ struct IntegratorOptions {
   ArkodeOptions arkode;           // arkode_erk, arkode_dirk
   ProjectiveDynamicsOptions pd;   // projective_dynamics
   XpbdOptions xpbd;               // xpbd
+  VbdOptions vbd;                 // vbd
 };
 
 }  // namespace jelly

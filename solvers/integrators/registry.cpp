@@ -16,6 +16,7 @@
 #include <jelly/solvers/integrators/projective_dynamics.hpp>
 #include <jelly/solvers/integrators/rk4.hpp>
 #include <jelly/solvers/integrators/symplectic_euler.hpp>
+#include <jelly/solvers/integrators/vbd.hpp>
 #include <jelly/solvers/integrators/xpbd.hpp>
 
 namespace jelly {
@@ -40,6 +41,7 @@ constexpr auto kImplicit = &IntegratorOptions::implicit;
 constexpr auto kArkode = &IntegratorOptions::arkode;
 constexpr auto kPd = &IntegratorOptions::pd;
 constexpr auto kXpbd = &IntegratorOptions::xpbd;
+constexpr auto kVbd = &IntegratorOptions::vbd;
 
 // arkode_erk's options: ArkodeOptions without arkode_dirk's linear solver.
 IntegratorOptionsIo arkode_erk_options() {
@@ -92,6 +94,11 @@ const std::vector<Entry>& table() {
         {{"symplectic_euler",
           "semi-implicit Euler, order 1 (what the report called implicit Euler)", kNoOptions},
          plain<SymplecticEuler>()},
+        {{"vbd",
+          "vertex block descent: per-particle 3x3 Newton steps of backward Euler in a graph "
+          "colouring (Chen 2024), order 1, implicit",
+          options_io<kVbd>()},
+         [](const IntegratorOptions& o) { return std::make_unique<Vbd>(o.vbd); }},
         {{"xpbd", "extended position-based dynamics with substeps (Macklin 2016, 2019), order 1",
           options_io<kXpbd>()},
          [](const IntegratorOptions& o) { return std::make_unique<Xpbd>(o.xpbd); }},

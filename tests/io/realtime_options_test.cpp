@@ -1,4 +1,4 @@
-// Scene files carry the options of projective_dynamics and xpbd (docs/scenes.md).
+// Scene files carry the options of projective_dynamics, xpbd and vbd (docs/scenes.md).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -36,6 +36,17 @@ TEST(SceneRealtimeOptions, RoundTrip) {
   EXPECT_EQ(xpbd_again.integrator.options.xpbd.iterations, 1);
   EXPECT_EQ(xpbd_again.integrator.options.xpbd.contact, PositionContactMode::kAfterStep);
   EXPECT_NO_THROW(make_simulator(xpbd));
+
+  const Scene vbd = parse_scene(
+      kScene, {"integrator.name=vbd", "integrator.options.iterations=15",
+               "integrator.options.chebyshev_rho=0.8", "integrator.options.damping=0.01",
+               "integrator.options.contact_hardness=50"});
+  const Scene vbd_again = parse_scene(scene_to_json(vbd));
+  EXPECT_EQ(vbd_again.integrator.options.vbd.iterations, 15);
+  EXPECT_EQ(vbd_again.integrator.options.vbd.chebyshev_rho, 0.8);
+  EXPECT_EQ(vbd_again.integrator.options.vbd.damping, 0.01);
+  EXPECT_EQ(vbd_again.integrator.options.vbd.contact_hardness, 50);
+  EXPECT_NO_THROW(make_simulator(vbd));
 }
 
 TEST(SceneRealtimeOptions, BadOptionsNameTheirPath) {
@@ -67,6 +78,15 @@ TEST(SceneRealtimeOptions, BadOptionsNameTheirPath) {
             R"(integrator.options.ordering = "colamd" is invalid: one of "amd", "metis", "nesdis", "best")"));
   }
   EXPECT_THROW(parse_scene(kScene, {"integrator.name=xpbd", "integrator.options.contact=\"x\""}),
+               InputError);
+  try {
+    parse_scene(kScene, {"integrator.name=vbd", "integrator.options.chebyshev_rho=1.5"});
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(),
+                ::testing::StartsWith("integrator.options.chebyshev_rho = 1.5 is invalid"));
+  }
+  EXPECT_THROW(parse_scene(kScene, {"integrator.name=vbd", "integrator.options.substeps=2"}),
                InputError);
   // substeps belongs to xpbd, not to projective_dynamics.
   EXPECT_THROW(

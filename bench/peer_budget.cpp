@@ -1,0 +1,236 @@
+#include <jelly/bench/peer_budget.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/geometry/cube.hpp>
+
+namespace jelly::bench {
+
+namespace {
+
+// The signed volume of the lattice cell whose corners are v (corner c at offset
+// (c >> 2 & 1, c >> 1 & 1, c & 1)), as 6 tetrahedra about its diagonal v0 - v7.
+Real cell_volume(const VecX& x, const std::array<int, 8>& v) {
+  static constexpr int kTets[6][2] = {{1, 3}, {3, 2}, {2, 6}, {6, 4}, {4, 5}, {5, 1}};
+  const Vec3 p0(particle(x, v[0])), p7(particle(x, v[7]));
+  Real volume = 0;
+  for (const auto& t : kTets) {
+    const Vec3 a = Vec3(particle(x, v[t[0]])) - p0, b = Vec3(particle(x, v[t[1]])) - p0;
+    volume += a.cross(b).dot(p7 - p0) / 6;
+  }
+  return volume;
+}
+
+Real median_of(std::vector<Real> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+class JellyRun final : public PeerRun {
+ public:
+  explicit JellyRun(Simulator sim) : sim_(std::move(sim)) {}
+  bool frame() override {
+    const StepResult r = sim_.step();
+    if (!r.ok) {
+      why_ = r.message;
+      return false;
+    }
+    if (auto why = sim_.options().divergence.check(sim_.model(), sim_.state())) {
+      why_ = *why;
+      return false;
+    }
+    return true;
+  }
+  const VecX& positions() override { return sim_.state().x; }
+  std::string why() const override { return why_; }
+
+ private:
+  Simulator sim_;
+  std::string why_;
+};
+
+}  // namespace
+
+FrameMeasures measure_frame(const Model& model, const Terrains& terrains, const VecX& x, Real t,
+                            int lattice_n) {
+  FrameMeasures m;
+  for (const auto& terrain : terrains)
+    for (int i = 0; i < model.num_particles(); ++i)
+      m.penetration = std::max(m.penetration, -terrain->signed_distance(particle(x, i), t));
+  const Springs& s = model.springs;
+  for (int k = 0; k < s.size(); ++k) {
+    const Real length = (Vec3(particle(x, s.a[k])) - Vec3(particle(x, s.b[k]))).norm();
+    m.stretch = std::max(m.stretch, (length - s.rest_length[k]) / s.rest_length[k]);
+  }
+  if (lattice_n > 1) {
+    const int n = lattice_n;
+    Real deformed = 0, rest = 0;
+    for (int i = 0; i + 1 < n; ++i)
+      for (int j = 0; j + 1 < n; ++j)
+        for (int k = 0; k + 1 < n; ++k) {
+          std::array<int, 8> v;
+          for (int c = 0; c < 8; ++c)
+            v[c] = cube_index(n, i + (c >> 2 & 1), j + (c >> 1 & 1), k + (c & 1));
+          const Real r = cell_volume(model.rest_position, v), d = cell_volume(x, v);
+          rest += r;
+          deformed += d;
+          if (d * r <= 0) ++m.inverted_cells;
+        }
+    m.volume_ratio = deformed / rest;
+  }
+  return m;
+}
+
+Scene peer_scene(const std::string& name, const std::string& scenes_dir) {
+  if (name == "cloth64")
+    return load_scene(scenes_dir + "/cloth_on_sphere.json", {"bodies.0.nu=64", "bodies.0.nv=64"});
+  if (name == "cube20")
+    return load_scene(scenes_dir + "/seed_slope.json",
+                      {"cube.n=20", "terrains.0.contact.model=\"coulomb\""});
+  throw InputError("--scenes", name, "\"cloth64\" or \"cube20\"");
+}
+
+int peer_lattice_n(const std::string& name) { return name == "cube20" ? 20 : 0; }
+
+PeerSetup jelly_peer_setup(const std::string& label, const std::string& integrator,
+                           const IntegratorOptions& options, int threads) {
+  PeerSetup s;
+  s.label = label;
+  s.engine = "jelly";
+  s.make = [integrator, options, threads](const Scene& scene, Real frame) {
+    Scene copy = scene;
+    copy.integrator.name = integrator;
+    copy.integrator.options = options;
+    copy.integrator.dt = frame;
+    copy.threads = threads;
+    return std::unique_ptr<PeerRun>(new JellyRun(make_simulator(copy)));
+  };
+  return s;
+}
+
+std::vector<PeerSetup> default_jelly_peer_setups(int threads, const IntegratorOptions& options) {
+  std::vector<PeerSetup> s;
+  s.push_back(
+      jelly_peer_setup("vbd i" + std::to_string(options.vbd.iterations), "vbd", options, threads));
+  s.push_back(
+      jelly_peer_setup("xpbd s" + std::to_string(options.xpbd.substeps), "xpbd", options, threads));
+  s.push_back(jelly_peer_setup("implicit_euler", "implicit_euler", options, threads));
+  return s;
+}
+
+void PeerBudgetOptions::validate() const {
+  require(!scenes.empty(), "--scenes", "(empty)", "\"cloth64\" and/or \"cube20\"");
+  for (const std::string& s : scenes)
+    require(s == "cloth64" || s == "cube20", "--scenes", s, "\"cloth64\" or \"cube20\"");
+  require(std::isfinite(frame) && frame > 0, "--frame", frame, "a frame time > 0 s");
+  require(std::isfinite(duration) && duration >= frame, "--duration", duration,
+          "a time >= one frame");
+  require(rounds >= 1 && rounds <= 1000, "--rounds", rounds, "an integer in [1, 1000]");
+}
+
+Table run_peer_budget(const PeerBudgetOptions& o, const std::vector<PeerSetup>& setups) {
+  o.validate();
+  using Clock = std::chrono::steady_clock;
+  Table table("peer_budget",
+              "frame by frame (one step per frame) in alternation, rounds x setups: frame_ms = "
+              "wall time of one frame (median/mean/max over all frames of all rounds), "
+              "time_ratio = median over rounds of mean frame time / the reference's; "
+              "penetration_max (m), stretch_max ((L - l0) / l0 over all springs and frames), "
+              "stretch_end (last frame), volume_ratio_min/_end and inverted_cells_max/_end "
+              "(cube: worst frame, last frame)",
+              {"scene:s", "setup:s", "engine:s", "particles", "springs", "status:s", "frames",
+               "frame_ms_median", "frame_ms_mean", "frame_ms_max", "time_ratio", "penetration_max",
+               "stretch_max", "stretch_end", "volume_ratio_min", "volume_ratio_end",
+               "inverted_cells_max", "inverted_cells_end", "reason:s"});
+  const int frames = static_cast<int>(std::lround(o.duration / o.frame));
+  for (const std::string& name : o.scenes) {
+    const Scene scene = peer_scene(name, o.scenes_dir);
+    const Simulator probe = make_simulator(scene);
+    const Model& model = probe.model();
+    const Terrains& terrains = probe.terrains();
+    const int lattice = peer_lattice_n(name);
+    struct Result {
+      std::vector<Real> times, round_means;
+      FrameMeasures worst;
+      Real stretch_end = NAN, volume_end = NAN;
+      int inverted_end = 0;
+      int done = 0;
+      std::string status = "completed", reason;
+    };
+    std::vector<Result> results(setups.size());
+    for (Result& r : results) r.worst.volume_ratio = lattice ? INFINITY : NAN;
+    for (int round = 0; round < o.rounds; ++round) {
+      for (size_t k = 0; k < setups.size(); ++k) {
+        Result& r = results[k];
+        if (r.status != "completed") continue;
+        std::unique_ptr<PeerRun> run = setups[k].make(scene, o.frame);
+        Real sum = 0;
+        int f = 0;
+        for (; f < frames; ++f) {
+          const auto start = Clock::now();
+          const bool ok = run->frame();
+          const Real seconds = std::chrono::duration<double>(Clock::now() - start).count();
+          if (!ok || !run->positions().allFinite()) {
+            r.status = "failed";
+            r.reason = run->why().empty() ? "a position is not finite" : run->why();
+            break;
+          }
+          r.times.push_back(seconds);
+          sum += seconds;
+          const FrameMeasures m =
+              measure_frame(model, terrains, run->positions(), (f + 1) * o.frame, lattice);
+          r.worst.penetration = std::max(r.worst.penetration, m.penetration);
+          r.worst.stretch = std::max(r.worst.stretch, m.stretch);
+          r.worst.inverted_cells = std::max(r.worst.inverted_cells, m.inverted_cells);
+          if (lattice) r.worst.volume_ratio = std::min(r.worst.volume_ratio, m.volume_ratio);
+          r.stretch_end = m.stretch;
+          r.volume_end = m.volume_ratio;
+          r.inverted_end = m.inverted_cells;
+        }
+        r.done = f;
+        r.round_means.push_back(f > 0 ? sum / f : NAN);
+        if (o.progress) {
+          *o.progress << "peer budget " << name << " round " << round + 1 << " " << setups[k].label
+                      << ": " << (f > 0 ? 1e3 * sum / f : NAN) << " ms/frame, " << r.status
+                      << std::endl;
+        }
+      }
+    }
+    int reference = -1;
+    for (size_t k = 0; k < setups.size(); ++k)
+      if (setups[k].label == o.reference) reference = static_cast<int>(k);
+    for (size_t k = 0; k < setups.size(); ++k) {
+      const Result& r = results[k];
+      Real ratio = NAN;
+      if (reference >= 0) {
+        std::vector<Real> ratios;
+        const auto& ref = results[reference].round_means;
+        for (size_t q = 0; q < std::min(ref.size(), r.round_means.size()); ++q)
+          ratios.push_back(r.round_means[q] / ref[q]);
+        ratio = median_of(ratios);
+      }
+      Real mean = 0, worst = 0;
+      for (Real t : r.times) {
+        mean += t / r.times.size();
+        worst = std::max(worst, t);
+      }
+      table.add_row({name, setups[k].label, setups[k].engine,
+                     static_cast<double>(model.num_particles()),
+                     static_cast<double>(model.springs.size()), r.status,
+                     static_cast<double>(r.done), 1e3 * median_of(r.times), 1e3 * mean, 1e3 * worst,
+                     ratio, r.worst.penetration, r.worst.stretch, r.stretch_end,
+                     lattice ? r.worst.volume_ratio : NAN, lattice ? r.volume_end : NAN,
+                     lattice ? static_cast<double>(r.worst.inverted_cells) : NAN,
+                     lattice ? static_cast<double>(r.inverted_end) : NAN, r.reason});
+    }
+  }
+  return table;
+}
+
+}  // namespace jelly::bench

@@ -1,0 +1,322 @@
+// Vertex block descent (solvers/integrators/vbd.hpp): its colouring, its conservation laws, its
+// rest state against backward Euler's static solution, the impact that crushes xpbd's jelly,
+// and its independence of the thread count (docs/realtime.md).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/integrators/detail/vertex_colouring.hpp>
+#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
+#include <jelly/solvers/integrators/vbd.hpp>
+#include <jelly/terrain/plane.hpp>
+
+#include "support/systems.hpp"
+
+namespace jelly {
+namespace {
+
+Simulator vbd_sim(const Model& model, const State& s, Real dt, const VbdOptions& vbd = {},
+                  int threads = 1) {
+  IntegratorOptions o;
+  o.vbd = vbd;
+  SimulatorOptions so;
+  so.dt = dt;
+  so.threads = threads;
+  return Simulator(model, s, make_integrator("vbd", o), so);
+}
+
+// The signed volume of an n^3 lattice's cells (each split into 6 tetrahedra about its main
+// diagonal) divided by their rest volume, and how many cells have a negative volume.
+struct LatticeVolume {
+  Real ratio = 0;
+  int inverted = 0;
+};
+Real hexahedron_volume(const VecX& x, const std::array<int, 8>& v) {
+  static constexpr int kTets[6][2] = {{1, 3}, {3, 2}, {2, 6}, {6, 4}, {4, 5}, {5, 1}};
+  const Vec3 p0(particle(x, v[0])), p7(particle(x, v[7]));
+  Real volume = 0;
+  for (const auto& t : kTets) {
+    const Vec3 a = Vec3(particle(x, v[t[0]])) - p0, b = Vec3(particle(x, v[t[1]])) - p0;
+    volume += a.cross(b).dot(p7 - p0) / 6;
+  }
+  return volume;
+}
+LatticeVolume lattice_volume(int n, const VecX& rest, const VecX& x) {
+  LatticeVolume out;
+  Real deformed = 0, undeformed = 0;
+  for (int i = 0; i + 1 < n; ++i)
+    for (int j = 0; j + 1 < n; ++j)
+      for (int k = 0; k + 1 < n; ++k) {
+        std::array<int, 8> v;
+        for (int c = 0; c < 8; ++c)
+          v[c] = cube_index(n, i + (c >> 2 & 1), j + (c >> 1 & 1), k + (c & 1));
+        const Real r = hexahedron_volume(rest, v), d = hexahedron_volume(x, v);
+        undeformed += r;
+        deformed += d;
+        if (d * r <= 0) ++out.inverted;
+      }
+  out.ratio = deformed / undeformed;
+  return out;
+}
+
+// No two particles of one colour share a spring, and every particle has one colour.
+TEST(Vbd, ColouringSeparatesEverySpring) {
+  const Model m = build_cube(testing::small_cube(5));
+  const VertexColouring g = colour_vertices(m.num_particles(), m.springs);
+  ASSERT_GT(g.colours(), 1);
+  std::vector<int> colour(m.num_particles(), -1);
+  for (int c = 0; c < g.colours(); ++c)
+    for (int p = g.colour_start[c]; p < g.colour_start[c + 1]; ++p) {
+      ASSERT_EQ(colour[g.particles[p]], -1);
+      colour[g.particles[p]] = c;
+    }
+  for (int i = 0; i < m.num_particles(); ++i) ASSERT_GE(colour[i], 0);
+  for (int k = 0; k < m.springs.size(); ++k)
+    EXPECT_NE(colour[m.springs.a[k]], colour[m.springs.b[k]]) << "spring " << k;
+  // Greedy: at most the largest degree + 1.
+  int degree = 0;
+  for (int i = 0; i < m.num_particles(); ++i)
+    degree = std::max(degree, g.spring_start[i + 1] - g.spring_start[i]);
+  EXPECT_LE(g.colours(), degree + 1);
+}
+
+State spinning(const Model& model, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  State s = rest_state(model);
+  const Vec3 c = center_of_mass(model, s);
+  for (int i = 0; i < model.num_particles(); ++i) {
+    auto x = particle(s.x, i);
+    for (int k = 0; k < 3; ++k) x[k] += 0.05 * u(rng);
+    particle(s.v, i) = Vec3(0.2, -0.1, 0.3) + Vec3(0.5, 1.0, -0.3).cross(Vec3(x) - c);
+  }
+  return s;
+}
+
+// A free, deformed, spinning cube (no gravity, no contact) at a game step: each particle's
+// Newton step moves only its own momentum, so the linear momentum is kept to the residual the
+// sweeps leave of the step's force balance, which falls as the sweeps grow: over one second at
+// 1/60 s it drifted by 1.8 % of p0 with the default 10 sweeps and by 1.4e-7 with 60 (the
+// registry's test checks 10 at dt = 1 ms). (Backward Euler itself damps the angular momentum.)
+TEST(Vbd, FreeCubeKeepsItsMomentum) {
+  CubeSpec spec = testing::small_cube(4);
+  spec.gravity.setZero();
+  const Model model = build_cube(spec);
+  const State s0 = spinning(model, 5);
+  const Vec3 p0 = linear_momentum(model, s0);
+  std::vector<Real> drift;
+  for (int iterations : {10, 60}) {
+    VbdOptions o;
+    o.iterations = iterations;
+    Simulator sim = vbd_sim(model, s0, 1.0 / 60, o);
+    ASSERT_TRUE(sim.run_until(1.0).ok());
+    const Vec3 p1 = linear_momentum(model, sim.state());
+    drift.push_back((p1 - p0).norm() / p0.norm());
+  }
+  EXPECT_LT(drift[0], 0.05);
+  EXPECT_LT(drift[1], 1e-6);
+}
+
+// A cube hanging from its top face: the rest state of backward Euler (implicit_euler, Newton to
+// convergence) is the static solution f(x) = 0. Started there, vbd stays there to within the
+// residual its sweeps leave: each step starts from y = x + h^2 g, and `iterations` sweeps take
+// back all but a fraction of that sag; the fraction shrinks as the iterations grow.
+Model hanging_cube() {
+  Model m = build_cube(testing::small_cube(4, 1.0, Vec3(0, 1, 0)));
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 4; ++k) {
+      const int p = cube_index(4, i, 3, k);
+      m.pins.add_fixed(p, Vec3(particle(m.rest_position, p)));
+    }
+  return m;
+}
+
+TEST(Vbd, HangingCubeStaysAtTheStaticSolution) {
+  const Model m = hanging_cube();
+  ImplicitEulerOptions newton;
+  newton.newton_iterations = 50;
+  newton.newton_tolerance = 1e-13;
+  SimulatorOptions so;
+  so.dt = 1.0 / 60;
+  so.threads = 1;
+  Simulator reference(m, rest_state(m), std::make_unique<ImplicitEuler>(newton), so);
+  ASSERT_TRUE(reference.run_until(20.0).ok());
+  State equilibrium = reference.state();
+  equilibrium.t = 0;
+  ASSERT_LT(testing::max_speed(equilibrium), 1e-9);
+  // The sag of the static solution, the scale of the error.
+  Real sag = 0;
+  for (int i = 0; i < m.num_particles(); ++i)
+    sag = std::max(sag,
+                   (Vec3(particle(equilibrium.x, i)) - Vec3(particle(m.rest_position, i))).norm());
+  ASSERT_GT(sag, 1e-3);
+  std::vector<Real> errors;
+  for (int iterations : {10, 40}) {
+    VbdOptions o;
+    o.iterations = iterations;
+    Simulator sim = vbd_sim(m, equilibrium, 1.0 / 60, o);
+    Real worst = 0;
+    testing::Probe probe([&](const Simulator& s) {
+      worst = std::max(worst, (s.state().x - equilibrium.x).lpNorm<Eigen::Infinity>());
+    });
+    sim.add_observer(probe);
+    ASSERT_TRUE(sim.run_until(3.0).ok());
+    errors.push_back(worst);
+  }
+  // The static solution is kept within 1 % of the sag with the default 10 iterations, and the
+  // error shrinks with more: the rest state is backward Euler's, not a softer one.
+  EXPECT_LT(errors[0], 1e-2 * sag) << "sag " << sag;
+  EXPECT_LT(errors[1], errors[0]);
+}
+
+// The seed cube at n = 20 dropped onto the coulomb slope at 1/60 s (it lands at about 11 m/s
+// after 1.1 s). Returns the run's report, the lowest volume ratio of its cells over the frames,
+// the most inverted cells and the deepest point below the slope.
+struct ImpactOutcome {
+  RunReport report;
+  Real lowest_ratio = INFINITY, deepest = 0;
+  int most_inverted = 0;
+};
+ImpactOutcome seed_cube_n20_impact(Real duration, Real contact_hardness) {
+  CubeSpec spec;
+  spec.n = 20;
+  const Model model = build_cube(spec);
+  SimulatorOptions so;
+  so.dt = 1.0 / 60;
+  so.threads = 1;
+  IntegratorOptions o;
+  o.vbd.contact_hardness = contact_hardness;
+  Simulator sim(model, rest_state(model), make_integrator("vbd", o), so);
+  sim.add_terrain(std::make_unique<Plane>(Plane::slope(20)));
+  const Terrain& slope = *sim.terrains()[0];
+  ImpactOutcome out;
+  testing::Probe probe([&](const Simulator& s) {
+    const LatticeVolume v = lattice_volume(20, model.rest_position, s.state().x);
+    out.lowest_ratio = std::min(out.lowest_ratio, v.ratio);
+    out.most_inverted = std::max(out.most_inverted, v.inverted);
+    for (int i = 0; i < model.num_particles(); ++i)
+      out.deepest = std::min(out.deepest, slope.signed_distance(particle(s.state().x, i), 0));
+  });
+  sim.add_observer(probe);
+  out.report = sim.run_until(duration);
+  return out;
+}
+
+// Through the impact vbd (10 sweeps, penalty contact of hardness 100) stays finite and on the
+// slope (the penalty contact and the contact after the step leave no penetration), but the cube
+// is crushed: the volume ratio fell to 0.22 (2,559 of 6,859 cells inverted; with the contact
+// only after the step, the default, it turns inside out: -0.12; xpbd's default: 0.10, 3,111;
+// implicit_euler: 0.67, 619, back to 0.93 at rest, docs/performance.md). Ten sweeps carry the
+// contact only part of the way up a 20-layer jelly within the step.
+TEST(Vbd, SeedCubeN20StaysFiniteThroughTheImpactAt1_60) {
+  const ImpactOutcome out = seed_cube_n20_impact(1.5, 100);
+  ASSERT_TRUE(out.report.ok()) << out.report.brief();
+  EXPECT_GT(out.deepest, -1e-6);
+  EXPECT_GT(out.lowest_ratio, 0.1);
+}
+
+// Issue 39's goal, not met (see above): the volume ratio above 0.8 through the impact.
+TEST(Vbd, DISABLED_SeedCubeN20KeepsItsVolumeThroughTheImpactAt1_60) {
+  const ImpactOutcome out = seed_cube_n20_impact(3.0, 100);
+  ASSERT_TRUE(out.report.ok()) << out.report.brief();
+  EXPECT_GT(out.lowest_ratio, 0.8);
+  EXPECT_EQ(out.most_inverted, 0);
+}
+
+// Within a colour the particles are independent: 1, 2 and 3 threads give the same bits, with
+// Chebyshev acceleration, Rayleigh damping, an anchor spring and a terrain.
+TEST(Vbd, SameBitsOnAnyThreadCount) {
+  CubeSpec spec = testing::small_cube(16, 1.0, Vec3(0, 0.3, 0));
+  const Model model = build_cube(spec);
+  // Colours large enough for a team of 3 (vbd.cpp: 128 particles per thread at least).
+  ASSERT_GE(colour_vertices(model.num_particles(), model.springs).largest_colour(), 3 * 128);
+  VbdOptions o;
+  o.chebyshev_rho = 0.7;
+  o.damping = 1e-3;
+  std::vector<VecX> ends;
+  for (int threads : {1, 2, 3}) {
+    Simulator sim = vbd_sim(model, spinning(model, 9), 1.0 / 60, o, threads);
+    sim.add_terrain(std::make_unique<Plane>(Vec3::Zero(), Vec3::UnitY()));
+    sim.set_anchors({AnchorSpring{7, Vec3(0.2, 1.5, 0.1), 500, 5}});
+    ASSERT_TRUE(sim.run_until(0.25).ok());
+    ends.push_back(sim.state().x);
+    ends.push_back(sim.state().v);
+  }
+  for (size_t k = 2; k < ends.size(); ++k) {
+    ASSERT_EQ(ends[k].size(), ends[k % 2].size());
+    EXPECT_EQ(0, std::memcmp(ends[k].data(), ends[k % 2].data(), ends[k].size() * sizeof(Real)))
+        << "run " << k / 2 + 1;
+  }
+}
+
+// Chebyshev acceleration brings a step closer to the backward-Euler step at equal iterations.
+TEST(Vbd, ChebyshevAccelerates) {
+  const Model m = build_cube(testing::small_cube(6));
+  State s0 = spinning(m, 3);
+  const Real h = 1.0 / 60;
+  ImplicitEulerOptions newton;
+  newton.newton_iterations = 100;
+  newton.newton_tolerance = 1e-14;
+  ImplicitEuler exact_integrator(newton);
+  ContactSolver contacts;
+  const Dynamics dynamics(m, contacts);
+  State exact = s0;
+  ASSERT_TRUE(exact_integrator.step(dynamics, exact, h).ok);
+  auto error = [&](int iterations, Real rho) {
+    VbdOptions o;
+    o.iterations = iterations;
+    o.chebyshev_rho = rho;
+    Vbd vbd(o);
+    State s = s0;
+    EXPECT_TRUE(vbd.step(dynamics, s, h).ok);
+    return (s.x - exact.x).norm();
+  };
+  // The plain sweeps' convergence factor per sweep, measured: the spectral radius Chebyshev
+  // needs.
+  const Real plain = error(20, 0);
+  const Real rho = std::pow(plain / error(10, 0), 1.0 / 10);
+  ASSERT_GT(rho, 0.1);
+  ASSERT_LT(rho, 1);
+  const Real accelerated = error(20, rho);
+  EXPECT_LT(accelerated, 0.5 * plain) << plain << " " << accelerated << " rho " << rho;
+}
+
+// Invalid options are refused, naming the field, its value and what is allowed.
+TEST(Vbd, InvalidOptionsNameTheField) {
+  auto message = [](const VbdOptions& vbd) -> std::string {
+    IntegratorOptions o;
+    o.vbd = vbd;
+    try {
+      make_integrator("vbd", o);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no InputError";
+  };
+  VbdOptions o;
+  o.iterations = 0;
+  EXPECT_NE(message(o).find("integrator.options.iterations = 0 is invalid"), std::string::npos)
+      << message(o);
+  o = {};
+  o.chebyshev_rho = 1;
+  EXPECT_NE(message(o).find("integrator.options.chebyshev_rho = 1 is invalid"), std::string::npos)
+      << message(o);
+  o = {};
+  o.damping = -1;
+  EXPECT_NE(message(o).find("integrator.options.damping = -1 is invalid"), std::string::npos)
+      << message(o);
+  o = {};
+  o.chebyshev_rho = NAN;
+  EXPECT_NE(message(o).find("integrator.options.chebyshev_rho"), std::string::npos);
+  EXPECT_NO_THROW(make_integrator("vbd"));
+}
+
+}  // namespace
+}  // namespace jelly
