@@ -97,6 +97,53 @@ void BodyContact::prepare(const Model& model) {
   for (int i = 0; i < n; ++i)
     std::sort(neighbours_.begin() + neighbour_start_[i],
               neighbours_.begin() + neighbour_start_[i + 1]);
+  spring_start_ = neighbour_start_;
+  springs_at_.resize(neighbours_.size());
+  fill.assign(spring_start_.begin(), spring_start_.end() - 1);
+  for (int k = 0; k < s.size(); ++k) {
+    springs_at_[fill[s.a[k]]++] = k;
+    springs_at_[fill[s.b[k]]++] = k;
+  }
+  is_touched_.assign(n, 0);
+}
+
+Real BodyContact::touched_energy(const Model& model, const VecX& x, const VecX& v) const {
+  const Springs& s = model.springs;
+  Real e = 0;
+  for (int i : touched_) {
+    e += 0.5 * model.mass[i] * particle(v, i).squaredNorm() -
+         model.mass[i] * model.gravity.dot(particle(x, i));
+    for (int q = spring_start_[i]; q < spring_start_[i + 1]; ++q) {
+      const int k = springs_at_[q];
+      const int other = s.a[k] == i ? s.b[k] : s.a[k];
+      if (is_touched_[other] && other < i) continue;  // counted at its other end
+      const Real stretch = (particle(x, s.a[k]) - particle(x, s.b[k])).norm() - s.rest_length[k];
+      e += 0.5 * s.ks[k] * stretch * stretch;
+    }
+  }
+  return e;
+}
+
+void BodyContact::limit_projection(const Model& model, State& state, Real budget, Real tolerance) {
+  const int m = static_cast<int>(touched_.size());
+  x_resolved_.resize(3 * static_cast<size_t>(m));
+  for (int t = 0; t < m; ++t) {
+    for (int q = 0; q < 3; ++q) x_resolved_[3 * t + q] = state.x[3 * touched_[t] + q];
+  }
+  ++stats_.projections_limited;
+  // Halve the projection until the energy fits; none at all fits (the impulses alone never add
+  // kinetic energy).
+  Real scale = 1;
+  for (int halving = 0; halving <= 10; ++halving) {
+    scale = halving == 10 ? 0.0 : scale * 0.5;
+    for (int t = 0; t < m; ++t) {
+      for (int q = 0; q < 3; ++q) {
+        const Real entry = x_entry_[3 * t + q];
+        state.x[3 * touched_[t] + q] = entry + scale * (x_resolved_[3 * t + q] - entry);
+      }
+    }
+    if (touched_energy(model, state.x, state.v) <= budget + tolerance) return;
+  }
 }
 
 bool BodyContact::joined(int i, int j) const {
@@ -173,6 +220,21 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
   broad_.find_pairs(state.x, radius_, candidates_);
   const auto t1 = Clock::now();
   filter(model);
+  // The particles the pairs touch, their energy at the step's start and now, and where they are.
+  touched_.clear();
+  for (const BroadPhase::Pair& p : contacts_) {
+    for (const int i : {p.first, p.second}) {
+      if (is_touched_[i]) continue;
+      is_touched_[i] = 1;
+      touched_.push_back(i);
+    }
+  }
+  const Real energy_before = touched_energy(model, before.x, before.v);
+  const Real energy_entry = touched_energy(model, state.x, state.v);
+  x_entry_.resize(3 * touched_.size());
+  for (size_t t = 0; t < touched_.size(); ++t) {
+    for (int q = 0; q < 3; ++q) x_entry_[3 * t + q] = state.x[3 * touched_[t] + q];
+  }
   const BodyContactParams& c = params_;
   // Sequential impulses: every pass resolves each pair with the current positions and velocities.
   for (int pass = 0; pass < c.iterations; ++pass) {
@@ -239,6 +301,13 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
     }
     if (!any) break;
   }
+  if (!contacts_.empty()) {
+    const Real budget = std::max(energy_before, energy_entry);
+    const Real tolerance = 1e-12 * (std::abs(energy_before) + std::abs(energy_entry));
+    if (touched_energy(model, state.x, state.v) > budget + tolerance)
+      limit_projection(model, state, budget, tolerance);
+  }
+  for (int i : touched_) is_touched_[i] = 0;
   const auto t2 = Clock::now();
   stats_.pairs += static_cast<long>(contacts_.size());
   stats_.broad_seconds += std::chrono::duration<double>(t1 - t0).count();
