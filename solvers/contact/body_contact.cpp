@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
+
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
 
@@ -127,21 +129,77 @@ Real BodyContact::touched_energy(const Model& model, const VecX& x, const VecX& 
 void BodyContact::limit_projection(const Model& model, State& state, Real budget, Real tolerance) {
   const int m = static_cast<int>(touched_.size());
   x_resolved_.resize(3 * static_cast<size_t>(m));
+  // (Workspace of the rare limited resolve, no allocation once sized.)
+  thread_local std::vector<Real> v_resolved;
+  v_resolved.resize(3 * static_cast<size_t>(m));
   for (int t = 0; t < m; ++t) {
-    for (int q = 0; q < 3; ++q) x_resolved_[3 * t + q] = state.x[3 * touched_[t] + q];
+    for (int q = 0; q < 3; ++q) {
+      x_resolved_[3 * t + q] = state.x[3 * touched_[t] + q];
+      v_resolved[3 * t + q] = state.v[3 * touched_[t] + q];
+    }
   }
   ++stats_.projections_limited;
+  // The touched particles' angular momentum after the resolve (which conserved it, less
+  // friction's torque): a shortened projection loses the lever it compensated, which a rigid
+  // rotation of the touched particles' velocities about their centre of mass gives back
+  // exactly (it changes no linear momentum).
+  const auto angular = [&](bool resolved) {
+    Vec3 l = Vec3::Zero();
+    for (int t = 0; t < m; ++t) {
+      const int i = touched_[t];
+      const Vec3 x = resolved
+                         ? Vec3(x_resolved_[3 * t], x_resolved_[3 * t + 1], x_resolved_[3 * t + 2])
+                         : Vec3(particle(state.x, i));
+      l += model.mass[i] * x.cross(Vec3(particle(state.v, i)));
+    }
+    return l;
+  };
+  const Vec3 target = angular(true);
+  const auto give_back_angular_momentum = [&]() {
+    Real total = 0;
+    Vec3 centre = Vec3::Zero();
+    for (int i : touched_) {
+      if (inverse_mass_[i] == 0) continue;  // a pin takes no part
+      total += model.mass[i];
+      centre += model.mass[i] * particle(state.x, i);
+    }
+    if (!(total > 0)) return;
+    centre /= total;
+    Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+    for (int i : touched_) {
+      if (inverse_mass_[i] == 0) continue;
+      const Vec3 r = particle(state.x, i) - centre;
+      inertia +=
+          model.mass[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+    }
+    // The pseudo-inverse (particles on a line cannot spin about it).
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(inertia);
+    const Vec3 error = angular(false) - target;
+    const Vec3 e = eigen.eigenvectors().transpose() * error;
+    const Real largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
+    Vec3 w = Vec3::Zero();
+    for (int q = 0; q < 3; ++q) {
+      if (eigen.eigenvalues()[q] > 1e-12 * largest) w[q] = -e[q] / eigen.eigenvalues()[q];
+    }
+    const Vec3 omega = eigen.eigenvectors() * w;
+    for (int i : touched_) {
+      if (inverse_mass_[i] > 0) particle(state.v, i) += omega.cross(particle(state.x, i) - centre);
+    }
+  };
   // Halve the projection until the energy fits; none at all fits (the impulses alone never add
-  // kinetic energy).
+  // kinetic energy) when the rotation is left out. (The rotation makes the limited resolve
+  // conserve angular momentum as the full one does.)
   Real scale = 1;
-  for (int halving = 0; halving <= 10; ++halving) {
-    scale = halving == 10 ? 0.0 : scale * 0.5;
+  for (int halving = 0; halving <= 11; ++halving) {
+    scale = halving >= 10 ? 0.0 : scale * 0.5;
     for (int t = 0; t < m; ++t) {
       for (int q = 0; q < 3; ++q) {
         const Real entry = x_entry_[3 * t + q];
         state.x[3 * touched_[t] + q] = entry + scale * (x_resolved_[3 * t + q] - entry);
+        state.v[3 * touched_[t] + q] = v_resolved[3 * t + q];
       }
     }
+    if (halving <= 10) give_back_angular_momentum();
     if (touched_energy(model, state.x, state.v) <= budget + tolerance) return;
   }
 }

@@ -100,7 +100,10 @@ Model two_cubes(Real gap, int n = 4, Real edge = 0.3) {
 // One resolve on overlapping bodies with random velocities: momentum exactly conserved, angular
 // momentum too without friction (friction's torque between particle centres is the one change).
 TEST(BodyContact, ResponseConservesMomentum) {
-  const Model model = two_cubes(-0.04);  // overlapping by 4 cm
+  // Soft springs: the projection stores less spring energy than the impulses absorb, so that it
+  // is not limited and takes the whole overlap out (BodyContactEnergy covers the limited case).
+  Model model = two_cubes(-0.04);  // overlapping by 4 cm
+  for (Real& ks : model.springs.ks) ks = 1;
   std::mt19937 rng(3);
   std::uniform_real_distribution<Real> u(-1, 1);
   State before = rest_state(model);
@@ -132,6 +135,33 @@ TEST(BodyContact, ResponseConservesMomentum) {
     }
     EXPECT_GT(worst, -0.01 * 0.1) << mu;
   }
+}
+
+// The same resolve with the seed's springs (ks = 1400): projecting the whole 4 cm overlap would
+// store more spring energy than the impulses absorb, so it is scaled back; the energy of the
+// touched particles does not rise, and momentum and (frictionless) angular momentum are still
+// conserved to 1e-12.
+TEST(BodyContact, LimitedProjectionConservesMomentum) {
+  const Model model = two_cubes(-0.04);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  State before = rest_state(model);
+  for (int i = 0; i < model.num_particles(); ++i) {
+    particle(before.v, i) =
+        Vec3(u(rng), u(rng), u(rng)) + (i < 64 ? Vec3(2, 0, 0) : Vec3(-2, 0, 0));
+  }
+  BodyContactParams params;
+  params.friction = params.static_friction = 0;
+  params.restitution = 0.5;
+  params.iterations = 50;
+  BodyContact contact(params);
+  State s = before;
+  contact.resolve(model, before, s, 1e-3);
+  EXPECT_EQ(contact.stats().projections_limited, 1);
+  const Real scale = model.mass.sum() * 2;
+  EXPECT_LT((linear_momentum(model, s) - linear_momentum(model, before)).norm(), 1e-12 * scale);
+  EXPECT_LT((angular_momentum(model, s) - angular_momentum(model, before)).norm(), 1e-12 * scale);
+  EXPECT_LE(total_energy(model, s), total_energy(model, before) * (1 + 1e-12));
 }
 
 // Two free cubes thrown at each other off-centre without gravity: they collide and separate;

@@ -212,12 +212,14 @@ Real settled_column_error(const Column& column, int substeps, int iterations) {
 }
 
 // The stretch of the springs under load converges to the compliance's prediction as the
-// substeps grow (one Gauss-Seidel sweep each), and as the sweeps grow.
+// substeps grow (one sweep each), and as the sweeps grow. (Up to 256 substeps: the Jacobi sweep
+// converges more slowly per sweep than the Gauss-Seidel one did, within 2 % at 64 substeps; at
+// 64 the Jacobi column is within 2.7 %.)
 TEST(Xpbd, ColumnCompressionConvergesToTheCompliancePrediction) {
   const Column column;
   const Real scale = (column.count - 1) * 9.8 / column.ks;  // the largest compression
   Real previous = INFINITY;
-  for (const int substeps : {1, 4, 16, 64}) {
+  for (const int substeps : {1, 4, 16, 64, 256}) {
     const Real error = settled_column_error(column, substeps, 1);
     EXPECT_LT(error, previous) << substeps << " substeps";
     previous = error;
@@ -265,11 +267,12 @@ Real settled_chain_error(const HangingChain& chain, const std::string& integrato
 }
 
 // XPBD's stretch of a hanging chain converges to the compliance's prediction as the substeps
-// grow (one sweep each): the pin is a particle of inverse mass 0 in the sweeps.
+// grow (one sweep each): the pin is a particle of inverse mass 0 in the sweeps. (Up to 256
+// substeps, as for the column.)
 TEST(Xpbd, HangingChainStretchConvergesToTheCompliancePrediction) {
   const HangingChain chain;
   Real previous = INFINITY;
-  for (const int substeps : {1, 4, 16, 64}) {
+  for (const int substeps : {1, 4, 16, 64, 256}) {
     IntegratorOptions o;
     o.xpbd.substeps = substeps;
     o.xpbd.iterations = 1;
@@ -537,8 +540,9 @@ TEST(Xpbd, StretchedCubeKeepsZeroMomentum) {
     ASSERT_TRUE(sim.run_until(1.0).ok());
     // It moved: the stretch oscillates back.
     EXPECT_GT(kinetic_energy(model, sim.state()) + elastic_energy(model, sim.state()), 0);
-    EXPECT_LT(spin, 1e-12);
-    EXPECT_LT(momentum, 1e-12);
+    const Real scale = model.mass.sum();  // kg m/s: the total mass at 1 m/s
+    EXPECT_LT(spin, 1e-12 * scale);
+    EXPECT_LT(momentum, 1e-12 * scale);
     EXPECT_LT(center_of_mass(model, sim.state()).norm(), 1e-12);
   }
 }
