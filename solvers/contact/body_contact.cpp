@@ -113,8 +113,7 @@ Real BodyContact::touched_energy(const Model& model, const VecX& x, const VecX& 
   const Springs& s = model.springs;
   Real e = 0;
   for (int i : touched_) {
-    e += 0.5 * model.mass[i] * particle(v, i).squaredNorm() -
-         model.mass[i] * model.gravity.dot(particle(x, i));
+    e += 0.5 * model.mass[i] * particle(v, i).squaredNorm();
     for (int q = spring_start_[i]; q < spring_start_[i + 1]; ++q) {
       const int k = springs_at_[q];
       const int other = s.a[k] == i ? s.b[k] : s.a[k];
@@ -287,8 +286,19 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
       touched_.push_back(i);
     }
   }
+  const auto kinetic = [&](const VecX& v) {
+    Real k = 0;
+    for (int i : touched_) k += 0.5 * model.mass[i] * particle(v, i).squaredNorm();
+    return k;
+  };
+  // The budget: the kinetic energy on entry (the impulses only take from it) and the larger of
+  // the springs' energies at the step's start and on entry (a resting body put back where it was
+  // at the step's start restores springs the step relaxed; never more than they had).
+  const Real kinetic_entry = kinetic(state.v);
   const Real energy_before = touched_energy(model, before.x, before.v);
   const Real energy_entry = touched_energy(model, state.x, state.v);
+  const Real budget =
+      kinetic_entry + std::max(energy_before - kinetic(before.v), energy_entry - kinetic_entry);
   x_entry_.resize(3 * touched_.size());
   for (size_t t = 0; t < touched_.size(); ++t) {
     for (int q = 0; q < 3; ++q) x_entry_[3 * t + q] = state.x[3 * touched_[t] + q];
@@ -360,8 +370,7 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
     if (!any) break;
   }
   if (!contacts_.empty()) {
-    const Real budget = std::max(energy_before, energy_entry);
-    const Real tolerance = 1e-12 * (std::abs(energy_before) + std::abs(energy_entry));
+    const Real tolerance = 1e-12 * (energy_before + energy_entry);
     if (touched_energy(model, state.x, state.v) > budget + tolerance)
       limit_projection(model, state, budget, tolerance);
   }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -12,12 +11,6 @@
 #include <jelly/solvers/contact/detail/position_contact.hpp>
 
 namespace jelly {
-namespace {
-Real experiment_relaxation() {
-  const char* r = std::getenv("XPBD_RELAX");
-  return r ? std::atof(r) : 1.0;
-}
-}  // namespace
 
 Xpbd::Xpbd(XpbdOptions options)
     : options_(std::move(options)), contact_(std::make_unique<PositionContact>()) {
@@ -111,8 +104,7 @@ void Xpbd::prepare(const Model& model, Real hs) {
     const bool jacobi = options_.sweep == XpbdSweep::kJacobi;
     const auto share = [&](int i) { return jacobi ? split_[i] : Real(1); };
     const Real w = share(c.a) * inverse_mass_[c.a] + share(c.b) * inverse_mass_[c.b];
-    c.inverse_denominator =
-        (jacobi ? experiment_relaxation() : 1.0) / ((c.stiffness + c.damping) * w + 1);
+    c.inverse_denominator = 1.0 / ((c.stiffness + c.damping) * w + 1);
   }
 }
 

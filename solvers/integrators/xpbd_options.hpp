@@ -22,11 +22,10 @@ const std::vector<EnumName<XpbdSweep>>& xpbd_sweeps();
 
 struct XpbdOptions {
   // Substeps per step (Macklin et al. 2019: many small steps of one iteration each beat few
-  // steps of many iterations).
-  int substeps = 1;
-  // Sweeps over the springs (and contacts) per substep. One sweep per substep is
-  // too soft at frame-sized substeps: the seed jelly landing at 11 m/s at 1/60 s is crushed
-  // (inverted springs, +87 % energy); two hold it (docs/realtime.md).
+  // steps of many iterations). Three with two Jacobi sweeps each hold the seed jelly landing at
+  // 11 m/s at 1/60 s; one substep of two did not (crushed: docs/realtime.md, "Defaults").
+  int substeps = 3;
+  // Sweeps over the springs (and contacts) per substep.
   int iterations = 2;
   // How a sweep visits the springs (names: xpbd_sweeps()).
   XpbdSweep sweep = XpbdSweep::kJacobi;
