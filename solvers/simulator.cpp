@@ -497,9 +497,6 @@ RunReport Simulator::run_until(Real t_end) {
     report.statistics["body_contact_pairs"] = static_cast<double>(b.pairs);
     report.statistics["broad_phase_ms"] = 1e3 * b.broad_seconds;
     report.statistics["narrow_phase_ms"] = 1e3 * b.narrow_seconds;
-    if (!integrator_->resolves_body_contact())
-      report.statistics["body_contact_projections_limited"] =
-          static_cast<double>(b.projections_limited);
   }
   report.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

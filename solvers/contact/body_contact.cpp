@@ -4,8 +4,6 @@
 #include <chrono>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
 
@@ -99,108 +97,6 @@ void BodyContact::prepare(const Model& model) {
   for (int i = 0; i < n; ++i)
     std::sort(neighbours_.begin() + neighbour_start_[i],
               neighbours_.begin() + neighbour_start_[i + 1]);
-  spring_start_ = neighbour_start_;
-  springs_at_.resize(neighbours_.size());
-  fill.assign(spring_start_.begin(), spring_start_.end() - 1);
-  for (int k = 0; k < s.size(); ++k) {
-    springs_at_[fill[s.a[k]]++] = k;
-    springs_at_[fill[s.b[k]]++] = k;
-  }
-  is_touched_.assign(n, 0);
-}
-
-Real BodyContact::touched_energy(const Model& model, const VecX& x, const VecX& v) const {
-  const Springs& s = model.springs;
-  Real e = 0;
-  for (int i : touched_) {
-    e += 0.5 * model.mass[i] * particle(v, i).squaredNorm();
-    for (int q = spring_start_[i]; q < spring_start_[i + 1]; ++q) {
-      const int k = springs_at_[q];
-      const int other = s.a[k] == i ? s.b[k] : s.a[k];
-      if (is_touched_[other] && other < i) continue;  // counted at its other end
-      const Real stretch = (particle(x, s.a[k]) - particle(x, s.b[k])).norm() - s.rest_length[k];
-      e += 0.5 * s.ks[k] * stretch * stretch;
-    }
-  }
-  return e;
-}
-
-void BodyContact::limit_projection(const Model& model, State& state, Real budget, Real tolerance) {
-  const int m = static_cast<int>(touched_.size());
-  x_resolved_.resize(3 * static_cast<size_t>(m));
-  // (Workspace of the rare limited resolve, no allocation once sized.)
-  thread_local std::vector<Real> v_resolved;
-  v_resolved.resize(3 * static_cast<size_t>(m));
-  for (int t = 0; t < m; ++t) {
-    for (int q = 0; q < 3; ++q) {
-      x_resolved_[3 * t + q] = state.x[3 * touched_[t] + q];
-      v_resolved[3 * t + q] = state.v[3 * touched_[t] + q];
-    }
-  }
-  ++stats_.projections_limited;
-  // The touched particles' angular momentum after the resolve (which conserved it, less
-  // friction's torque): a shortened projection loses the lever it compensated, which a rigid
-  // rotation of the touched particles' velocities about their centre of mass gives back
-  // exactly (it changes no linear momentum).
-  const auto angular = [&](bool resolved) {
-    Vec3 l = Vec3::Zero();
-    for (int t = 0; t < m; ++t) {
-      const int i = touched_[t];
-      const Vec3 x = resolved
-                         ? Vec3(x_resolved_[3 * t], x_resolved_[3 * t + 1], x_resolved_[3 * t + 2])
-                         : Vec3(particle(state.x, i));
-      l += model.mass[i] * x.cross(Vec3(particle(state.v, i)));
-    }
-    return l;
-  };
-  const Vec3 target = angular(true);
-  const auto give_back_angular_momentum = [&]() {
-    Real total = 0;
-    Vec3 centre = Vec3::Zero();
-    for (int i : touched_) {
-      if (inverse_mass_[i] == 0) continue;  // a pin takes no part
-      total += model.mass[i];
-      centre += model.mass[i] * particle(state.x, i);
-    }
-    if (!(total > 0)) return;
-    centre /= total;
-    Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
-    for (int i : touched_) {
-      if (inverse_mass_[i] == 0) continue;
-      const Vec3 r = particle(state.x, i) - centre;
-      inertia +=
-          model.mass[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
-    }
-    // The pseudo-inverse (particles on a line cannot spin about it).
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(inertia);
-    const Vec3 error = angular(false) - target;
-    const Vec3 e = eigen.eigenvectors().transpose() * error;
-    const Real largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
-    Vec3 w = Vec3::Zero();
-    for (int q = 0; q < 3; ++q) {
-      if (eigen.eigenvalues()[q] > 1e-12 * largest) w[q] = -e[q] / eigen.eigenvalues()[q];
-    }
-    const Vec3 omega = eigen.eigenvectors() * w;
-    for (int i : touched_) {
-      if (inverse_mass_[i] > 0) particle(state.v, i) += omega.cross(particle(state.x, i) - centre);
-    }
-  };
-  // Halve the projection until the energy fits; none at all fits (the impulses alone never add
-  // kinetic energy) when the rotation is left out. (The rotation makes the limited resolve
-  // conserve angular momentum as the full one does.)
-  Real scale = 1;
-  for (int halving = 0; halving <= 11; ++halving) {
-    scale = halving >= 10 ? 0.0 : scale * 0.5;
-    for (int t = 0; t < m; ++t) {
-      for (int q = 0; q < 3; ++q) {
-        const Real entry = x_entry_[3 * t + q];
-        state.x[3 * touched_[t] + q] = entry + scale * (x_resolved_[3 * t + q] - entry);
-        state.v[3 * touched_[t] + q] = v_resolved[3 * t + q];
-      }
-    }
-    if (halving <= 10) give_back_angular_momentum();
-    if (touched_energy(model, state.x, state.v) <= budget + tolerance) return;
-  }
 }
 
 bool BodyContact::joined(int i, int j) const {
@@ -277,32 +173,6 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
   broad_.find_pairs(state.x, radius_, candidates_);
   const auto t1 = Clock::now();
   filter(model);
-  // The particles the pairs touch, their energy at the step's start and now, and where they are.
-  touched_.clear();
-  for (const BroadPhase::Pair& p : contacts_) {
-    for (const int i : {p.first, p.second}) {
-      if (is_touched_[i]) continue;
-      is_touched_[i] = 1;
-      touched_.push_back(i);
-    }
-  }
-  const auto kinetic = [&](const VecX& v) {
-    Real k = 0;
-    for (int i : touched_) k += 0.5 * model.mass[i] * particle(v, i).squaredNorm();
-    return k;
-  };
-  // The budget: the kinetic energy on entry (the impulses only take from it) and the larger of
-  // the springs' energies at the step's start and on entry (a resting body put back where it was
-  // at the step's start restores springs the step relaxed; never more than they had).
-  const Real kinetic_entry = kinetic(state.v);
-  const Real energy_before = touched_energy(model, before.x, before.v);
-  const Real energy_entry = touched_energy(model, state.x, state.v);
-  const Real budget =
-      kinetic_entry + std::max(energy_before - kinetic(before.v), energy_entry - kinetic_entry);
-  x_entry_.resize(3 * touched_.size());
-  for (size_t t = 0; t < touched_.size(); ++t) {
-    for (int q = 0; q < 3; ++q) x_entry_[3 * t + q] = state.x[3 * touched_[t] + q];
-  }
   const BodyContactParams& c = params_;
   // Sequential impulses: every pass resolves each pair with the current positions and velocities.
   for (int pass = 0; pass < c.iterations; ++pass) {
@@ -369,12 +239,6 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
     }
     if (!any) break;
   }
-  if (!contacts_.empty()) {
-    const Real tolerance = 1e-12 * (energy_before + energy_entry);
-    if (touched_energy(model, state.x, state.v) > budget + tolerance)
-      limit_projection(model, state, budget, tolerance);
-  }
-  for (int i : touched_) is_touched_[i] = 0;
   const auto t2 = Clock::now();
   stats_.pairs += static_cast<long>(contacts_.size());
   stats_.broad_seconds += std::chrono::duration<double>(t1 - t0).count();

@@ -11,13 +11,6 @@
 // momentum is conserved exactly by the normal response and the projection (the projection's
 // lever is compensated), and changed by friction only (by the torque of a tangential impulse
 // between two particle centres, which the particles cannot take up as spin).
-// The impulses never add kinetic energy, but the projection moves particles against their
-// springs (and gravity) without taking the work from anyone: at large steps (ks h^2 > m) it
-// would store more spring energy than the contact absorbed. So the resolve never ends with more
-// energy in its particles and their springs (kinetic + elastic + gravitational, over the
-// particles it touched and the springs at them) than they had at the step's start or before the
-// resolve, whichever is more: the projection is scaled back (halved until it does not, at
-// worst dropped) and the overlap left is taken out in later steps.
 #include <string>
 #include <vector>
 
@@ -51,7 +44,6 @@ class BodyContact {
     double broad_seconds = 0;   // time in the broad phase
     double narrow_seconds = 0;  // time filtering and resolving the pairs
     long steps = 0;
-    long projections_limited = 0;  // resolves whose projection was scaled back (energy)
   };
 
   BodyContact() = default;
@@ -92,12 +84,6 @@ class BodyContact {
   // Keeps the broad phase's pairs that may touch: other bodies, or (self-contact) no spring.
   void filter(const Model& model);
   bool joined(int i, int j) const;
-  // Kinetic + gravitational energy of the touched particles and elastic energy of the springs
-  // at them, at (x, v).
-  Real touched_energy(const Model& model, const VecX& x, const VecX& v) const;
-  // Scales the touched particles' projection back (from x_entry_) until touched_energy is at
-  // most `budget`.
-  void limit_projection(const Model& model, State& state, Real budget, Real tolerance);
 
   BodyContactParams params_;
   BroadPhase broad_;
@@ -106,13 +92,6 @@ class BodyContact {
   VecX radius_, inverse_mass_, padded_;
   std::vector<int> body_;
   std::vector<int> neighbour_start_, neighbours_;  // CSR, sorted
-  std::vector<int> spring_start_, springs_at_;     // CSR: the springs at each particle
-  // The particles of the current resolve's pairs (each once), their flags, and their positions
-  // on entry and after the projection (3 per touched particle); workspace, no allocation once
-  // sized.
-  std::vector<int> touched_;
-  std::vector<char> is_touched_;
-  std::vector<Real> x_entry_, x_resolved_;
   std::vector<BroadPhase::Pair> candidates_, contacts_;
   Stats stats_;
 };

@@ -100,10 +100,7 @@ Model two_cubes(Real gap, int n = 4, Real edge = 0.3) {
 // One resolve on overlapping bodies with random velocities: momentum exactly conserved, angular
 // momentum too without friction (friction's torque between particle centres is the one change).
 TEST(BodyContact, ResponseConservesMomentum) {
-  // Soft springs: the projection stores less spring energy than the impulses absorb, so that it
-  // is not limited and takes the whole overlap out (BodyContactEnergy covers the limited case).
-  Model model = two_cubes(-0.04);  // overlapping by 4 cm
-  for (Real& ks : model.springs.ks) ks = 1;
+  const Model model = two_cubes(-0.04);  // overlapping by 4 cm
   std::mt19937 rng(3);
   std::uniform_real_distribution<Real> u(-1, 1);
   State before = rest_state(model);
@@ -135,33 +132,6 @@ TEST(BodyContact, ResponseConservesMomentum) {
     }
     EXPECT_GT(worst, -0.01 * 0.1) << mu;
   }
-}
-
-// The same resolve with the seed's springs (ks = 1400): projecting the whole 4 cm overlap would
-// store more spring energy than the impulses absorb, so it is scaled back; the energy of the
-// touched particles does not rise, and momentum and (frictionless) angular momentum are still
-// conserved to 1e-12.
-TEST(BodyContact, LimitedProjectionConservesMomentum) {
-  const Model model = two_cubes(-0.04);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<Real> u(-1, 1);
-  State before = rest_state(model);
-  for (int i = 0; i < model.num_particles(); ++i) {
-    particle(before.v, i) =
-        Vec3(u(rng), u(rng), u(rng)) + (i < 64 ? Vec3(2, 0, 0) : Vec3(-2, 0, 0));
-  }
-  BodyContactParams params;
-  params.friction = params.static_friction = 0;
-  params.restitution = 0.5;
-  params.iterations = 50;
-  BodyContact contact(params);
-  State s = before;
-  contact.resolve(model, before, s, 1e-3);
-  EXPECT_EQ(contact.stats().projections_limited, 1);
-  const Real scale = model.mass.sum() * 2;
-  EXPECT_LT((linear_momentum(model, s) - linear_momentum(model, before)).norm(), 1e-12 * scale);
-  EXPECT_LT((angular_momentum(model, s) - angular_momentum(model, before)).norm(), 1e-12 * scale);
-  EXPECT_LE(total_energy(model, s), total_energy(model, before) * (1 + 1e-12));
 }
 
 // Two free cubes thrown at each other off-centre without gravity: they collide and separate;
@@ -468,75 +438,6 @@ TEST(BodyContact, BadParametersNameTheField) {
   p = {};
   p.iterations = 0;
   EXPECT_THROW(BodyContact{p}, InputError);
-}
-
-}  // namespace
-}  // namespace jelly
-
-namespace jelly {
-namespace {
-
-// Two n = 4 cubes thrown head on at 3 m/s each (no gravity), frictionless, with `restitution`,
-// under `integrator` (implicit_euler with its body contact after the step): of the seed's
-// material (ks = 1400, kd = 50, 1 kg particles) or stiff (two_jellies.json's: ks = 5000, kd = 8,
-// 0.1 kg: ks h^2 / m = 14 at 1/60 s). Returns the largest total energy (kinetic + elastic +
-// gravitational) at any step over E0, and asserts that they touched.
-Real largest_energy_ratio(const std::string& integrator, Real dt, Real restitution, bool stiff) {
-  SCOPED_TRACE(integrator + " at dt = " + std::to_string(dt) + (stiff ? ", stiff" : ", seed"));
-  Model model;
-  for (const Real x : {-0.35, 0.05}) {
-    CubeSpec c = testing::small_cube(4, 0.3, Vec3(x, x < 0 ? 0.0 : 0.1, x < 0 ? 0.0 : 0.05));
-    if (stiff) {
-      c.particle_mass = 0.1;
-      for (auto& k : c.springs) k = SpringCoefficients{5000, 8};
-    }
-    model.add_body(x < 0 ? "left" : "right", c.shape().build(c.material(), "c."));
-  }
-  model.gravity.setZero();
-  State s = rest_state(model);
-  for (int i = 0; i < model.num_particles(); ++i)
-    particle(s.v, i) = Vec3(i < 64 ? 3.0 : -3.0, 0, 0);
-  IntegratorOptions o;
-  o.implicit.contact = ImplicitContactMode::kAfterStep;
-  SimulatorOptions so;
-  so.dt = dt;
-  Simulator sim(model, s, make_integrator(integrator, o), so);
-  BodyContactParams params;
-  params.friction = params.static_friction = 0;
-  params.restitution = restitution;
-  sim.set_body_contact(params);
-  const Real e0 = total_energy(model, s);
-  Real highest = e0;
-  long touching = 0;
-  testing::Probe probe([&](const Simulator& sm) {
-    highest = std::max(highest, total_energy(model, sm.state()));
-    touching += sm.body_contact().pairs().empty() ? 0 : 1;
-  });
-  sim.add_observer(probe);
-  EXPECT_TRUE(sim.run_until(0.4).ok());
-  EXPECT_GT(touching, 0);
-  return highest / e0;
-}
-
-// A frictionless, inelastic collision never raises the total energy (it rose to 1.16-1.19 E0 at
-// 1/60 s: the projection compressed springs that no one paid for), at game steps; elastic, it
-// keeps it to 0.1 % at 1 ms (it gained 2.8 %).
-class BodyContactEnergy : public ::testing::TestWithParam<std::string> {};
-INSTANTIATE_TEST_SUITE_P(AfterTheStep, BodyContactEnergy,
-                         ::testing::Values("xpbd", "projective_dynamics", "implicit_euler"),
-                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
-
-TEST_P(BodyContactEnergy, InelasticCollisionNeverGainsEnergy) {
-  for (const bool stiff : {false, true}) {
-    for (const Real dt : {1.0 / 60, 1.0 / 30}) {
-      EXPECT_LE(largest_energy_ratio(GetParam(), dt, 0, stiff), 1 + 1e-12);
-    }
-  }
-}
-
-TEST_P(BodyContactEnergy, ElasticCollisionKeepsEnergyAt1ms) {
-  for (const bool stiff : {false, true})
-    EXPECT_LE(largest_energy_ratio(GetParam(), 1e-3, 1, stiff), 1.001);
 }
 
 }  // namespace
