@@ -40,7 +40,7 @@ struct Scene {
   DivergenceGuard divergence;
   // When a run reports a body crushed (solvers/run_report.hpp; key "crush"; written only when
   // not the defaults).
-  CrushLimits crush;
+  CrushLimits crush{};
   // Most particles the bodies may have together (a guard against a spacing or n that would
   // exhaust memory).
   long max_particles = 2'000'000;

@@ -112,7 +112,7 @@ struct SimulatorOptions {
   // same bit for bit for any value.
   int threads = 0;
   // When the end of a run reports a body crushed (run_report.hpp).
-  CrushLimits crush;
+  CrushLimits crush{};
   void validate() const;
 };
 
