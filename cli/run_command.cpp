@@ -210,7 +210,9 @@ int run_command(const RunArgs& args) {
   }
   if (report.has_warnings()) {
     if (args.strict) {
-      std::fprintf(stderr, "error: the run missed its solver's tolerance (--strict): %s\n",
+      const bool crushed = report.reason.find(" is crushed: ") != std::string::npos;
+      std::fprintf(stderr, "error: the run %s (--strict): %s\n",
+                   crushed ? "ended with warnings" : "missed its solver's tolerance",
                    report.reason.c_str());
       return kExitRunFailed;
     }

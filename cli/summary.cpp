@@ -31,6 +31,8 @@ void print_summary(std::FILE* out, const Scene& scene, const Simulator& sim,
     stats += (stats.empty() ? "" : ", ") + name + " = " + number;
   }
   if (!stats.empty()) std::fprintf(out, "  statistics      %s\n", stats.c_str());
+  for (const std::string& note : report.notes)
+    std::fprintf(out, "  note            %s\n", note.c_str());
   if (!output_path.empty()) std::fprintf(out, "  output          %s\n", output_path.c_str());
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // A body of the model: a named range of particles and springs with its own material and render
 // surface; and BodyPart, what a body builder (geometry/) returns before it joins a model.
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +18,18 @@ struct ParticleGroup {
   std::vector<int> particles;
 };
 
+// The volume a body fills, for measuring how much it is crushed (core/body_volume.hpp): the
+// lattice's cells (corner c at grid offset (c & 1, (c >> 1) & 1, (c >> 2) & 1)) or a mesh's
+// tetrahedra (positively oriented at rest). Both empty: a body without volume (cloth).
+struct VolumeElements {
+  std::vector<std::array<int, 8>> cells;
+  std::vector<std::array<int, 4>> tets;
+
+  bool empty() const { return cells.empty() && tets.empty(); }
+  long size() const { return static_cast<long>(cells.size() + tets.size()); }
+  void shift_particles(int offset);
+};
+
 // What a body builder makes: particles, springs and surface with indices local to the part.
 struct BodyPart {
   std::string kind;  // the body kind that built it ("cube", "box", "cloth", ...)
@@ -26,6 +39,7 @@ struct BodyPart {
   Surface surface;   // local particle indices
   Real spacing = 0;  // typical distance between neighbouring particles (m)
   std::vector<ParticleGroup> groups;
+  VolumeElements volume;  // local particle indices
 
   int num_particles() const { return static_cast<int>(mass.size()); }
 };
@@ -43,6 +57,7 @@ struct Body {
   Vec3 angular_velocity = Vec3::Zero();  // rad/s
   Surface surface;                       // global particle indices
   std::vector<ParticleGroup> groups;     // global particle indices
+  VolumeElements volume;                 // global particle indices
   // Its colour in pictures and exports: sRGB [r, g, b], each in [0, 1]; none = the viewer's
   // palette by body index.
   std::optional<Vec3> color;

@@ -1,5 +1,6 @@
 #include <jelly/core/measures.hpp>
 
+#include <array>
 #include <vector>
 
 #include <jelly/core/detail/parallel.hpp>
@@ -24,6 +25,39 @@ Real springs_energy(const Springs& s, const VecX& x, long begin, long end) {
   return e;
 }
 }  // namespace
+
+namespace {
+Real signed_six_volume(const VecX& x, int a, int b, int c, int d) {
+  const Vec3 pa = particle(x, a);
+  return (particle(x, b) - pa).dot((particle(x, c) - pa).cross(particle(x, d) - pa));
+}
+
+// Six times a lattice cell's signed volume: the six tetrahedra around its diagonal 0-7, the
+// corners 1, 3, 2, 6, 4, 5 taken in turn around it (each positive for an undeformed cell).
+Real cell_six_volume(const VecX& x, const std::array<int, 8>& c) {
+  constexpr int kRing[7] = {1, 3, 2, 6, 4, 5, 1};
+  Real v = 0;
+  for (int t = 0; t < 6; ++t) v += signed_six_volume(x, c[0], c[kRing[t]], c[kRing[t + 1]], c[7]);
+  return v;
+}
+}  // namespace
+
+BodyVolume body_volume(const Model& model, const Body& body, const VecX& x) {
+  BodyVolume out;
+  const VolumeElements& e = body.volume;
+  out.elements = e.size();
+  const auto add = [&](Real rest6, Real now6) {
+    out.rest += rest6 / 6;
+    out.current += now6 / 6;
+    if (!(now6 * rest6 > 0)) ++out.inverted;
+  };
+  for (const auto& c : e.cells) add(cell_six_volume(model.rest_position, c), cell_six_volume(x, c));
+  for (const auto& t : e.tets) {
+    add(signed_six_volume(model.rest_position, t[0], t[1], t[2], t[3]),
+        signed_six_volume(x, t[0], t[1], t[2], t[3]));
+  }
+  return out;
+}
 
 Real elastic_energy(const Model& model, const VecX& x) {
   return springs_energy(model.springs, x, 0, model.springs.size());

@@ -27,6 +27,22 @@ inline Real total_energy(const Model& m, const State& s) {
   return kinetic_energy(m, s.v) + elastic_energy(m, s.x) + gravitational_energy(m, s.x);
 }
 
+// How much a body is crushed at x: the signed volumes of its volume elements (Body::volume; a
+// lattice cell's as the sum of the six tetrahedra around its diagonal from corner 0 to 7)
+// against the same at the rest positions. An element is inverted when its signed volume has
+// lost the sign it has at rest, or is 0.
+struct BodyVolume {
+  long elements = 0;  // cells or tetrahedra; 0: a body without volume (a cloth)
+  long inverted = 0;
+  Real rest = 0, current = 0;  // m^3, the sums of the elements' signed volumes
+
+  bool has_volume() const { return elements > 0 && rest != 0; }
+  Real ratio() const { return has_volume() ? current / rest : 1; }
+  Real inverted_fraction() const { return elements > 0 ? Real(inverted) / elements : 0; }
+};
+// No allocation; O(elements).
+BodyVolume body_volume(const Model& model, const Body& body, const VecX& x);
+
 // elastic_energy on up to `threads` threads, its terms summed in fixed chunks: the same value
 // for any thread count (rounded unlike the one-loop sum above).
 Real elastic_energy(const Model& model, const VecX& x, int threads);

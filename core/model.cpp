@@ -31,6 +31,8 @@ int Model::add_body(const std::string& name, BodyPart part, Real radius) {
   for (ParticleGroup& g : body.groups) {
     for (int& p : g.particles) p += first;
   }
+  body.volume = std::move(part.volume);
+  body.volume.shift_particles(first);
 
   mass.conservativeResize(first + n);
   mass.tail(n) = part.mass;
@@ -39,6 +41,15 @@ int Model::add_body(const std::string& name, BodyPart part, Real radius) {
   springs.append(part.springs, first);
   bodies.push_back(std::move(body));
   return num_bodies() - 1;
+}
+
+void VolumeElements::shift_particles(int offset) {
+  for (auto& c : cells) {
+    for (int& p : c) p += offset;
+  }
+  for (auto& t : tets) {
+    for (int& p : t) p += offset;
+  }
 }
 
 const Body* Model::find_body(std::string_view name) const {

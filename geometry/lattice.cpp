@@ -166,6 +166,15 @@ BodyPart build_lattice(const LatticeGrid& g, const Material& material, const std
         connect(i, j, k, 0, 0, 2, SpringType::kBending);
       }
   part.surface = boundary_surface(g, index);
+  for (int i = 0; i + 1 < g.n[0]; ++i)
+    for (int j = 0; j + 1 < g.n[1]; ++j)
+      for (int k = 0; k + 1 < g.n[2]; ++k) {
+        if (!solid_cell(g, i, j, k)) continue;
+        std::array<int, 8> cell;
+        for (int c = 0; c < 8; ++c)
+          cell[c] = index[g.index(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))];
+        part.volume.cells.push_back(cell);
+      }
   return part;
 }
 

@@ -232,6 +232,13 @@ BodyPart build_tetmesh(const TetMesh& mesh, const Pose& pose, const Material& ma
     part.surface.triangles.push_back(t);
   }
   for (const VertexGroup& g : mesh.groups) part.groups.push_back({g.name, g.vertices});
+  part.volume.tets.reserve(mesh.tets.size());
+  for (const Tet& t : mesh.tets) {
+    std::array<int, 4> oriented{t[0], t[1], t[2], t[3]};
+    if (six_volume(placed[t[0]], placed[t[1]], placed[t[2]], placed[t[3]]) < 0)
+      std::swap(oriented[2], oriented[3]);
+    part.volume.tets.push_back(oriented);
+  }
   return part;
 }
 

@@ -315,7 +315,8 @@ const Json* at_path(const Json& j, const std::string& path) {
 // The parts of a scene that decide its trajectory, as JSON.
 Json run_defining_json(const Scene& scene) {
   Json j = detail::parse_json(scene_to_json(scene), "scene");
-  for (const char* key : {"description", "duration", "output_interval", "divergence"}) j.erase(key);
+  for (const char* key : {"description", "duration", "output_interval", "divergence", "crush"})
+    j.erase(key);
   return j;
 }
 
@@ -344,7 +345,7 @@ void check_same_scene(const Checkpoint& cp, const Scene& scene, const std::strin
   throw InputError("--restart " + source + ": its run had " + path + " = " + text(was) +
                    ", this scene has " + text(now) +
                    ": a restart continues the same run (only duration, output_interval, "
-                   "divergence and description may change)");
+                   "divergence, crush and description may change)");
 }
 
 }  // namespace jelly

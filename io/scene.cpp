@@ -20,6 +20,7 @@ SimulatorOptions simulator_options(const Scene& scene) {
   options.dt = scene.integrator.dt;
   options.output_interval = scene.output_interval;
   options.divergence = scene.divergence;
+  options.crush = scene.crush;
   options.threads = scene.threads;
   return options;
 }

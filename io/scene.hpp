@@ -38,6 +38,9 @@ struct Scene {
   Real duration = 5;                // s simulated by `jelly run`; required in a scene file
   Real output_interval = 1.0 / 60;  // s between recorded frames; 0 = every step
   DivergenceGuard divergence;
+  // When a run reports a body crushed (solvers/run_report.hpp; key "crush"; written only when
+  // not the defaults).
+  CrushLimits crush{};
   // Most particles the bodies may have together (a guard against a spacing or n that would
   // exhaust memory).
   long max_particles = 2'000'000;

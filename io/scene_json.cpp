@@ -101,6 +101,13 @@ Scene scene_from_json(const Json& j, const std::string& base_directory) {
     s.divergence.max_distance = f.number_or("max_distance", s.divergence.max_distance);
     f.reject_unknown();
   }
+  if (const Json* c = root.value("crush")) {
+    JsonFields f(*c, "crush");
+    s.crush.min_volume_ratio = f.number_or("min_volume_ratio", s.crush.min_volume_ratio);
+    s.crush.max_inverted_fraction =
+        f.number_or("max_inverted_fraction", s.crush.max_inverted_fraction);
+    f.reject_unknown();
+  }
   s.threads = root.integer_or("threads", s.threads);
   root.reject_unknown();
   s.validate();
@@ -133,6 +140,12 @@ std::string scene_to_json(const Scene& s) {
   j["output_interval"] = s.output_interval;
   j["divergence"] = {{"max_speed", s.divergence.max_speed},
                      {"max_distance", s.divergence.max_distance}};
+  const CrushLimits defaults;
+  if (s.crush.min_volume_ratio != defaults.min_volume_ratio ||
+      s.crush.max_inverted_fraction != defaults.max_inverted_fraction) {
+    j["crush"] = {{"min_volume_ratio", s.crush.min_volume_ratio},
+                  {"max_inverted_fraction", s.crush.max_inverted_fraction}};
+  }
   j["threads"] = s.threads;
   return j.dump(2) + "\n";
 }

@@ -1,6 +1,10 @@
 #include <jelly/solvers/run_report.hpp>
 
+#include <cmath>
 #include <cstdio>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
 
 namespace jelly {
 
@@ -25,6 +29,44 @@ std::string RunReport::brief() const {
   std::string out = buffer;
   if (!reason.empty()) out += ": " + reason;
   return out;
+}
+
+void CrushLimits::validate() const {
+  require(std::isfinite(min_volume_ratio) && min_volume_ratio >= 0 && min_volume_ratio <= 1,
+          "crush.min_volume_ratio", min_volume_ratio, "a number in [0, 1] (0: never by volume)");
+  require(std::isfinite(max_inverted_fraction) && max_inverted_fraction >= 0 &&
+              max_inverted_fraction <= 1,
+          "crush.max_inverted_fraction", max_inverted_fraction,
+          "a number in [0, 1] (1: never by inverted cells)");
+}
+
+void report_crushed_bodies(const Model& model, const VecX& x, const CrushLimits& limits,
+                           RunReport& report) {
+  for (const Body& body : model.bodies) {
+    const BodyVolume v = body_volume(model, body, x);
+    if (!v.has_volume()) {
+      report.notes.push_back("body \"" + body.name + "\" (" + body.kind +
+                             ") has no volume: not checked for crushing");
+      continue;
+    }
+    const bool cells = !body.volume.cells.empty();
+    const std::string what = cells ? "cells" : "tetrahedra";
+    report.statistics["volume_ratio." + body.name] = v.ratio();
+    report.statistics[(cells ? "inverted_cells." : "inverted_tets.") + body.name] =
+        static_cast<double>(v.inverted);
+    const bool small = v.ratio() < limits.min_volume_ratio;
+    const bool inverted = v.inverted_fraction() > limits.max_inverted_fraction;
+    if (!report.ok() || !(small || inverted)) continue;
+    char figures[160];
+    std::snprintf(figures, sizeof figures, "volume %.3g of its rest volume, %ld of %ld %s inverted",
+                  v.ratio(), v.inverted, v.elements, what.c_str());
+    char limit[160];
+    std::snprintf(limit, sizeof limit, "crush limits: volume ratio >= %g, at most %g %% inverted",
+                  limits.min_volume_ratio, 100 * limits.max_inverted_fraction);
+    report.status = RunStatus::kCompletedWithWarnings;
+    if (!report.reason.empty()) report.reason += "; ";
+    report.reason += "body \"" + body.name + "\" is crushed: " + figures + " (" + limit + ")";
+  }
 }
 
 }  // namespace jelly

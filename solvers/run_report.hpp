@@ -10,7 +10,8 @@ namespace jelly {
 
 enum class RunStatus {
   kCompleted,              // reached the requested time
-  kCompletedWithWarnings,  // reached it, but some steps missed the solver's own tolerance
+  kCompletedWithWarnings,  // reached it, but some steps missed the solver's own tolerance, or
+                           // a body ended crushed (CrushLimits)
   kDiverged,               // NaN, Inf or runaway speed: the divergence guard stopped the run
   kSolverFailed,  // the integrator returned a failure (e.g. a matrix not positive definite)
 };
@@ -39,5 +40,28 @@ struct RunReport {
   // One line: status, time, steps, wall time (and the reason when it stopped early).
   std::string brief() const;
 };
+
+}  // namespace jelly
+
+namespace jelly {
+
+// When a run that reached its end says a body is crushed (scene key "crush"): its volume
+// (core/measures.hpp, body_volume) below min_volume_ratio times its rest volume, or more than
+// max_inverted_fraction of its cells (tetrahedra) inverted.
+struct CrushLimits {
+  Real min_volume_ratio = 0.5;        // in [0, 1]; 0: never by volume
+  Real max_inverted_fraction = 0.05;  // in [0, 1]; 1: never by inverted cells
+
+  // Throws InputError naming "crush."field.
+  void validate() const;
+};
+
+// Adds each body's volume ratio and inverted cells (lattice bodies) or tetrahedra (tet meshes)
+// at x to report.statistics ("volume_ratio.<body>", "inverted_cells.<body>" or
+// "inverted_tets.<body>"); a note for each body without volume (a cloth: not checked); and for
+// a body beyond `limits`, when the run reached its end, the status kCompletedWithWarnings with
+// the body and figure in the reason. O(cells), no allocation beyond the report's own strings.
+void report_crushed_bodies(const Model& model, const VecX& x, const CrushLimits& limits,
+                           RunReport& report);
 
 }  // namespace jelly

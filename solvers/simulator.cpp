@@ -17,6 +17,7 @@ void SimulatorOptions::validate() const {
           output_interval, "a finite interval >= 0 s (0 = every step)");
   require(threads >= 0, "threads", threads, "an integer >= 0 (0 = all cores)");
   divergence.validate();
+  crush.validate();
 }
 
 Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integrator,
@@ -504,6 +505,7 @@ RunReport Simulator::run_until(Real t_end) {
   report.force_evaluations = force_evaluations_ - evaluations_before;
   note_forces(report);
   report.statistics = integrator_->statistics();
+  report_crushed_bodies(model_, state_.x, options_.crush, report);
   if (body_contact_.active(model_)) {
     const BodyContact::Stats& b = body_contact_.stats();
     report.statistics["body_contact_pairs"] = static_cast<double>(b.pairs);

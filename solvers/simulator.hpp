@@ -111,6 +111,8 @@ struct SimulatorOptions {
   // busy neighbour can make a team slower than one thread; docs/threads.md). Results are the
   // same bit for bit for any value.
   int threads = 0;
+  // When the end of a run reports a body crushed (run_report.hpp).
+  CrushLimits crush{};
   void validate() const;
 };
 

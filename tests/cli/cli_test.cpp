@@ -53,7 +53,10 @@ TEST(Cli, AShortGoodRunExitsZeroWithASummary) {
   EXPECT_THAT(r.out, HasSubstr("integrator      midpoint, dt = 0.001 s"));
   EXPECT_THAT(r.out, HasSubstr("centre of mass  ("));
   EXPECT_THAT(r.out, HasSubstr("energy          kinetic "));
-  EXPECT_THAT(r.out, HasSubstr("statistics      steps = 50"));
+  // The integrator's counters and each body's crush measures (volume ratio, inverted cells).
+  EXPECT_THAT(
+      r.out,
+      HasSubstr("statistics      inverted_cells.jelly = 0, steps = 50, volume_ratio.jelly = 1"));
 }
 
 // Implicit Euler at a game's time step with contact inside its solve: it completes, and the

@@ -96,3 +96,39 @@ TEST(SceneRealtimeOptions, BadOptionsNameTheirPath) {
 
 }  // namespace
 }  // namespace jelly
+
+namespace jelly {
+namespace {
+
+// xpbd's sweep and the crush limits read, written back and validated with the field named.
+TEST(SceneRealtimeOptions, XpbdSweepAndCrushLimits) {
+  const char* const scene = R"({
+    "integrator": {"name": "xpbd", "options": {"sweep": "gauss_seidel"}},
+    "crush": {"min_volume_ratio": 0.25, "max_inverted_fraction": 0.5},
+    "duration": 1
+  })";
+  const Scene s = parse_scene(scene);
+  EXPECT_EQ(s.integrator.options.xpbd.sweep, XpbdSweep::kGaussSeidel);
+  EXPECT_EQ(s.crush.min_volume_ratio, 0.25);
+  const Scene again = parse_scene(scene_to_json(s));
+  EXPECT_EQ(again.integrator.options.xpbd.sweep, XpbdSweep::kGaussSeidel);
+  EXPECT_EQ(again.crush.max_inverted_fraction, 0.5);
+  // The defaults are not written.
+  EXPECT_EQ(scene_to_json(parse_scene(kScene)).find("crush"), std::string::npos);
+  try {
+    parse_scene(scene, {"integrator.options.sweep=\"random\""});
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("integrator.options.sweep"));
+  }
+  try {
+    parse_scene(scene, {"crush.max_inverted_fraction=2"});
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "crush.max_inverted_fraction = 2 is invalid: a number in [0, 1] (1: "
+                           "never by inverted cells)");
+  }
+}
+
+}  // namespace
+}  // namespace jelly

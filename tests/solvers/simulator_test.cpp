@@ -7,7 +7,10 @@
 #include <vector>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
+#include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/geometry/tetmesh.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 #include "support/systems.hpp"
@@ -337,6 +340,113 @@ TEST(Observers, FollowAMovedSimulatorAndCopiesAreNotAdded) {
   ASSERT_TRUE(second.run_until(0.02).ok());
   EXPECT_EQ(counter.frames, 3);
   EXPECT_EQ(copy.frames, 2);
+}
+
+}  // namespace
+}  // namespace jelly
+
+namespace jelly {
+namespace {
+
+// A cube squashed to 30 % of its height, and one with a corner pushed through the cube (cells
+// inverted): the end of a run reports each, naming the body; an untouched cube is completed
+// with its volume ratio 1 and no inverted cell; a cloth is skipped with a note.
+TEST(CrushReport, CrushedBodiesEndWithWarnings) {
+  const CubeSpec spec = testing::small_cube(5, 1.0, Vec3::Zero());
+  Model m;
+  m.add_body("squashed", spec.shape().build(spec.material(), "a."));
+  m.gravity.setZero();
+  State s = rest_state(m);
+  for (int i = 0; i < m.num_particles(); ++i) s.x[3 * i + 1] *= 0.3;
+  Simulator squashed(m, s, make_integrator("symplectic_euler"));
+  RunReport r = squashed.run_until(0);
+  EXPECT_EQ(r.status, RunStatus::kCompletedWithWarnings);
+  EXPECT_THAT(r.reason, ::testing::HasSubstr("body \"squashed\" is crushed: volume 0.3 of its "
+                                             "rest volume, 0 of 64 cells inverted"));
+  EXPECT_NEAR(r.statistics.at("volume_ratio.squashed"), 0.3, 1e-12);
+  EXPECT_EQ(r.statistics.at("inverted_cells.squashed"), 0);
+
+  // Corner particle (0, 0, 0) moved through to (0.6, 0.6, 0.6): its cell inverted, 1 of 64
+  // (1.6 %, under the 5 % limit, and the volume barely changed): completed; a limit of 1 %
+  // reports it.
+  State corner = rest_state(m);
+  particle(corner.x, 0) = Vec3(0.6, 0.6, 0.6);
+  Simulator dented(m, corner, make_integrator("symplectic_euler"));
+  r = dented.run_until(0);
+  EXPECT_EQ(r.status, RunStatus::kCompleted) << r.reason;
+  EXPECT_EQ(r.statistics.at("inverted_cells.squashed"), 1);
+  SimulatorOptions strict;
+  strict.crush.max_inverted_fraction = 0.01;
+  Simulator dented_strict(m, corner, make_integrator("symplectic_euler"), strict);
+  r = dented_strict.run_until(0);
+  EXPECT_EQ(r.status, RunStatus::kCompletedWithWarnings);
+  EXPECT_THAT(r.reason, ::testing::HasSubstr("1 of 64 cells inverted"));
+
+  // Untouched, moving freely for a while: not crushed.
+  Model free;
+  free.add_body("free", spec.shape().build(spec.material(), "f."));
+  Simulator fine = testing::make_sim(free, rest_state(free), "xpbd", 1.0 / 60);
+  r = fine.run_until(0.5);
+  EXPECT_EQ(r.status, RunStatus::kCompleted) << r.reason;
+  EXPECT_NEAR(r.statistics.at("volume_ratio.free"), 1, 1e-6);
+  EXPECT_EQ(r.statistics.at("inverted_cells.free"), 0);
+  EXPECT_TRUE(r.notes.empty());
+}
+
+TEST(CrushReport, ClothIsSkippedAndSaysSo) {
+  ClothShape cloth;
+  cloth.nu = cloth.nv = 4;
+  Model m;
+  m.add_body("sheet", cloth.build(Material{}, "c."));
+  State s = rest_state(m);
+  for (int i = 0; i < m.num_particles(); ++i) s.x[3 * i] *= 0.01;  // folded flat: no matter
+  Simulator sim(m, s, make_integrator("symplectic_euler"));
+  const RunReport r = sim.run_until(0);
+  EXPECT_EQ(r.status, RunStatus::kCompleted);
+  EXPECT_EQ(r.statistics.count("volume_ratio.sheet"), 0u);
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_EQ(r.notes[0], "body \"sheet\" (cloth) has no volume: not checked for crushing");
+}
+
+// Tetrahedra oriented either way in the file count as positive at rest; one turned inside out
+// counts as inverted.
+TEST(CrushReport, InvertedTetrahedraOfATetMesh) {
+  TetMesh mesh;
+  mesh.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1)};
+  mesh.tets = {{0, 1, 2, 3}, {1, 3, 2, 4}};
+  Model m;
+  m.add_body("tets", build_tetmesh(mesh, Pose{}, Material{}, "t."));
+  EXPECT_EQ(m.bodies[0].volume.tets.size(), 2u);
+  const BodyVolume rest = body_volume(m, m.bodies[0], m.rest_position);
+  EXPECT_NEAR(rest.rest, 1.0 / 6 + 1.0 / 3, 1e-12);
+  EXPECT_EQ(rest.inverted, 0);
+  VecX x = m.rest_position;
+  particle(x, 0) = Vec3(0.5, 0.5, 0.5);  // through the face 1, 2, 3
+  const BodyVolume flipped = body_volume(m, m.bodies[0], x);
+  EXPECT_EQ(flipped.inverted, 1);
+  State s = rest_state(m);
+  s.x = x;
+  Simulator sim(m, s, make_integrator("symplectic_euler"));
+  const RunReport r = sim.run_until(0);
+  EXPECT_EQ(r.statistics.at("inverted_tets.tets"), 1);
+  EXPECT_EQ(r.status, RunStatus::kCompletedWithWarnings);  // 1 of 2 inverted
+  EXPECT_THAT(r.reason, ::testing::HasSubstr("body \"tets\" is crushed"));
+}
+
+TEST(CrushReport, LimitsAreValidated) {
+  SimulatorOptions o;
+  o.crush.min_volume_ratio = 1.5;
+  try {
+    o.validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(
+        e.what(),
+        "crush.min_volume_ratio = 1.5 is invalid: a number in [0, 1] (0: never by volume)");
+  }
+  o.crush = CrushLimits{};
+  o.crush.max_inverted_fraction = -0.1;
+  EXPECT_THROW(o.validate(), InputError);
 }
 
 }  // namespace

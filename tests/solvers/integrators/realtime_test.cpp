@@ -3,8 +3,10 @@
 // jelly on the slope (docs/realtime.md).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
@@ -210,12 +212,14 @@ Real settled_column_error(const Column& column, int substeps, int iterations) {
 }
 
 // The stretch of the springs under load converges to the compliance's prediction as the
-// substeps grow (one Gauss-Seidel sweep each), and as the sweeps grow.
+// substeps grow (one sweep each), and as the sweeps grow. (Up to 256 substeps: the Jacobi sweep
+// converges more slowly per sweep than the Gauss-Seidel one did, within 2 % at 64 substeps; at
+// 64 the Jacobi column is within 2.7 %.)
 TEST(Xpbd, ColumnCompressionConvergesToTheCompliancePrediction) {
   const Column column;
   const Real scale = (column.count - 1) * 9.8 / column.ks;  // the largest compression
   Real previous = INFINITY;
-  for (const int substeps : {1, 4, 16, 64}) {
+  for (const int substeps : {1, 4, 16, 64, 256}) {
     const Real error = settled_column_error(column, substeps, 1);
     EXPECT_LT(error, previous) << substeps << " substeps";
     previous = error;
@@ -263,11 +267,12 @@ Real settled_chain_error(const HangingChain& chain, const std::string& integrato
 }
 
 // XPBD's stretch of a hanging chain converges to the compliance's prediction as the substeps
-// grow (one sweep each): the pin is a particle of inverse mass 0 in the sweeps.
+// grow (one sweep each): the pin is a particle of inverse mass 0 in the sweeps. (Up to 256
+// substeps, as for the column.)
 TEST(Xpbd, HangingChainStretchConvergesToTheCompliancePrediction) {
   const HangingChain chain;
   Real previous = INFINITY;
-  for (const int substeps : {1, 4, 16, 64}) {
+  for (const int substeps : {1, 4, 16, 64, 256}) {
     IntegratorOptions o;
     o.xpbd.substeps = substeps;
     o.xpbd.iterations = 1;
@@ -348,15 +353,29 @@ TEST(ProjectiveDynamics, SeedSlopeAtDt1_60NeverGainsEnergy) {
   EXPECT_LT(out.final_energy, out.initial);
 }
 
-// XPBD at dt = 1/60 with one substep (two sweeps, the default): stable, on the slope, never
-// more energy than at the start (between frames it grew by up to 2 % of |E0|).
-TEST(Xpbd, StableOnTheSlopeAtDt1_60WithOneSubstep) {
-  const Outcome out = run_seed_slope("xpbd", {}, 1.0 / 60, 1400, 50, 5);
-  ASSERT_TRUE(out.report.ok()) << out.report.brief();
-  EXPECT_GT(out.deepest, -1e-9);
-  EXPECT_LE(out.highest, out.initial);
-  EXPECT_LE(out.worst_growth, 0.03 * out.scale);
-  EXPECT_LT(out.final_energy, out.initial);
+// XPBD at dt = 1/60 with its defaults (three substeps of two Jacobi sweeps) and with the old
+// sweep's (one substep of two Gauss-Seidel sweeps): stable, on the slope, not crushed, ending
+// with less energy than at the start. The Gauss-Seidel sweep never has more energy than at the
+// start (between frames it grew by up to 2 % of |E0|); the Jacobi default does at the landing
+// (measured: up to 1.64 E0, 7.7 kJ between two frames; docs/realtime.md).
+TEST(Xpbd, StableOnTheSlopeAtDt1_60ByDefault) {
+  IntegratorOptions old;
+  old.xpbd.substeps = 1;
+  old.xpbd.sweep = XpbdSweep::kGaussSeidel;
+  for (const IntegratorOptions& o : {IntegratorOptions{}, old}) {
+    SCOPED_TRACE(o.xpbd.substeps);
+    const Outcome out = run_seed_slope("xpbd", o, 1.0 / 60, 1400, 50, 5);
+    ASSERT_TRUE(out.report.ok()) << out.report.brief();
+    EXPECT_EQ(out.report.status, RunStatus::kCompleted) << out.report.reason;
+    EXPECT_GT(out.deepest, -1e-9);
+    EXPECT_LT(out.final_energy, out.initial);
+    if (o.xpbd.sweep == XpbdSweep::kGaussSeidel) {
+      EXPECT_LE(out.highest, out.initial);
+      EXPECT_LE(out.worst_growth, 0.03 * out.scale);
+    } else {
+      EXPECT_LE(out.highest, 1.7 * out.initial);
+    }
+  }
 }
 
 class RealtimeIntegrators : public ::testing::TestWithParam<std::string> {};
@@ -425,9 +444,127 @@ Vec3 driven_com(const std::string& integrator, Real dt) {
 
 TEST_P(RealtimeIntegrators, DrivenPinDragsTheJelly) {
   const Vec3 reference = driven_com("rk4", 1e-3);
-  // First order: measured 4.6 / 3.4 cm at 1/60 and 0.66 / 0.59 cm at 1/240 (pd / xpbd).
-  EXPECT_LT((driven_com(GetParam(), 1.0 / 60) - reference).norm(), 0.06);
-  EXPECT_LT((driven_com(GetParam(), 1.0 / 240) - reference).norm(), 0.01);
+  // First order: measured 4.6 / 3.4 cm at 1/60 and 0.66 / 0.59 cm at 1/240 (pd / xpbd with the
+  // Gauss-Seidel sweep); xpbd's Jacobi default, softer at few sweeps, 21.6 cm and 1.003 cm.
+  const bool jacobi = GetParam() == "xpbd";
+  EXPECT_LT((driven_com(GetParam(), 1.0 / 60) - reference).norm(), jacobi ? 0.25 : 0.06);
+  EXPECT_LT((driven_com(GetParam(), 1.0 / 240) - reference).norm(), jacobi ? 0.012 : 0.01);
+}
+
+}  // namespace
+}  // namespace jelly
+
+namespace jelly {
+namespace {
+
+// Two n = 4 cubes mirror images of each other across x = 0 (gap 0.1 m), thrown at each other
+// head on at 2 m/s each, without gravity; xpbd resolves their contact after each step.
+Simulator mirrored_collision(Real dt, int threads) {
+  Model model;
+  const CubeSpec a = testing::small_cube(4, 0.3, Vec3(-0.35, 0, 0));
+  const CubeSpec b = testing::small_cube(4, 0.3, Vec3(0.05, 0, 0));
+  model.add_body("left", a.shape().build(a.material(), "a."));
+  model.add_body("right", b.shape().build(b.material(), "b."));
+  model.gravity.setZero();
+  State s = rest_state(model);
+  for (int i = 0; i < model.num_particles(); ++i)
+    particle(s.v, i) = Vec3(i < 64 ? 2.0 : -2.0, 0, 0);
+  SimulatorOptions so;
+  so.dt = dt;
+  so.threads = threads;
+  Simulator sim(model, s, make_integrator("xpbd"), so);
+  BodyContactParams params;
+  params.friction = params.static_friction = 0;
+  params.restitution = 0;
+  sim.set_body_contact(params);
+  return sim;
+}
+
+// The symmetric head-on collision stays symmetric at 1/240 s: no sideways velocity, no spin, no
+// net momentum (Gauss-Seidel's order left +-0.10 m/s sideways and |L| = 13 kg m^2/s); and at
+// 1/60 s a run is the same bits for 1 and 2 threads.
+TEST(Xpbd, MirroredCollisionStaysSymmetric) {
+  // (At 1/60 s the cubes overlap by more in a step, a particle meets several of the other
+  // cube's, and the body contact's sequential impulses (solvers/contact/body_contact.cpp), which
+  // take the pairs one after the other, break the symmetry from the third step on, for
+  // projective_dynamics and implicit_euler with its contact after the step as for xpbd.)
+  for (const Real dt : {1.0 / 240}) {
+    SCOPED_TRACE(dt);
+    Simulator sim = mirrored_collision(dt, 1);
+    const Model& model = sim.model();
+    long touching = 0;
+    Real sideways = 0, spin = 0, momentum = 0;
+    testing::Probe probe([&](const Simulator& s) {
+      touching += s.body_contact().pairs().empty() ? 0 : 1;
+      // Each cube's mean velocity across the collision's axis.
+      for (int body = 0; body < 2; ++body) {
+        Vec3 mean = Vec3::Zero();
+        for (int i = 64 * body; i < 64 * (body + 1); ++i) mean += particle(s.state().v, i) / 64;
+        sideways = std::max({sideways, std::abs(mean.y()), std::abs(mean.z())});
+      }
+      spin = std::max(spin, angular_momentum(model, s.state()).norm());
+      momentum = std::max(momentum, linear_momentum(model, s.state()).norm());
+    });
+    sim.add_observer(probe);
+    ASSERT_TRUE(sim.run_until(0.5).ok());
+    EXPECT_GT(touching, 0);
+    const Real scale = model.mass.sum() * 2;  // kg m/s: total mass x approach speed
+    EXPECT_LT(sideways, 1e-12 * 2);
+    EXPECT_LT(spin, 1e-12 * scale);
+    EXPECT_LT(momentum, 1e-12 * scale);
+    // The mirror image: particle (i, j, k) of the left cube and (3 - i, j, k) of the right one.
+    Real asymmetry = 0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        for (int k = 0; k < 4; ++k) {
+          const Vec3 xl = particle(sim.state().x, (i * 4 + j) * 4 + k);
+          const Vec3 xr = particle(sim.state().x, 64 + ((3 - i) * 4 + j) * 4 + k);
+          asymmetry = std::max({asymmetry, std::abs(xl.x() + xr.x()), std::abs(xl.y() - xr.y()),
+                                std::abs(xl.z() - xr.z())});
+        }
+    EXPECT_LT(asymmetry, 1e-12);
+  }
+  Simulator one = mirrored_collision(1.0 / 60, 1), two = mirrored_collision(1.0 / 60, 2);
+  ASSERT_TRUE(one.run_until(0.3).ok());
+  ASSERT_TRUE(two.run_until(0.3).ok());
+  EXPECT_EQ(one.state().x, two.state().x);
+  EXPECT_EQ(one.state().v, two.state().v);
+}
+
+// A cube stretched symmetrically about its centre and let go (no gravity, no terrain): the
+// internal constraints keep linear and angular momentum at zero to 1e-12 (Gauss-Seidel gained
+// |L| = 0.89 kg m^2/s), for one and several substeps and sweeps.
+TEST(Xpbd, StretchedCubeKeepsZeroMomentum) {
+  for (const auto& [substeps, iterations] : {std::pair{1, 2}, std::pair{4, 1}, std::pair{1, 10}}) {
+    SCOPED_TRACE(std::to_string(substeps) + " substeps, " + std::to_string(iterations));
+    const CubeSpec spec = testing::small_cube(5, 1.0, Vec3(-0.5, -0.5, -0.5));
+    Model model = build_cube(spec);
+    model.gravity.setZero();
+    State s = rest_state(model);
+    for (int i = 0; i < model.num_particles(); ++i) {
+      const Vec3 p = particle(s.x, i);
+      particle(s.x, i) = Vec3(1.4 * p.x(), 0.8 * p.y(), 1.1 * p.z());
+    }
+    IntegratorOptions o;
+    o.xpbd.substeps = substeps;
+    o.xpbd.iterations = iterations;
+    SimulatorOptions so;
+    so.dt = 1.0 / 60;
+    Simulator sim(model, s, make_integrator("xpbd", o), so);
+    Real spin = 0, momentum = 0;
+    testing::Probe probe([&](const Simulator& sm) {
+      spin = std::max(spin, angular_momentum(model, sm.state()).norm());
+      momentum = std::max(momentum, linear_momentum(model, sm.state()).norm());
+    });
+    sim.add_observer(probe);
+    ASSERT_TRUE(sim.run_until(1.0).ok());
+    // It moved: the stretch oscillates back.
+    EXPECT_GT(kinetic_energy(model, sim.state()) + elastic_energy(model, sim.state()), 0);
+    const Real scale = model.mass.sum();  // kg m/s: the total mass at 1 m/s
+    EXPECT_LT(spin, 1e-12 * scale);
+    EXPECT_LT(momentum, 1e-12 * scale);
+    EXPECT_LT(center_of_mass(model, sim.state()).norm(), 1e-12);
+  }
 }
 
 }  // namespace
