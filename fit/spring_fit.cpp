@@ -571,6 +571,24 @@ Real replay_cost(const Trajectory& trajectory, Real window) {
 
 namespace {
 
+// The solver's summary and the fitted coefficients (exp of log_k) into `result`, their standard
+// deviations not known yet (NaN). Summary: ceres::Solver's or ceres::GradientProblemSolver's.
+template <class Summary>
+void take_summary(const Summary& summary, const std::vector<double>& log_k, FitResult& result) {
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  result.termination = summary.message;
+  result.brief_report = summary.BriefReport();
+  result.residual_rms = std::sqrt(2 * summary.final_cost / result.residuals);
+  for (size_t p = 0; p < log_k.size(); ++p) {
+    result.parameters[p].value = std::exp(log_k[p]);
+    result.parameters[p].stddev = std::numeric_limits<Real>::quiet_NaN();
+    result.parameters[p].stddev_independent = std::numeric_limits<Real>::quiet_NaN();
+  }
+}
+
 // Why the adjoint cannot take this fit before trying it ("" when it may).
 std::string adjoint_refusal(const Trajectory& trajectory, const FitOptions& options) {
   if (trajectory.integrator != "implicit_euler")
@@ -625,18 +643,7 @@ bool fit_with_adjoint(const Trajectory& trajectory, const FitOptions& options,
   if (!function->refused.empty()) return refuse(function->refused + " (during the fit)");
   result.gradient_path = "adjoint";
   result.adjoint_passes = function->passes;
-  result.initial_cost = summary.initial_cost;
-  result.final_cost = summary.final_cost;
-  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  result.converged = summary.termination_type == ceres::CONVERGENCE;
-  result.termination = summary.message;
-  result.brief_report = summary.BriefReport();
-  result.residual_rms = std::sqrt(2 * summary.final_cost / result.residuals);
-  for (int p = 0; p < p_count; ++p) {
-    result.parameters[p].value = std::exp(log_k[p]);
-    result.parameters[p].stddev = std::numeric_limits<Real>::quiet_NaN();
-    result.parameters[p].stddev_independent = std::numeric_limits<Real>::quiet_NaN();
-  }
+  take_summary(summary, log_k, result);
   const auto covariance_start = std::chrono::steady_clock::now();
   if (!options.compute_covariance) {
     result.covariance_message = "not requested";
@@ -771,18 +778,7 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
 
-  result.initial_cost = summary.initial_cost;
-  result.final_cost = summary.final_cost;
-  result.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  result.converged = summary.termination_type == ceres::CONVERGENCE;
-  result.termination = summary.message;
-  result.brief_report = summary.BriefReport();
-  result.residual_rms = std::sqrt(2 * summary.final_cost / result.residuals);
-  for (int p = 0; p < p_count; ++p) {
-    result.parameters[p].value = std::exp(log_k[p]);
-    result.parameters[p].stddev = std::numeric_limits<Real>::quiet_NaN();
-    result.parameters[p].stddev_independent = std::numeric_limits<Real>::quiet_NaN();
-  }
+  take_summary(summary, log_k, result);
 
   const auto covariance_start = std::chrono::steady_clock::now();
   if (options.compute_covariance) {
