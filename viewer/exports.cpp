@@ -120,7 +120,7 @@ int export_obj_sequence(const Recording& recording, const std::string& dir, bool
     throw InputError("--obj-sequence", dir, "a folder that can be created");
   // Every frame is written beside its file first and the files are renamed only when all are
   // written: a failed write (a full disk) leaves an earlier sequence in the folder as it was.
-  std::vector<detail::FileReplacement> files;
+  std::vector<jelly::detail::FileReplacement> files;
   files.reserve(static_cast<size_t>(recording.frames()));
   for (int k = 0; k < recording.frames(); ++k) {
     files.emplace_back((std::filesystem::path(dir) / obj_sequence_name(k)).string());
@@ -146,7 +146,7 @@ int export_obj_sequence(const Recording& recording, const std::string& dir, bool
       if (std::stol(name.substr(6, name.size() - 10)) >= recording.frames()) stale.push_back(f);
     }
   }
-  for (detail::FileReplacement& file : files) file.commit();
+  for (jelly::detail::FileReplacement& file : files) file.commit();
   for (const std::string& f : stale) {
     std::error_code remove_error;
     std::filesystem::remove(f, remove_error);
@@ -171,7 +171,7 @@ std::string export_pc2(const Recording& recording, const std::string& pc2_path) 
   // vertices (Blender's custom normals), so they would be the rest pose's in every frame.
   std::vector<ObjObject> rest_objects = surface_objects(surfaces, recording.model.rest_position);
   for (ObjObject& o : rest_objects) o.normals.clear();
-  detail::FileReplacement rest(obj_path);
+  jelly::detail::FileReplacement rest(obj_path);
   rest.write(obj_text(rest_objects, std::filesystem::path(pc2_path).stem().string()));
   Pc2Writer pc2(pc2_path, points, 0, 1);
   std::vector<double> xyz(static_cast<size_t>(3 * points));

@@ -280,7 +280,7 @@ void export_gltf(const Recording& recording, const std::string& path) {
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToStream(&model, out, false, true))
     throw std::runtime_error("cannot write '" + path + "' (tinygltf could not encode the scene)");
-  detail::replace_file(path, out.str());
+  jelly::detail::replace_file(path, out.str());
 }
 
 #else  // without tinygltf

@@ -21,7 +21,7 @@ void write_png(const std::string& path, int width, int height, const std::uint8_
   };
   if (!stbi_write_png_to_func(append, &png, width, height, 3, rgb, 3 * width))
     throw std::runtime_error("cannot encode the PNG file '" + path + "'");
-  detail::replace_file(path, png);
+  jelly::detail::replace_file(path, png);
 }
 
 Image read_png(const std::string& path) {

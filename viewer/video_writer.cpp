@@ -73,11 +73,11 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
         "bayer_scale=4");
   }
   if (format_ == VideoFormat::kPngSequence) {
-    ffmpeg_path_ = detail::FileReplacement::temporary_name(
-        path, detail::FileReplacement::Name::kBeforeExtension);
+    ffmpeg_path_ = jelly::detail::FileReplacement::temporary_name(
+        path, jelly::detail::FileReplacement::Name::kBeforeExtension);
   } else {
-    replacement_ = std::make_unique<detail::FileReplacement>(
-        path, detail::FileReplacement::Name::kBeforeExtension);
+    replacement_ = std::make_unique<jelly::detail::FileReplacement>(
+        path, jelly::detail::FileReplacement::Name::kBeforeExtension);
     ffmpeg_path_ = replacement_->temporary();
   }
   args.push_back(ffmpeg_path_);
@@ -191,10 +191,10 @@ void VideoWriter::close() {
     return;
   }
   // A PNG sequence: every frame's file must be there before any is renamed.
-  std::vector<detail::FileReplacement> files;
+  std::vector<jelly::detail::FileReplacement> files;
   for (int k = 0; k < frames_; ++k) {
     files.push_back(
-        detail::FileReplacement::adopt(frame_name(path_, k), frame_name(ffmpeg_path_, k)));
+        jelly::detail::FileReplacement::adopt(frame_name(path_, k), frame_name(ffmpeg_path_, k)));
   }
   for (int k = 0; k < frames_; ++k) {
     struct stat info {};
@@ -204,7 +204,7 @@ void VideoWriter::close() {
                                "'");
     }
   }
-  for (detail::FileReplacement& file : files) file.commit();
+  for (jelly::detail::FileReplacement& file : files) file.commit();
 }
 
 }  // namespace jelly::viewer
