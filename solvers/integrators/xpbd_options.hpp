@@ -22,8 +22,8 @@ const std::vector<EnumName<XpbdSweep>>& xpbd_sweeps();
 
 struct XpbdOptions {
   // Substeps per step (Macklin et al. 2019: many small steps of one iteration each beat few
-  // steps of many iterations). Three with two Jacobi sweeps each hold the seed jelly landing at
-  // 11 m/s at 1/60 s; one substep of two did not (crushed: docs/realtime.md, "Defaults").
+  // steps of many iterations). Three with two Jacobi sweeps each hold the seed jelly's landing
+  // at 1/60 s; one substep of two did not (docs/realtime.md, "Defaults").
   int substeps = 3;
   // Sweeps over the springs (and contacts) per substep.
   int iterations = 2;

@@ -125,8 +125,9 @@ TEST(SceneRealtimeOptions, XpbdSweepAndCrushLimits) {
     parse_scene(scene, {"crush.max_inverted_fraction=2"});
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "crush.max_inverted_fraction = 2 is invalid: a number in [0, 1] (1: "
-                           "never by inverted cells)");
+    EXPECT_STREQ(e.what(),
+                 "crush.max_inverted_fraction = 2 is invalid: a number in [0, 1] (1: "
+                 "never by inverted cells)");
   }
 }
 
