@@ -326,8 +326,7 @@ TEST(RenderCli, KeepsTheBodiesColours) {
 
 // Without --camera, `jelly render` follows the bodies and keeps them large: the seed jelly,
 // 4 s down the slope, fills a good part of the picture at the end of the video (issue 40,
-// items 3 and 9: the camera framed the whole motion and the jelly filled under 5 %; framed
-// with the ground below its start, 5.6 %; now about 12 %).
+// items 3 and 9: the camera framed the whole motion; docs/viewer.md, "Speed").
 TEST(RenderCli, FollowsTheBodies) {
   TempDir dir;
   const std::string jelly = std::string("'") + JELLY_CLI + "' ";

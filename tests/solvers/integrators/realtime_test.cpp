@@ -355,8 +355,7 @@ TEST(ProjectiveDynamics, SeedSlopeAtDt1_60NeverGainsEnergy) {
 // XPBD at dt = 1/60 with its defaults (three substeps of two Jacobi sweeps) and with the old
 // sweep's (one substep of two Gauss-Seidel sweeps): stable, on the slope, not crushed, ending
 // with less energy than at the start. The Gauss-Seidel sweep never has more energy than at the
-// start (between frames it grew by up to 2 % of |E0|); the Jacobi default does at the landing
-// (measured: up to 1.64 E0, 7.7 kJ between two frames; docs/realtime.md).
+// start; the Jacobi default does at the landing (docs/realtime.md).
 TEST(Xpbd, StableOnTheSlopeAtDt1_60ByDefault) {
   IntegratorOptions old;
   old.xpbd.substeps = 1;

@@ -102,9 +102,9 @@ State spinning(const Model& model, unsigned seed) {
 
 // A free, deformed, spinning cube (no gravity, no contact) at a game step: each particle's
 // Newton step moves only its own momentum, so the linear momentum is kept to the residual the
-// sweeps leave of the step's force balance, which falls as the sweeps grow: over one second at
-// 1/60 s it drifted by 1.8 % of p0 with the default 10 sweeps and by 1.4e-7 with 60 (the
-// registry's test checks 10 at dt = 1 ms). (Backward Euler itself damps the angular momentum.)
+// sweeps leave of the step's force balance, which falls as the sweeps grow (the drift measured:
+// docs/realtime.md; the registry's test checks 10 sweeps at dt = 1 ms). (Backward Euler itself
+// damps the angular momentum.)
 TEST(Vbd, FreeCubeKeepsItsMomentum) {
   CubeSpec spec = testing::small_cube(4);
   spec.gravity.setZero();
