@@ -571,6 +571,18 @@ Real replay_cost(const Trajectory& trajectory, Real window) {
 
 namespace {
 
+// The fit's iteration limit, tolerances and progress output into a Ceres solver's options
+// (ceres::Solver's or ceres::GradientProblemSolver's).
+template <class SolverOptions>
+void take_stopping_rules(const FitOptions& options, SolverOptions& solver) {
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  solver.gradient_tolerance = options.gradient_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
+  solver.minimizer_progress_to_stdout = options.progress_to_stdout;
+  solver.logging_type = options.progress_to_stdout ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+}
+
 // The solver's summary and the fitted coefficients (exp of log_k) into `result`, their standard
 // deviations not known yet (NaN). Summary: ceres::Solver's or ceres::GradientProblemSolver's.
 template <class Summary>
@@ -632,12 +644,7 @@ bool fit_with_adjoint(const Trajectory& trajectory, const FitOptions& options,
   ceres::GradientProblemSolver::Options solver;
   // Few coefficients: dense BFGS builds the curvature from successive exact gradients.
   solver.line_search_direction_type = ceres::BFGS;
-  solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = options.function_tolerance;
-  solver.gradient_tolerance = options.gradient_tolerance;
-  solver.parameter_tolerance = options.parameter_tolerance;
-  solver.minimizer_progress_to_stdout = options.progress_to_stdout;
-  solver.logging_type = options.progress_to_stdout ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  take_stopping_rules(options, solver);
   ceres::GradientProblemSolver::Summary summary;
   ceres::Solve(solver, problem, log_k.data(), &summary);
   if (!function->refused.empty()) return refuse(function->refused + " (during the fit)");
@@ -768,13 +775,8 @@ FitResult fit_recording(const Trajectory& trajectory, const FitOptions& options)
   // A few coefficients: dense QR. With a velocity block per window, each residual block touches
   // one of them, so the Schur complement onto the coefficients is exact and small.
   solver.linear_solver_type = fit_velocities ? ceres::DENSE_SCHUR : ceres::DENSE_QR;
-  solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = options.function_tolerance;
-  solver.gradient_tolerance = options.gradient_tolerance;
-  solver.parameter_tolerance = options.parameter_tolerance;
+  take_stopping_rules(options, solver);
   solver.num_threads = options.num_threads;
-  solver.minimizer_progress_to_stdout = options.progress_to_stdout;
-  solver.logging_type = options.progress_to_stdout ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
 
