@@ -72,7 +72,7 @@ Table run_seed(const SeedOptions& o) {
             continue;
           }
           if (contact == ContactModel::kSeedFramework &&
-              !make_integrator(integrator)->supports_in_evaluation_contact()) {
+              !integrator_supports_in_evaluation_contact(integrator)) {
             row.insert(row.end(), {std::string("skipped_unsupported"), NAN,
                                    std::string("seed_framework needs an explicit integrator")});
             table.add_row(row);

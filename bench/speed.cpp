@@ -101,8 +101,7 @@ struct SpeedRun {
       const double step_time = seconds_since(start);
       start = Clock::now();
       if (result.ok)
-        resolve_contact_after_step(*method, contacts, model, parts.terrains, before, state, o.dt,
-                                   team);
+        finish_step(result, contacts, nullptr, model, parts.terrains, before, state, o.dt, team);
       const double contact_time = seconds_since(start);
       if (chooser) chooser->record(step_time + contact_time);
       if (timing) {

@@ -219,6 +219,8 @@ int BandSystem::team(int threads) const {
 bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, DefinitenessFix fix,
                           Real alpha, Real beta, const VecX& w, VecX& kw, int threads) {
   const int n = num_particles_;
+  extra_column_.clear();
+  extra_value_.clear();
   const std::vector<SpringBands::Band>& bands = bands_->bands();
   const int team = this->team(threads);
   const size_t stride = stride_;
@@ -310,6 +312,42 @@ void BandSystem::diagonal_block(int i, Real out[9]) const {
   out[1] = out[3] = d[3 * n];
   out[2] = out[6] = d[4 * n];
   out[5] = out[7] = d[5 * n];
+  if (extra_column_.empty()) return;
+  for (int e = extra_start_[i]; e < extra_start_[i + 1]; ++e) {
+    if (extra_column_[e] != i) continue;
+    const Real* b = extra_value_.data() + 9 * static_cast<size_t>(e);
+    for (int k = 0; k < 9; ++k) out[k] += b[k];
+  }
+}
+
+void BandSystem::set_extra_blocks(const ForceJacobian& jacobian, Real alpha, Real beta) {
+  const int n = num_particles_;
+  extra_column_.clear();
+  extra_value_.clear();
+  if (jacobian.empty()) return;
+  // Counting sort of the 2 entries per block by row.
+  extra_start_.assign(static_cast<size_t>(n) + 1, 0);
+  for (const ForceJacobian::Block& b : jacobian.blocks()) {
+    ++extra_start_[b.i + 1];
+    ++extra_start_[b.j + 1];
+  }
+  for (int i = 0; i < n; ++i) extra_start_[i + 1] += extra_start_[i];
+  const size_t entries = static_cast<size_t>(extra_start_[n]);
+  extra_column_.resize(entries);
+  extra_value_.resize(9 * entries);
+  extra_fill_.assign(extra_start_.begin(), extra_start_.end() - 1);
+  const auto put = [&](int row, int column, const Eigen::Matrix3d& value) {
+    const int e = extra_fill_[row]++;
+    extra_column_[e] = column;
+    Real* out = extra_value_.data() + 9 * static_cast<size_t>(e);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) out[3 * r + c] = value(r, c);
+  };
+  for (const ForceJacobian::Block& b : jacobian.blocks()) {
+    const Eigen::Matrix3d half = -0.5 * (alpha * b.dfdv + beta * b.dfdx);
+    put(b.i, b.j, half);
+    put(b.j, b.i, half.transpose());
+  }
 }
 
 void BandSystem::slot_block(size_t band, int slot, Real out[6]) const {
@@ -371,6 +409,13 @@ void BandSystem::multiply_rows(const VecX& p, const std::vector<int>& particles,
           acc[c] -= ts[c];
         }
       }
+    }
+    for (int e = extra_column_.empty() ? 0 : extra_start_[i];
+         !extra_column_.empty() && e < extra_start_[i + 1]; ++e) {
+      const Real* b = extra_value_.data() + 9 * static_cast<size_t>(e);
+      const int j = extra_column_[e];
+      for (int c = 0; c < 3; ++c)
+        acc[c] += b[3 * c] * p[3 * j] + b[3 * c + 1] * p[3 * j + 1] + b[3 * c + 2] * p[3 * j + 2];
     }
     for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c];
   };
@@ -437,6 +482,17 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, ProductFilter fil
     }
     for (int i = p0; i < p1; ++i) {
       for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c * n + i];
+    }
+    if (!extra_column_.empty()) {
+      for (int i = p0; i < p1; ++i) {
+        for (int e = extra_start_[i]; e < extra_start_[i + 1]; ++e) {
+          const Real* b = extra_value_.data() + 9 * static_cast<size_t>(e);
+          const int j = extra_column_[e];
+          const Real q0 = sp[j], q1 = sp[n + j], q2 = sp[2 * n + j];
+          for (int c = 0; c < 3; ++c)
+            y[3 * i + c] += b[3 * c] * q0 + b[3 * c + 1] * q1 + b[3 * c + 2] * q2;
+        }
+      }
     }
     if (filter.scale != nullptr) {
       for (int i = p0; i < p1; ++i) {

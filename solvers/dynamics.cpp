@@ -25,6 +25,25 @@ void Dynamics::add_applied_forces(Real t, const VecX& x, const VecX& v, VecX& f)
     for (const std::shared_ptr<Force>& force : *forces_) force->add_forces(t, x, v, f);
 }
 
+void Dynamics::added_force_jacobians(Real t, const VecX& x, const VecX& v,
+                                     ForceJacobian& out) const {
+  out.clear();
+  if (forces_ == nullptr) return;
+  const int n = model_->num_particles();
+  for (const std::shared_ptr<Force>& force : *forces_) {
+    if (!force->has_jacobian()) continue;
+    const std::size_t before = out.blocks().size();
+    force->add_jacobian(t, x, v, out);
+    for (std::size_t k = before; k < out.blocks().size(); ++k) {
+      const ForceJacobian::Block& b = out.blocks()[k];
+      if (b.i < 0 || b.i >= n || b.j < 0 || b.j >= n || !b.dfdx.allFinite() ||
+          !b.dfdv.allFinite()) {
+        out.validate(n, force->name());  // throws, naming the block
+      }
+    }
+  }
+}
+
 namespace {
 // a = M^-1 f in place, then the pinned particles' path accelerations.
 void finish_acceleration(const Model& model, int threads, Real t, VecX& a) {

@@ -45,6 +45,10 @@ class Dynamics {
   // added Force plugins (not gravity, the springs or contact). For methods that treat these
   // explicitly while they handle the springs themselves (xpbd).
   void add_applied_forces(Real t, const VecX& x, const VecX& v, VecX& f) const;
+  // The Jacobian blocks at (t, x, v) of the added forces that give them (Force::has_jacobian())
+  // into `out` (cleared first; no allocation in steady state). Throws InputError naming the
+  // force for a block out of range or not finite.
+  void added_force_jacobians(Real t, const VecX& x, const VecX& v, ForceJacobian& out) const;
   // a = M^-1 f(t, x, v), except that pinned particles get their path's acceleration.
   void acceleration(Real t, const VecX& x, const VecX& v, VecX& a) const;
   // The evaluation of an explicit method's stage at time t (docs/contact.md, seed_framework):
@@ -55,7 +59,7 @@ class Dynamics {
   // acceleration(t, x, v, a), v unchanged.
   void stage_acceleration(Real t, const VecX& x, VecX& v, VecX& a) const;
   // True when a terrain uses seed_framework: the integrator must evaluate through
-  // stage_acceleration() (Integrator::supports_in_evaluation_contact()).
+  // stage_acceleration() (integrator_supports_in_evaluation_contact()).
   bool has_in_evaluation_contact() const { return in_evaluation_contact_; }
 
   const Model& model() const { return *model_; }

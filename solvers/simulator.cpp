@@ -8,6 +8,7 @@
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/detail/team_chooser.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
 
@@ -43,7 +44,7 @@ Simulator& Simulator::operator=(Simulator&&) noexcept = default;
 void Simulator::check_terrain(const Terrain* terrain, size_t index) const {
   require(terrain != nullptr, "terrain", "null", "a terrain");
   if (terrain_contact_model(*terrain).acts_in_evaluation() &&
-      !integrator_->supports_in_evaluation_contact()) {
+      !integrator_supports_in_evaluation_contact(integrator_->name())) {
     throw InputError("terrains[" + std::to_string(index) + "].contact.model", "\"seed_framework\"",
                      in_evaluation_contact_requirement(integrator_->name()));
   }
@@ -130,7 +131,7 @@ void Simulator::set_integrator(std::unique_ptr<Integrator> integrator) {
   require(integrator != nullptr, "integrator", "null", "an integrator");
   for (std::size_t k = 0; k < terrains_.size(); ++k) {
     if (terrain_contact_model(*terrains_[k]).acts_in_evaluation() &&
-        !integrator->supports_in_evaluation_contact()) {
+        !integrator_supports_in_evaluation_contact(integrator->name())) {
       throw InputError("terrains[" + std::to_string(k) + "].contact.model", "\"seed_framework\"",
                        in_evaluation_contact_requirement(integrator->name()));
     }
@@ -428,12 +429,8 @@ StepResult Simulator::step() {
   }
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
-  // Bodies first, then the terrains: a terrain has the last word on where a particle may be.
-  if (bodies && !integrator_->resolves_body_contact())
-    body_contact_.resolve(model_, before_, state_, options_.dt);
-  resolve_contact_after_step(*integrator_, contacts_, model_, terrains_, before_, state_,
-                             options_.dt, threads);
-  if (!model_.pins.empty()) model_.pins.apply(state_.t, state_.x, state_.v);
+  finish_step(result, contacts_, bodies ? &body_contact_ : nullptr, model_, terrains_, before_,
+              state_, options_.dt, threads);
   ++total_steps_;
   if (team_ && options_.threads == 0)
     team_->record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -455,7 +452,14 @@ void Simulator::note_forces(RunReport& report) {
       if (force->has_jacobian()) continue;
       note = "force '" + force->name() +
              "' gives no Jacobian: " + std::string(integrator_->name()) +
-             " treats it explicitly within each step";
+             (integrator_->is_adaptive()
+                  ? "'s Newton matrix leaves it out (more Newton iterations or smaller steps)"
+                  : " treats it explicitly within each step");
+    } else if (integrator_->is_implicit() && integrator_->is_adaptive()) {
+      // ARKODE's DIRK: the force is in every implicit stage's residual, not in its matrix.
+      note = "force '" + force->name() + "': " + std::string(integrator_->name()) +
+             "'s Newton matrix leaves added forces out with this linear_solver (more Newton "
+             "iterations or smaller steps)";
     } else if (integrator_->is_implicit()) {
       note = "force '" + force->name() + "': " + std::string(integrator_->name()) +
              " treats added forces explicitly within each step";

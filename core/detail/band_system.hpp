@@ -12,6 +12,7 @@
 #include <jelly/core/definiteness.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 
 namespace jelly {
@@ -53,6 +54,13 @@ class BandSystem {
                 Real beta, const VecX& w, VecX& kw, int threads);
   // A_pp += value I (anchors, wind drag). Call after assemble.
   void add_diagonal(int particle, Real value);
+  // A += the symmetric part of -(alpha df/dv + beta df/dx) for the blocks of `jacobian` (added
+  // forces' Jacobians, which lie off the bands): a block B at (i, j) puts B / 2 at (i, j) and
+  // B^T / 2 at (j, i). Kept row by row, so that products, rows and diagonal blocks add them as
+  // their own rows are computed (the same bits for any thread count). Replaces the blocks of
+  // the last call; assemble() forgets them. No allocation in steady state.
+  void set_extra_blocks(const ForceJacobian& jacobian, Real alpha, Real beta);
+  bool has_extra_blocks() const { return !extra_column_.empty(); }
   // y = A p, or y = A p filtered by `filter` (when its slot is not null). No allocation after
   // the first call with this thread count.
   void multiply(const VecX& p, VecX& y, int threads, ProductFilter filter = {}) const;
@@ -89,6 +97,10 @@ class BandSystem {
   std::vector<Real> mass_;       // [N] m + the diagonal additions
   std::vector<Real> diagonal_;   // [6N] xx, yy, zz, xy, xz, yz of the spring part of A_ii
   std::vector<Real> positions_;  // [3N] x, y, z of the particles at the last assembly
+  // set_extra_blocks(): per particle row i, the entries extra_start_[i] .. extra_start_[i + 1]
+  // of column extra_column_[e] and 3x3 value extra_value_[9 e ..] (row-major).
+  std::vector<int> extra_start_, extra_column_, extra_fill_;
+  std::vector<Real> extra_value_;
   // Scratch: SoA copies of the inputs, accumulators, and per thread its slots' terms.
   mutable std::vector<Real> scratch_;
   mutable std::vector<Real> band_;

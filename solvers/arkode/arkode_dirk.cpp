@@ -228,7 +228,9 @@ class DirkDriver final : public arkode::Driver {
     const Eigen::Map<const VecX> yy(N_VGetArrayPointer(y), 2 * n);
     data.x = yy.head(n);
     data.v = yy.tail(n);
-    self.preconditioner_.linearize(model, data.x, data.v, data.dynamics->anchors(), t);
+    data.dynamics->added_force_jacobians(t, data.x, data.v, self.forces_);
+    self.preconditioner_.linearize(model, data.x, data.v, data.dynamics->anchors(), t,
+                                   &self.forces_);
     *jcur = SUNTRUE;
     return 0;
   }
@@ -249,6 +251,7 @@ class DirkDriver final : public arkode::Driver {
   std::string method_;
   ArkodeLinearSolver linear_solver_kind_;               // kAuto resolved
   arkode::SpringOperator preconditioner_;               // gmres: the block Jacobi
+  ForceJacobian forces_;                                // gmres: the added forces' blocks
   std::unique_ptr<arkode::SchurSystem> schur_;          // klu: the K, D assembly
   std::vector<sunindextype> column_start_, row_index_;  // klu: the pattern of J
   arkode::MatrixPtr jacobian_;
@@ -269,8 +272,10 @@ ArkodeDirk::ArkodeDirk(const ArkodeOptions& options) {
   }
   require(embedded, "integrator.options.method", method,
           "a diagonally implicit table of ARKODE with an embedding");
-  driver_ =
-      std::make_unique<DirkDriver>(options, method, resolve_linear_solver(options.linear_solver));
+  const ArkodeLinearSolver kind = resolve_linear_solver(options.linear_solver);
+  uses_force_jacobians_ = kind == ArkodeLinearSolver::kCg || kind == ArkodeLinearSolver::kJacobi ||
+                          kind == ArkodeLinearSolver::kGmres;
+  driver_ = std::make_unique<DirkDriver>(options, method, kind);
 }
 
 ArkodeDirk::~ArkodeDirk() = default;

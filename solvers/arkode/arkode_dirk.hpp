@@ -26,6 +26,11 @@ class ArkodeDirk final : public Integrator {
   int order() const override { return order_; }
   bool is_implicit() const override { return true; }
   bool is_adaptive() const override { return true; }
+  // With the linear solvers "cg", "jacobi" (the added forces' Jacobians in their operator and
+  // block diagonal) and "gmres" (products from the right-hand side, the blocks in its
+  // preconditioner); "schur" and "klu" keep the springs' fixed pattern and leave them out of
+  // the Newton matrix (the forces stay in the implicit stages: Newton converges more slowly).
+  bool uses_force_jacobians() const override { return uses_force_jacobians_; }
   // "steps" plus ARKODE's counters (as arkode_erk) and newton_iterations,
   // newton_convergence_failures, linear_setups, and for "schur" schur_factorizations,
   // schur_not_positive_definite; for "klu" jacobian_evaluations.
@@ -37,6 +42,7 @@ class ArkodeDirk final : public Integrator {
  private:
   std::unique_ptr<arkode::Driver> driver_;
   int order_ = 0;
+  bool uses_force_jacobians_ = false;
 };
 
 }  // namespace jelly

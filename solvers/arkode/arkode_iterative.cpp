@@ -29,7 +29,7 @@ inline void pack(const Real* b, Real* out) {
 }  // namespace
 
 void SpringOperator::linearize(const Model& model, const VecX& x, const VecX& v,
-                               const AnchorSprings* anchors, Real t) {
+                               const AnchorSprings* anchors, Real t, const ForceJacobian* forces) {
   spring_jacobian_blocks(model, x, v, JacobianOptions{}, k_blocks_, d_blocks_);
   const Springs& s = model.springs;
   const size_t blocks = 9 * static_cast<size_t>(model.num_particles());
@@ -58,6 +58,19 @@ void SpringOperator::linearize(const Model& model, const VecX& x, const VecX& v,
         k_diagonal_[9 * static_cast<size_t>(a.particle) + 4 * c] -= a.stiffness;
         d_diagonal_[9 * static_cast<size_t>(a.particle) + 4 * c] -= a.damping;
       }
+    }
+  }
+  // The added forces' blocks: the symmetric part of a block on the diagonal goes to K's and
+  // D's diagonal blocks; products take every block (multiply_s, multiply_k).
+  forces_.clear();
+  if (forces != nullptr) {
+    for (const ForceJacobian::Block& b : forces->blocks()) {
+      forces_.add(b.i, b.j, b.dfdx, b.dfdv);
+      if (b.i != b.j) continue;
+      MutableBlock(&k_diagonal_[9 * static_cast<size_t>(b.i)]) +=
+          0.5 * (b.dfdx + b.dfdx.transpose());
+      MutableBlock(&d_diagonal_[9 * static_cast<size_t>(b.i)]) +=
+          0.5 * (b.dfdv + b.dfdv.transpose());
     }
   }
   // Wind drag: d(f)/d(v) = -drag I on its particles.
@@ -162,12 +175,23 @@ void SpringOperator::multiply_s(const Model& model, const VecX& p, VecX& out) co
         (gamma_ * a.damping + gamma_ * gamma_ * a.stiffness) * p.segment<3>(3 * a.particle);
   for (size_t k = 0; k < dragged_.size(); ++k)
     out.segment<3>(3 * dragged_[k]) += gamma_ * drag_[k] * p.segment<3>(3 * dragged_[k]);
+  // S -= gamma S_D + gamma^2 S_K for the added forces (S_ the symmetric parts).
+  for (const ForceJacobian::Block& b : forces_.blocks()) {
+    const Eigen::Matrix3d a = -0.5 * (gamma_ * b.dfdv + gamma_ * gamma_ * b.dfdx);
+    out.segment<3>(3 * b.i) += a * p.segment<3>(3 * b.j);
+    out.segment<3>(3 * b.j) += a.transpose() * p.segment<3>(3 * b.i);
+  }
 }
 
 void SpringOperator::multiply_k(const Model& model, const Real* p, VecX& out) const {
   spring_product(model, spring_.data(), 12, p, false, out);
   for (const AnchorSpring& a : anchors_)
     for (int c = 0; c < 3; ++c) out[3 * a.particle + c] -= a.stiffness * p[3 * a.particle + c];
+  for (const ForceJacobian::Block& b : forces_.blocks()) {
+    const Eigen::Map<const Vec3> pi(p + 3 * b.i), pj(p + 3 * b.j);
+    out.segment<3>(3 * b.i) += 0.5 * b.dfdx * pj;
+    out.segment<3>(3 * b.j) += 0.5 * b.dfdx.transpose() * pi;
+  }
 }
 
 void SpringOperator::filter(VecX& r) const {
@@ -257,6 +281,7 @@ struct IterativeContent {
   const RhsData* data = nullptr;
   IterativeMode mode = IterativeMode::kCg;
   SpringOperator op;
+  ForceJacobian forces;  // the added forces' blocks at the linearization
   VecX x, v, f, rhs, prescribed, dv, r, z, p, q;
   IterativeStatistics statistics;
   int last_iterations = 0;
@@ -289,7 +314,8 @@ int setup(SUNLinearSolver s, SUNMatrix /*unused*/) {
   c.v = yy.tail(n);
   realtype t = 0;
   ARKStepGetCurrentTime(c.arkode_memory, &t);
-  c.op.linearize(model, c.x, c.v, c.data->dynamics->anchors(), t);
+  c.data->dynamics->added_force_jacobians(t, c.x, c.v, c.forces);
+  c.op.linearize(model, c.x, c.v, c.data->dynamics->anchors(), t, &c.forces);
   // The seed contacts whose force pushes into the surface at this iterate (see SpringOperator).
   const auto& seed = c.data->dynamics->contacts().seed_contacts();
   if (!seed.empty()) {

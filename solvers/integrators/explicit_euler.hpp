@@ -9,7 +9,6 @@ class ExplicitEuler final : public Integrator {
   std::string_view name() const override { return "explicit_euler"; }
   int order() const override { return 1; }
   // Every force evaluation goes through Dynamics::stage_acceleration().
-  bool supports_in_evaluation_contact() const override { return true; }
 
  protected:
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;

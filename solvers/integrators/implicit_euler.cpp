@@ -48,14 +48,6 @@ void for_each_entry(int threads, Eigen::Index n, Body&& body) {
       parallel::kMinItemsPerThread, 3);
 }
 
-// True when an added force gives its Jacobians.
-bool has_force_jacobians(const Dynamics& dynamics) {
-  const ForceList* forces = dynamics.added_forces();
-  if (forces == nullptr) return false;
-  return std::any_of(forces->begin(), forces->end(),
-                     [](const std::shared_ptr<Force>& f) { return f->has_jacobian(); });
-}
-
 }  // namespace
 
 ImplicitLinearSolver auto_linear_solver(int dofs) {
@@ -142,14 +134,6 @@ ImplicitEuler::ImplicitEuler(ImplicitEulerOptions options)
 }
 
 ImplicitEuler::~ImplicitEuler() = default;
-
-bool ImplicitEuler::resolves_contact() const { return impl_->resolves_contact(); }
-
-bool ImplicitEuler::resolves_body_contact() const { return impl_->resolves_body_contact(); }
-
-int ImplicitEuler::contacts_resolved() const {
-  return impl_->contact_active_ ? impl_->contact_.count() : 0;
-}
 
 const ImplicitEulerOptions& ImplicitEuler::options() const { return impl_->options_; }
 
@@ -253,10 +237,8 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
       kind == ImplicitLinearSolver::kCg &&
       (automatic || options_.cg_preconditioner != CgPreconditionerKind::kCholmod) &&
       bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_ &&
-      // Contact pairs between bodies and added forces' Jacobians add blocks off the springs'
-      // bands: the assembled matrix.
-      !(options_.contact == ImplicitContactMode::kImplicit && dynamics.body_contact() != nullptr) &&
-      !has_force_jacobians(dynamics);
+      // Contact pairs between bodies add blocks off the springs' bands: the assembled matrix.
+      !(options_.contact == ImplicitContactMode::kImplicit && dynamics.body_contact() != nullptr);
   const auto size_vectors = [&] {
     for (VecX* w : {&f_, &kw_, &b_, &v1_, &x1_, &g_, &delta_, &rhs_, &z_})
       if (w->size() != n) w->setZero(n);
@@ -305,14 +287,13 @@ void ImplicitEuler::Impl::add_external_damping_system(const Model& model, Real t
 
 StepResult ImplicitEuler::Impl::assemble(const Dynamics& dynamics, const VecX& x, const VecX& v,
                                          Real t, Real h) {
-  if (AssembledSystem* a = assembled()) {
-    if (StepResult r = a->collect_force_jacobians(dynamics, x, v, t); !r.ok) return r;
-  }
+  if (StepResult r = system_->collect_force_jacobians(dynamics, x, v, t); !r.ok) return r;
   if (!system_->assemble(dynamics, x, v, h, kw_)) {
     // A collapsed spring in the matrix-free system: the assembled system from then on.
     matrix_free_failed_ = true;
     if (StepResult r = prepare(dynamics, h); !r.ok) return r;
     system_->set_threads(threads_);
+    if (StepResult r = system_->collect_force_jacobians(dynamics, x, v, t); !r.ok) return r;
     system_->assemble(dynamics, x, v, h, kw_);
   }
   add_external_damping_system(dynamics.model(), t, h);
@@ -384,8 +365,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
     if (StepResult r = assembled_->ensure_pairs(model, bodies_.pairs()); !r.ok) return r;
   }
   if (StepResult r = assemble(dynamics, s.x, s.v, s.t + h, h); !r.ok) return r;
-  anchored_ =
-      dynamics.anchors() != nullptr || (assembled() && assembled_->has_force_terms()) || damped_;
+  anchored_ = dynamics.anchors() != nullptr || system_->has_force_terms() || damped_;
   b_.resize(f_.size());
   for_each_entry(threads_, b_.size(), [&](long k) { b_[k] = h * (f_[k] + h * kw_[k]); });
   if (bodies_active_ && bodies_.any_active()) assembled_->refresh_pair_terms(bodies_, b_);
@@ -527,7 +507,10 @@ StepResult ImplicitEuler::Impl::step(const Dynamics& dynamics, State& s, Real h)
   } else if (body_contact_ != nullptr) {
     body_contact_->record_step({}, 0.0);
   }
-  return StepResult::success();
+  StepResult result = StepResult::success();
+  result.contact = {resolves_contact(), resolves_body_contact(),
+                    contact_active_ ? contact_.count() : 0};
+  return result;
 }
 
 }  // namespace jelly

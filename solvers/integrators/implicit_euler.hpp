@@ -24,13 +24,6 @@ class ImplicitEuler final : public Integrator {
   int order() const override { return 1; }
   bool is_implicit() const override { return true; }
   bool uses_force_jacobians() const override { return true; }
-  // With contact = "implicit", unless the last step's Dynamics carried no terrains (then the
-  // caller's resolve after the step must handle them all).
-  bool resolves_contact() const override;
-  // With contact = "implicit" and contact between bodies (Dynamics::body_contact()): the pairs
-  // are part of the solve (docs/contact.md).
-  bool resolves_body_contact() const override;
-  int contacts_resolved() const override;
   // steps, symbolic_analyses, numeric_factorizations, linear_solves, cg_iterations,
   // newton_iterations, newton_not_converged, assembly_seconds, factorization_seconds,
   // solve_seconds, and for contact inside the solve contact_extra_solves,

@@ -4,6 +4,8 @@
 #include <cstdio>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
 
@@ -18,15 +20,11 @@ StepResult Integrator::step(const Dynamics& dynamics, State& state, Real h) {
   const Eigen::Index n = dynamics.model().num_dofs();
   require(state.x.size() == n && state.v.size() == n, "state.size", state.x.size(),
           "3 x the number of particles (" + std::to_string(n) + ")");
-  if (dynamics.has_in_evaluation_contact() && !supports_in_evaluation_contact())
+  if (dynamics.has_in_evaluation_contact() && !integrator_supports_in_evaluation_contact(name()))
     throw InputError("terrains.contact.model", "\"seed_framework\"",
                      in_evaluation_contact_requirement(name()));
   StepResult result = do_step(dynamics, state, h);
-  if (!result.ok) return result;
-  // Pinned particles end the step exactly on their paths, whatever the method did with them.
-  const Pins& pins = dynamics.model().pins;
-  if (!pins.empty()) pins.apply(state.t, state.x, state.v);
-  ++steps_;
+  if (result.ok) ++steps_;
   return result;
 }
 
@@ -41,15 +39,19 @@ void Integrator::restore_internal_state(const std::vector<Real>& /*data*/) {}
 
 Statistics Integrator::statistics() const { return {{"steps", static_cast<double>(steps_)}}; }
 
-void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,
-                                const Model& model, const Terrains& terrains, const State& before,
-                                State& state, Real h, int threads) {
-  if (!integrator.resolves_contact()) {
+void finish_step(const StepResult& result, ContactSolver& contacts, BodyContact* bodies,
+                 const Model& model, const Terrains& terrains, const State& before, State& state,
+                 Real h, int threads) {
+  // Bodies first, then the terrains: a terrain has the last word on where a particle may be.
+  if (bodies != nullptr && !result.contact.bodies) bodies->resolve(model, before, state, h);
+  if (result.contact.terrains) {
+    contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kUnsolvedOnly,
+                     threads);
+    contacts.add_resolved(result.contact.particles);
+  } else {
     contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kAll, threads);
-    return;
   }
-  contacts.resolve(model, terrains, before, state, h, ContactSolver::Scope::kUnsolvedOnly, threads);
-  contacts.add_resolved(integrator.contacts_resolved());
+  if (!model.pins.empty()) model.pins.apply(state.t, state.x, state.v);
 }
 
 }  // namespace jelly

@@ -24,21 +24,37 @@ struct ToleranceMiss {
 // A tolerance as people write it, for ToleranceMiss::what (1e-12, not 9.9999999999999998e-13).
 std::string tolerance_text(double value);
 
+// What a step resolved of the contact inside its own solve or iterations, so that finish_step()
+// leaves it alone: per step, since it depends on what the step's Dynamics carried.
+struct StepContact {
+  // The terrains whose model constrains the solves (TerrainContactModel::constrains_solves()):
+  // finish_step() then resolves only the others (the seed models) after the step.
+  bool terrains = false;
+  // The contact between bodies (Dynamics::body_contact()): finish_step() then skips it.
+  bool bodies = false;
+  // With `terrains`: the particles in terrain contact at the step's end.
+  int particles = 0;
+};
+
 // A recoverable numerical failure is a returned status, not an exception.
 struct StepResult {
   bool ok = true;
   std::string message;
+  StepContact contact;
   static StepResult success() { return {}; }
-  static StepResult failure(std::string why) { return {false, std::move(why)}; }
+  static StepResult failure(std::string why) { return {false, std::move(why), {}}; }
 };
 
 class Integrator {
  public:
   virtual ~Integrator() = default;
 
-  // Advances state (t, x, v) by h under `dynamics`. Throws InputError unless h is finite and
-  // > 0 and the state's sizes match the model, or when `dynamics` has seed_framework terrains
-  // and the method does not support them.
+  // Advances state (t, x, v) by h under `dynamics`: the integration alone, which may resolve
+  // contact inside its solve (StepResult::contact says what it did); finish_step() completes the
+  // step (the contact left, then the pins). Throws InputError unless h is finite and > 0 and the
+  // state's sizes match the model, or when `dynamics` has seed_framework terrains and the method
+  // does not evaluate through Dynamics::stage_acceleration()
+  // (integrator_supports_in_evaluation_contact()).
   StepResult step(const Dynamics& dynamics, State& state, Real h);
 
   virtual std::string_view name() const = 0;
@@ -50,19 +66,6 @@ class Integrator {
   // True when the method chooses its own internal steps within each step(h) (error control):
   // the h-convergence of fixed-step methods does not apply to it.
   virtual bool is_adaptive() const { return false; }
-  // True when every force evaluation of do_step() goes through Dynamics::stage_acceleration(),
-  // so that seed_framework terrains act inside it (the explicit methods). The others reject
-  // such terrains: a velocity reflection inside an implicit solve's or ARKODE's right-hand side
-  // is not a function of the state they iterate on (docs/contact.md).
-  virtual bool supports_in_evaluation_contact() const { return false; }
-  // True when do_step() already applied the contact of the coulomb terrains (inside its solve);
-  // the Simulator then applies only the seed model's contact after the step.
-  virtual bool resolves_contact() const { return false; }
-  // True when do_step() resolved the contact between bodies (Dynamics::body_contact()) inside
-  // its solve; the Simulator then does not resolve it after the step.
-  virtual bool resolves_body_contact() const { return false; }
-  // When resolves_contact(): the particles in coulomb contact at the end of the last step.
-  virtual int contacts_resolved() const { return 0; }
   // What the next steps depend on besides the state (warm starts, contact sets), as numbers a
   // checkpoint can store; empty for a method without such state. restore_internal_state() takes
   // back what internal_state() gave (an empty vector: start afresh; a method without state
@@ -85,12 +88,15 @@ class Integrator {
   long steps_ = 0;
 };
 
-// The contact after a step of `integrator` from `before` to `state` (as the Simulator does it):
-// every terrain's, or, when the integrator resolved the coulomb terrains inside its step, only
-// the seed model's, with the integrator's contacts added to the count.
-void resolve_contact_after_step(const Integrator& integrator, ContactSolver& contacts,
-                                const Model& model, const Terrains& terrains, const State& before,
-                                State& state, Real h, int threads = 1);
+// Completes a step that Integrator::step() took from `before` to `state` with `result` (ok):
+// the contact between bodies unless the step resolved it (`bodies` may be null: none), then
+// every terrain's contact, or only the after-step models' when the step resolved the others
+// (the step's contacts added to the count), then the pins: pinned particles end the step
+// exactly on their paths, whatever the method and the contact did with them. The one place
+// pins are enforced; the Simulator and anything stepping an integrator itself call it.
+void finish_step(const StepResult& result, ContactSolver& contacts, BodyContact* bodies,
+                 const Model& model, const Terrains& terrains, const State& before, State& state,
+                 Real h, int threads = 1);
 
 // What InputError says is allowed when `integrator` meets a seed_framework terrain.
 std::string in_evaluation_contact_requirement(std::string_view integrator);

@@ -58,10 +58,6 @@ ProjectiveDynamics::ProjectiveDynamics(ProjectiveDynamicsOptions options)
 
 ProjectiveDynamics::~ProjectiveDynamics() = default;
 
-int ProjectiveDynamics::contacts_resolved() const {
-  return contact_active_ ? contact_->count() : 0;
-}
-
 std::vector<ToleranceMiss> ProjectiveDynamics::tolerance_misses() const {
   if (options_.tolerance == 0) return {};
   return {{"projective_dynamics: the residual stayed above integrator.options.tolerance = " +
@@ -81,7 +77,7 @@ Statistics ProjectiveDynamics::statistics() const {
   s["factorization_seconds"] = factorization_seconds_;
   s["solve_seconds"] = solve_seconds_;
   if (options_.chebyshev) s["chebyshev_rho"] = rho_;
-  if (resolves_contact())
+  if (contact_in_step())
     s["contact_restitution_limited"] =
         static_cast<double>(contact_->counters().restitution_limited);
   return s;
@@ -294,7 +290,7 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
     particle(x_, i) = particle(s.x, i) + h * particle(s.v, i) + (h * h) * model.gravity;
   const Terrains* terrains = dynamics.terrains();
   terrains_seen_ = terrains != nullptr;
-  contact_active_ = resolves_contact() && contact_->begin(model, *terrains, s, h, true);
+  contact_active_ = contact_in_step() && contact_->begin(model, *terrains, s, h, true);
   if (contact_active_) contact_->project(x_);
   place_pins(model, s.t + h);
   set_pins(model.pins);
@@ -364,7 +360,9 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
   s.x = x_;
   s.t += h;
   if (contact_active_) contact_->finish(model, s, dynamics.threads());
-  return StepResult::success();
+  StepResult result = StepResult::success();
+  result.contact = {contact_in_step(), false, contact_active_ ? contact_->count() : 0};
+  return result;
 }
 
 }  // namespace jelly

@@ -32,10 +32,6 @@ class ProjectiveDynamics final : public Integrator {
   std::string_view name() const override { return "projective_dynamics"; }
   int order() const override { return 1; }
   bool is_implicit() const override { return true; }
-  bool resolves_contact() const override {
-    return options_.contact == PositionContactMode::kProjection && terrains_seen_;
-  }
-  int contacts_resolved() const override;
   // steps, symbolic_analyses, factorizations (once per model and dt), iterations (global
   // solves), not_converged (steps that ended above the tolerance), chebyshev_rho,
   // factorization_seconds, solve_seconds, contact_restitution_limited.
@@ -56,6 +52,11 @@ class ProjectiveDynamics final : public Integrator {
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;
 
  private:
+  // With contact = "projection", unless the last step's Dynamics carried no terrains (then
+  // finish_step() resolves them all after the step).
+  bool contact_in_step() const {
+    return options_.contact == PositionContactMode::kProjection && terrains_seen_;
+  }
   // (Re)builds and factorizes A when the model or h changed.
   StepResult prepare(const Model& model, Real h);
   // r_ at the iterate x_ (v_ = (x_ - x0) / h), with the contact forces taken out.

@@ -78,21 +78,22 @@ const std::vector<Entry>& table() {
         {{"arkode_erk", "SUNDIALS ARKODE adaptive explicit Runge-Kutta (default 5(4) pair)",
           arkode_erk_options()},
          [](const IntegratorOptions& o) { return std::make_unique<ArkodeErk>(o.arkode); }},
-        {{"explicit_euler", "forward Euler, order 1, explicit", kNoOptions},
+        {{"explicit_euler", "forward Euler, order 1, explicit", kNoOptions, true},
          plain<ExplicitEuler>()},
         {{"implicit_euler",
           "backward Euler on a sparse Cholesky/CG solver, order 1, implicit (stable at any dt)",
           options_io<kImplicit>()},
          [](const IntegratorOptions& o) { return std::make_unique<ImplicitEuler>(o.implicit); }},
-        {{"midpoint", "explicit midpoint (the report's midpoint Euler), order 2", kNoOptions},
+        {{"midpoint", "explicit midpoint (the report's midpoint Euler), order 2", kNoOptions, true},
          plain<Midpoint>()},
         {{"projective_dynamics",
           "local/global backward Euler on one prefactored matrix (Liu 2013), order 1, implicit",
           options_io<kPd>()},
          [](const IntegratorOptions& o) { return std::make_unique<ProjectiveDynamics>(o.pd); }},
-        {{"rk4", "classical Runge-Kutta, order 4, explicit", kNoOptions}, plain<RungeKutta4>()},
+        {{"rk4", "classical Runge-Kutta, order 4, explicit", kNoOptions, true},
+         plain<RungeKutta4>()},
         {{"symplectic_euler",
-          "semi-implicit Euler, order 1 (what the report called implicit Euler)", kNoOptions},
+          "semi-implicit Euler, order 1 (what the report called implicit Euler)", kNoOptions, true},
          plain<SymplecticEuler>()},
         {{"vbd",
           "vertex block descent: per-particle 3x3 Newton steps of backward Euler in a graph "
@@ -125,6 +126,13 @@ std::vector<std::string> integrator_names() {
   std::vector<std::string> names;
   for (const Entry& e : table()) names.emplace_back(e.info.name);
   return names;
+}
+
+bool integrator_supports_in_evaluation_contact(std::string_view name) {
+  for (const IntegratorInfo& info : integrator_infos()) {
+    if (info.name == name) return info.in_evaluation_contact;
+  }
+  return false;
 }
 
 const IntegratorInfo& find_integrator(std::string_view name, std::string_view field) {

@@ -25,11 +25,20 @@ struct IntegratorInfo {
   std::string_view name;
   std::string_view description;
   IntegratorOptionsIo options;
+  // True when every force evaluation of the method's step goes through
+  // Dynamics::stage_acceleration(), so that the models acting inside evaluations
+  // (seed_framework) work with it (the explicit methods). The others refuse such terrains: a
+  // velocity reflection inside an implicit solve's or ARKODE's right-hand side is not a function
+  // of the state they iterate on (docs/contact.md).
+  bool in_evaluation_contact = false;
 };
 
 // Every registered integrator, sorted by name.
 const std::vector<IntegratorInfo>& integrator_infos();
 std::vector<std::string> integrator_names();
+// The registered integrator's IntegratorInfo::in_evaluation_contact; false for a name the
+// registry does not know (an integrator of the user's own).
+bool integrator_supports_in_evaluation_contact(std::string_view name);
 // Throws InputError "<field> = "rk5" is invalid: one of ..." for an unknown name.
 const IntegratorInfo& find_integrator(std::string_view name,
                                       std::string_view field = "integrator.name");

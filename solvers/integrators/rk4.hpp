@@ -9,7 +9,6 @@ class RungeKutta4 final : public Integrator {
   std::string_view name() const override { return "rk4"; }
   int order() const override { return 4; }
   // Every force evaluation goes through Dynamics::stage_acceleration().
-  bool supports_in_evaluation_contact() const override { return true; }
 
  protected:
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;

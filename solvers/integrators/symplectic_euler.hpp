@@ -10,7 +10,6 @@ class SymplecticEuler final : public Integrator {
   std::string_view name() const override { return "symplectic_euler"; }
   int order() const override { return 1; }
   // Every force evaluation goes through Dynamics::stage_acceleration().
-  bool supports_in_evaluation_contact() const override { return true; }
 
  protected:
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;

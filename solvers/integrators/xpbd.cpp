@@ -19,13 +19,11 @@ Xpbd::Xpbd(XpbdOptions options)
 
 Xpbd::~Xpbd() = default;
 
-int Xpbd::contacts_resolved() const { return contact_active_ ? contact_->count() : 0; }
-
 Statistics Xpbd::statistics() const {
   Statistics s = Integrator::statistics();
   s["substeps"] = static_cast<double>(substeps_);
   s["sweeps"] = static_cast<double>(sweeps_);
-  if (resolves_contact())
+  if (contact_in_step())
     s["contact_restitution_limited"] =
         static_cast<double>(contact_->counters().restitution_limited);
   return s;
@@ -248,7 +246,7 @@ StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
     dynamics.add_applied_forces(s.t, s.x, s.v, f_);
     dynamics.contacts().add_forces(s.v, f_);
     const Real t1 = sub + 1 == substeps ? t_end : s.t + hs;
-    contact_active_ = resolves_contact() && contact_->begin(model, *terrains, s, hs);
+    contact_active_ = contact_in_step() && contact_->begin(model, *terrains, s, hs);
     x_start_ = s.x;
     for (int i = 0; i < n; ++i) {
       particle(s.v, i) += (hs * inverse_mass_[i]) * particle(f_, i);
@@ -279,7 +277,9 @@ StepResult Xpbd::do_step(const Dynamics& dynamics, State& s, Real h) {
   }
   if (!s.x.allFinite() || !s.v.allFinite())
     return StepResult::failure("xpbd: a position or velocity is not finite");
-  return StepResult::success();
+  StepResult result = StepResult::success();
+  result.contact = {contact_in_step(), false, contact_active_ ? contact_->count() : 0};
+  return result;
 }
 
 }  // namespace jelly

@@ -39,10 +39,6 @@ class Xpbd final : public Integrator {
   int order() const override { return 1; }
   // The springs are solved implicitly (compliant constraints): stable at any step.
   bool is_implicit() const override { return true; }
-  bool resolves_contact() const override {
-    return options_.contact == PositionContactMode::kProjection && terrains_seen_;
-  }
-  int contacts_resolved() const override;
   // steps, substeps, sweeps, contact_restitution_limited.
   Statistics statistics() const override;
 
@@ -52,6 +48,11 @@ class Xpbd final : public Integrator {
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;
 
  private:
+  // With contact = "projection", unless the last step's Dynamics carried no terrains (then
+  // finish_step() resolves them all after the step).
+  bool contact_in_step() const {
+    return options_.contact == PositionContactMode::kProjection && terrains_seen_;
+  }
   // One spring as the sweep reads it: coefficients premultiplied for the substep size.
   struct Constraint {
     int a, b;

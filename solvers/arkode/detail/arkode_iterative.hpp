@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <jelly/core/anchor_springs.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/arkode/detail/arkode_support.hpp>
 
@@ -33,6 +34,8 @@ namespace jelly::arkode {
 // Pinned particles follow their paths: their acceleration does not depend on the state, so
 // their rows of J are [0, I; 0, 0] and the Newton system prescribes dv_i = bv_i. They are
 // filtered the same way with P_i = 0 (z_i = bv_i). Wind drag adds -drag I to D's diagonal.
+// Added forces' Jacobian blocks (Force::add_jacobian) add their symmetric parts to K and D, as
+// implicit_euler takes them.
 class SpringOperator {
  public:
   struct Constraint {
@@ -43,8 +46,11 @@ class SpringOperator {
   // `anchors` (may be null): their diagonal Jacobians -k I, -c I are added; the wind drag of
   // the model's external forces active at time t: -drag I on D's diagonal; the model's pins
   // (always) as above.
+  // `forces` (may be null): the added forces' Jacobian blocks at (t, x, v)
+  // (Dynamics::added_force_jacobians), copied.
   void linearize(const Model& model, const VecX& x, const VecX& v,
-                 const AnchorSprings* anchors = nullptr, Real t = 0);
+                 const AnchorSprings* anchors = nullptr, Real t = 0,
+                 const ForceJacobian* forces = nullptr);
   // The particles whose normal acceleration the seed contact cancels (see above); call after
   // linearize(), before set_gamma().
   void set_constraints(std::vector<Constraint> constraints);
@@ -90,6 +96,7 @@ class SpringOperator {
   VecX damping_;                           // workspace of linearize()
   std::vector<int> constraint_of_;         // [N] index into constraints_, or -1
   std::vector<Real> k_blocks_, d_blocks_;  // workspace of linearize()
+  ForceJacobian forces_;                   // the added forces' blocks at the linearization
   VecX filtered_;                          // workspace of multiply_filtered()
   Real gamma_ = -1;
   bool ready_ = false;

@@ -125,23 +125,9 @@ LinearResult AssembledSystem::solve(const VecX& b, VecX& y, ImplicitContact* /*c
 
 StepResult AssembledSystem::collect_force_jacobians(const Dynamics& dynamics, const VecX& x,
                                                     const VecX& v, Real t) {
-  force_jacobian_.clear();
-  const ForceList* forces = dynamics.added_forces();
-  if (forces == nullptr) return StepResult::success();
+  dynamics.added_force_jacobians(t, x, v, force_jacobian_);
+  if (force_jacobian_.empty()) return StepResult::success();
   const Model& model = dynamics.model();
-  const int n = model.num_particles();
-  for (const std::shared_ptr<Force>& force : *forces) {
-    if (!force->has_jacobian()) continue;
-    const std::size_t before = force_jacobian_.blocks().size();
-    force->add_jacobian(t, x, v, force_jacobian_);
-    for (std::size_t k = before; k < force_jacobian_.blocks().size(); ++k) {
-      const ForceJacobian::Block& b = force_jacobian_.blocks()[k];
-      if (b.i < 0 || b.i >= n || b.j < 0 || b.j >= n || !b.dfdx.allFinite() ||
-          !b.dfdv.allFinite()) {
-        force_jacobian_.validate(n, force->name());  // throws, naming the block
-      }
-    }
-  }
   bool complete = true;
   for (const ForceJacobian::Block& b : force_jacobian_.blocks())
     if (b.i != b.j && !has_block(a_, b.i, b.j)) {

@@ -40,13 +40,12 @@ class AssembledSystem final : public BackwardEulerSystem {
   LinearResult solve(const VecX& b, VecX& y, ImplicitContact* constraints, Real tolerance,
                      bool resume) override;
 
-  // The added forces' Jacobian blocks at (t, x, v), for the next assembly, and their blocks in
-  // the pattern (a new symbolic analysis only when a block is new). Throws InputError for a
-  // block out of range or not finite, naming the force.
+  // The added forces' Jacobian blocks, and their blocks in the pattern (a new symbolic
+  // analysis only when a block is new).
   StepResult collect_force_jacobians(const Dynamics& dynamics, const VecX& x, const VecX& v,
-                                     Real t);
+                                     Real t) override;
   // Whether the last collect_force_jacobians() found blocks.
-  bool has_force_terms() const { return !force_jacobian_.empty(); }
+  bool has_force_terms() const override { return !force_jacobian_.empty(); }
 
   // Contact pairs between bodies inside the solve: the pattern holds the blocks of `pairs` (the
   // union of the candidates seen so far; a new symbolic analysis only when a pair is new).

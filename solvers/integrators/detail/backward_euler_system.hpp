@@ -33,6 +33,12 @@ class BackwardEulerSystem {
   // dt changed: what was computed for the old one (factorizations, coarse operators) is stale.
   virtual void invalidate() = 0;
 
+  // The added forces' Jacobian blocks at (t, x, v), for the next assemble(). Throws InputError
+  // for a block out of range or not finite, naming the force.
+  virtual StepResult collect_force_jacobians(const Dynamics& dynamics, const VecX& x, const VecX& v,
+                                             Real t) = 0;
+  // Whether the last collect_force_jacobians() found blocks.
+  virtual bool has_force_terms() const = 0;
   // A at (x, v) for a step of size h, with kw = K v (the springs' and anchors' stiffness times
   // v). False when the system cannot represent it (the matrix-free system meets a collapsed
   // spring): the caller moves to an assembled system.

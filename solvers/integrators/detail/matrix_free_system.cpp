@@ -43,6 +43,12 @@ std::string_view MatrixFreeSystem::name() const {
   return use_multigrid_ ? "cg_multigrid_matrix_free" : "cg_jacobi_matrix_free";
 }
 
+StepResult MatrixFreeSystem::collect_force_jacobians(const Dynamics& dynamics, const VecX& x,
+                                                     const VecX& v, Real t) {
+  dynamics.added_force_jacobians(t, x, v, force_jacobian_);
+  return StepResult::success();
+}
+
 bool MatrixFreeSystem::assemble(const Dynamics& dynamics, const VecX& x, const VecX& v, Real h,
                                 VecX& kw) {
   // A collapsed spring (its direction from the rest positions) cannot be held in the bands.
@@ -54,6 +60,13 @@ bool MatrixFreeSystem::assemble(const Dynamics& dynamics, const VecX& x, const V
       band_->add_diagonal(anchor.particle, h * anchor.damping + h * h * anchor.stiffness);
       kw.segment<3>(3 * anchor.particle) -= anchor.stiffness * v.segment<3>(3 * anchor.particle);
     }
+  }
+  // The added forces' Jacobians, their symmetric part S = (J + J^T) / 2 as the assembled
+  // system takes it: A -= h S_D + h^2 S_K, kw += S_K v.
+  band_->set_extra_blocks(force_jacobian_, h, h * h);
+  for (const ForceJacobian::Block& b : force_jacobian_.blocks()) {
+    kw.segment<3>(3 * b.i) += 0.5 * b.dfdx * v.segment<3>(3 * b.j);
+    kw.segment<3>(3 * b.j) += 0.5 * b.dfdx.transpose() * v.segment<3>(3 * b.i);
   }
   return true;
 }

@@ -2,7 +2,9 @@
 // The backward-Euler system without a matrix: A's blocks per spring in the springs' bands
 // (core/detail/band_system.hpp), solved by CG preconditioned by block Jacobi or by a lattice
 // multigrid V-cycle. Only for models whose springs fill the bands, without contact pairs
-// between bodies or added forces' Jacobians in the solve (their blocks lie off the bands).
+// between bodies in the solve. Added forces' Jacobian blocks (off the bands) are kept per row
+// beside them (BandSystem::set_extra_blocks); the multigrid's coarse levels leave them out (a
+// preconditioner: its fine level and the CG products have them).
 #include <optional>
 #include <utility>
 #include <vector>
@@ -39,6 +41,9 @@ class MatrixFreeSystem final : public BackwardEulerSystem {
   int rows() const override { return band_->rows(); }
   void set_threads(int threads) override { threads_ = threads; }
   void invalidate() override { coarse_stale_ = true; }
+  StepResult collect_force_jacobians(const Dynamics& dynamics, const VecX& x, const VecX& v,
+                                     Real t) override;
+  bool has_force_terms() const override { return !force_jacobian_.empty(); }
   bool assemble(const Dynamics& dynamics, const VecX& x, const VecX& v, Real h, VecX& kw) override;
   void add_diagonal(int particle, Real value) override { band_->add_diagonal(particle, value); }
   void constrain(ImplicitContact& contacts, const VecX& b, bool prescribe, VecX& rhs, VecX& z,
@@ -65,6 +70,7 @@ class MatrixFreeSystem final : public BackwardEulerSystem {
   // another set are far from its operator (a released contact's coupling is missing from
   // them), so a solve with another set rebuilds them.
   std::vector<std::pair<int, int>> coarse_contacts_, contacts_now_;
+  ForceJacobian force_jacobian_;  // the added forces' blocks for the next assembly
   VecX az_;
   VecX cg_x_;                      // a loose solve's iterate, for resuming it
   int loose_iterations_ = 0;       // ... and its CG iterations

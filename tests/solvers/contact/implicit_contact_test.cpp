@@ -281,18 +281,23 @@ TEST(ImplicitContact, InternalStateRoundTripsAndIsChecked) {
 TEST(ImplicitContact, AfterStepOptionUsesTheSimulatorsResolve) {
   ImplicitEulerOptions o;
   o.contact = ImplicitContactMode::kAfterStep;
-  EXPECT_FALSE(ImplicitEuler(o).resolves_contact());
-  EXPECT_TRUE(ImplicitEuler().resolves_contact());
-  // Stepped with a Dynamics that has no terrains, it has resolved nothing: the caller's resolve
-  // after the step must handle every terrain.
-  ImplicitEuler alone;
   const FallingCube c;
   const ContactSolver contacts;
   State s = c.s0;
-  ASSERT_TRUE(alone.step(Dynamics(c.model, contacts), s, c.h).ok);
-  EXPECT_FALSE(alone.resolves_contact());
-  ASSERT_TRUE(alone.step(Dynamics(c.model, contacts, &c.terrains), s, c.h).ok);
-  EXPECT_TRUE(alone.resolves_contact());
+  ImplicitEuler after_step(o);
+  StepResult r = after_step.step(Dynamics(c.model, contacts, &c.terrains), s, c.h);
+  ASSERT_TRUE(r.ok);
+  EXPECT_FALSE(r.contact.terrains);
+  // Stepped with a Dynamics that has no terrains, it has resolved nothing: finish_step() must
+  // handle every terrain.
+  ImplicitEuler alone;
+  s = c.s0;
+  r = alone.step(Dynamics(c.model, contacts), s, c.h);
+  ASSERT_TRUE(r.ok);
+  EXPECT_FALSE(r.contact.terrains);
+  r = alone.step(Dynamics(c.model, contacts, &c.terrains), s, c.h);
+  ASSERT_TRUE(r.ok);
+  EXPECT_TRUE(r.contact.terrains);
 
   const Json penalty = Json::parse(R"({"contact": "penalty"})");
   JsonFields f(penalty, "integrator.options");
