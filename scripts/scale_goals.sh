@@ -20,8 +20,7 @@
 # --quick: small cubes and few steps, to check that the script runs (its figures are not the
 # goals'). Default: 3 rounds, output under out/scale_goals of the current directory (each run's
 # CSV or log, rounds.csv with every figure, summary.txt); a DIR that is not empty is refused
-# unless --overwrite (which removes the round folders, rounds.csv and summary.txt in it). Takes
-# about 50 s per round on the 2-core machine of docs/.
+# unless --overwrite (which removes the round folders, rounds.csv and summary.txt in it).
 #
 # Environment: JELLY_BENCH and JELLY, the programs (default: build/bench/jelly-bench and
 # build/cli/jelly of this checkout). Run it with nothing else running. Exit codes: 0 (whether
