@@ -221,7 +221,8 @@ def render_stability(data):
     first = rows[0]
     intro = (f"Largest stable dt in ms, measured ({' / '.join(scenes)}) and predicted in "
              f"parentheses; the seed cube (n = {int(first['n'])}), {first['contact']} contact, "
-             f"{first['horizon']:g} s, kd = ks x {sig(first['kd'] / first['ks'])} s.")
+             f"{first['horizon']:g} s, kd = ks x {sig(first['kd'] / first['ks'])} s. The runs are "
+             "deterministic: these figures do not depend on the machine or its load.")
     return "\n\n".join([intro, table(header, body), measured(meta)])
 
 
