@@ -259,6 +259,23 @@ def render_speed(data):
     return "\n\n".join([intro, table(header, body), measured(meta)])
 
 
+def status_text(r, short=False):
+    """A row's status, with what stopped a run that did not complete and when."""
+    status = r["status"]
+    if short and status not in COMPLETED:
+        return "energy cap" if "above the cap" in r.get("reason", "") else status.replace("_", " ")
+    if status in COMPLETED or status.startswith("skipped"):
+        return status.replace("_", " ")
+    reason = r.get("reason", "")
+    when = re.search(r" at t = ([-+0-9.eE]+)", reason)
+    at = f" at t = {float(when.group(1)):.2f} s" if when else ""
+    if "above the cap" in reason:
+        return "energy above the cap" + at
+    if reason:
+        return status.replace("_", " ") + ": " + reason.split(" at t = ")[0][:60] + at
+    return status.replace("_", " ")
+
+
 def scene_name(r):
     n = int(r["n"])
     return f"cube n = {n}" if r.get("scene", "cube") == "cube" else f"cloth {n} x {n}"
@@ -274,7 +291,7 @@ def render_budget(data):
                                                        "frame_seconds_max")) if ok else "",
                  sig(r["error_max"], 2), sig(r["com_error_max"], 2),
                  signed(r["energy_end_vs_reference"]), signed(r["energy_growth_max"]),
-                 sig(r["stiffest_ks"]), r["status"].replace("_", " ")]
+                 sig(r["stiffest_ks"]), status_text(r)]
         body.append(cells)
     header = ["scene", "setup", "steps/frame", "frame ms: median / mean / max", "error max (m)",
               "com error (m)", "energy end vs ref", "largest growth", "stiffest ks (N/m)",
@@ -303,7 +320,7 @@ def render_integrators(data):
                 cost.append(sig(r["frame_seconds"] * 1e3))
             else:
                 steps.append("-")
-                cost.append(r["status"].replace("_", " "))
+                cost.append(status_text(r, short=True))
         reference = mine.get(first_cube) if first_cube else None
         error = sig(reference["error_max"], 2) if reference else ""
         stiffest = sig(reference["stiffest_ks"]) if reference else ""
@@ -322,7 +339,8 @@ def render_bullet(data):
     body = []
     for r in rows:
         cube = finite(r["volume_ratio_min"])
-        body.append([r["scene"], r["setup"],
+        scene = {"cloth64": "cloth 64 x 64", "cube20": "cube n = 20"}.get(r["scene"], r["scene"])
+        body.append([scene, r["setup"],
                      " / ".join(sig(r[k], 3) for k in ("frame_ms_median", "frame_ms_mean",
                                                         "frame_ms_max")),
                      sig(r["time_ratio"], 2), sig(r["penetration_max"], 2),
@@ -367,9 +385,10 @@ def render_core(data):
     load = context.get("load_avg")
     meta = {"cpu": context.get("host_name", "an unrecorded host"),
             "cores": str(context.get("num_cpus", "?"))}
-    line = (f"*Measured {context.get('date', 'at an unrecorded date')} on host "
-            f"{meta['cpu']} ({meta['cores']} CPUs, {context.get('mhz_per_cpu', '?')} MHz), "
-            f"{context.get('library_build_type', '?')} Google Benchmark library; "
+    date = context.get("date", "")
+    when = f"{date[:10]} {date[11:16]} UTC" if len(date) >= 16 else "at an unrecorded date"
+    line = (f"*Measured {when} on host {meta['cpu']} ({meta['cores']} CPUs at "
+            f"{context.get('mhz_per_cpu', '?')} MHz); "
             + (f"load average (1, 5, 15 min) {' '.join(f'{x:.2f}' for x in load)} at the start"
                if load else "load not recorded")
             + f". Program: `{os.path.basename(context.get('executable', '?'))}`, medians of "
@@ -424,6 +443,8 @@ def main():
     try:
         if not os.path.isdir(args.docs):
             raise InputProblem(f"--docs {args.docs}: no such folder")
+        # Every page is rendered before any is written: bad input leaves them all as they were.
+        rendered = []
         for name in sorted(os.listdir(args.docs)):
             if not name.endswith(".md"):
                 continue
@@ -431,8 +452,9 @@ def main():
             with open(path, encoding="utf-8") as f:
                 text = f.read()
             new, tables = render_page(text, args.data, path)
-            if not tables:
-                continue
+            if tables:
+                rendered.append((path, text, new, tables))
+        for path, text, new, tables in rendered:
             if new == text:
                 print(f"{path}: up to date ({', '.join(tables)})")
             elif args.check:

@@ -162,8 +162,8 @@ def plot_budget(rows, meta, out):
         return (r.get("scene", "cube"), int(r["n"]))
 
     def name(w):
-        return "n = %d" % w[1] if w[0] == "cube" else "cloth %d x %d" % (w[1], w[1])
-    sizes = sorted({what(r) for r in rows})
+        return "cube n = %d" % w[1] if w[0] == "cube" else "cloth %d x %d" % (w[1], w[1])
+    sizes = sorted({what(r) for r in rows}, key=lambda w: (w[0] != "cube", w[1]))
     setups = []
     for r in rows:  # in the table's order
         if r["setup"] not in setups:
@@ -175,7 +175,7 @@ def plot_budget(rows, meta, out):
         for j, n in enumerate(sizes):
             sel = [r for r in rows if r["setup"] == setup and what(r) == n
                    and r["status"] in COMPLETED and finite(r["frame_seconds_mean"])
-                   and finite(r["error_max"])]
+                   and finite(r["error_max"]) and r["error_max"] > 0]  # 0: the reference
             for r in sel:
                 axes[0].loglog(r["frame_seconds_mean"] * 1e3, max(r["error_max"], 1e-9),
                                markers[j % len(markers)], color="C%d" % (i % 10),
