@@ -46,17 +46,16 @@ NAMES = {"explicit_euler": "explicit Euler", "symplectic_euler": "symplectic Eul
 # What each integrator does with contact (docs/contact.md, docs/realtime.md, docs/arkode.md):
 # a property of the code, not a measurement.
 CONTACT = {
-    "explicit_euler": "terrains and bodies after the step; `seed_framework` in every evaluation",
-    "symplectic_euler": "terrains and bodies after the step; `seed_framework` in every evaluation",
-    "midpoint": "terrains and bodies after the step; `seed_framework` in every evaluation",
-    "rk4": "terrains and bodies after the step; `seed_framework` in every evaluation",
-    "implicit_euler": "`coulomb` terrains and bodies inside the solve; `seed` after the step",
-    "projective_dynamics": "`coulomb` terrains around each solve; `seed` and bodies after the step",
-    "xpbd": "`coulomb` terrains in every substep; `seed` and bodies after the step",
-    "vbd": "after the step; `contact_hardness` > 0: `coulomb` terrains as penalties in the sweeps "
-           "(no restitution or friction)",
-    "arkode_erk": "terrains and bodies after each interval dt",
-    "arkode_dirk": "terrains and bodies after each interval dt",
+    "explicit_euler": "after the step",
+    "symplectic_euler": "after the step",
+    "midpoint": "after the step",
+    "rk4": "after the step",
+    "implicit_euler": "in the solve",
+    "projective_dynamics": "around each solve",
+    "xpbd": "in each substep",
+    "vbd": "penalties in the sweeps",
+    "arkode_erk": "after each interval",
+    "arkode_dirk": "after each interval",
 }
 ORDER_OF_ACCURACY = {"explicit_euler": 1, "symplectic_euler": 1, "midpoint": 2, "rk4": 4,
                      "implicit_euler": 1, "projective_dynamics": 1, "xpbd": 1, "vbd": 1}
