@@ -12,6 +12,7 @@
 #include <jelly/bench/scenes.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/io/scene.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly::bench {
@@ -35,12 +36,21 @@ std::vector<BudgetSetup> default_budget_setups() {
     o.xpbd.substeps = substeps;
     s.push_back({"xpbd s" + std::to_string(substeps), "xpbd", o, 1});
   }
+  // vbd's penalty contact inside its sweeps (contact after the step only crushes the cube).
+  IntegratorOptions vbd;
+  vbd.vbd.iterations = 10;
+  vbd.vbd.contact_hardness = 100;
+  s.push_back({"vbd i10 h100", "vbd", vbd, 1});
   return s;
 }
 
 void BudgetOptions::validate() const {
-  require(!sizes.empty(), "--sizes", "(empty)", "at least one cube size");
+  require(!sizes.empty() || !cloth_sizes.empty(), "--sizes", "(empty)",
+          "at least one cube size (or a --cloth size)");
   for (int n : sizes) require(n >= 2 && n <= 100, "--sizes", n, "sizes in [2, 100]");
+  for (int n : cloth_sizes) require(n >= 2 && n <= 512, "--cloth", n, "sizes in [2, 512]");
+  require(cloth_sizes.empty() || !scenes_dir.empty(), "--scenes-dir", "(empty)",
+          "the folder of cloth_on_sphere.json");
   require(std::isfinite(frame) && frame > 0, "--frame", frame, "a frame time > 0 s");
   require(std::isfinite(horizon) && horizon >= frame, "--horizon", horizon, "a time >= one frame");
   require(std::isfinite(search_horizon) && search_horizon >= frame, "--search-horizon",
@@ -58,7 +68,31 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-SceneParts budget_scene(const BudgetOptions& o, int n, Real ks, Real kd) {
+// What one row measures: the seed cube of n per edge, or the cloth of n x n particles.
+struct BudgetScene {
+  bool cloth = false;
+  int n = 0;
+  bool operator<(const BudgetScene& other) const {
+    return cloth != other.cloth ? other.cloth : n < other.n;
+  }
+};
+
+// The cloth of scenes/cloth_on_sphere.json with nu = nv = n, at rest, over its sphere and floor.
+SceneParts budget_cloth(const BudgetOptions& o, int n) {
+  const Scene scene =
+      load_scene(o.scenes_dir + "/cloth_on_sphere.json",
+                 {"bodies.0.nu=" + std::to_string(n), "bodies.0.nv=" + std::to_string(n)});
+  SceneParts parts;
+  parts.model = make_model(scene);
+  parts.state = initial_state(parts.model);
+  for (const auto& spec : scene.terrains) parts.terrains.push_back(make_terrain(*spec));
+  return parts;
+}
+
+// The cube at (ks, kd); the cloth keeps its scene's springs (its rows search no ks ladder).
+SceneParts budget_scene(const BudgetOptions& o, const BudgetScene& what, Real ks, Real kd) {
+  if (what.cloth) return budget_cloth(o, what.n);
+  const int n = what.n;
   SceneSpec spec;
   spec.name = "slope";
   spec.n = n;
@@ -91,7 +125,8 @@ Simulator budget_simulator(SceneParts parts, const std::string& integrator,
   return sim;
 }
 
-bool stable(const BudgetOptions& o, int n, const BudgetSetup& setup, int steps, Real ks) {
+bool stable(const BudgetOptions& o, const BudgetScene& n, const BudgetSetup& setup, int steps,
+            Real ks) {
   const Real kd = ks * (o.kd / o.ks);
   Simulator sim = budget_simulator(budget_scene(o, n, ks, kd), setup.integrator, setup.options,
                                    o.frame / steps, o.search_horizon);
@@ -104,7 +139,7 @@ struct BudgetReference {
   std::vector<VecX> positions;  // every sample_every frames
 };
 
-BudgetReference make_budget_reference(const BudgetOptions& o, int n, int frames) {
+BudgetReference make_budget_reference(const BudgetOptions& o, const BudgetScene& n, int frames) {
   SceneParts parts = budget_scene(o, n, o.ks, o.kd);
   const Model model = parts.model;
   Simulator sim = budget_simulator(std::move(parts), "rk4", {},
@@ -149,15 +184,19 @@ Table run_budget(const BudgetOptions& o) {
                  setups.end());
   }
   for (const BudgetSetup& s : setups) make_integrator(s.integrator, s.options);
+  // A cloth scene that cannot be read fails now, not after the cubes' minutes of measuring.
+  for (int n : o.cloth_sizes) budget_cloth(o, n);
   Table table(
       "budget",
-      "seed cube on the seed slope (coulomb contact) frame by frame: frame_seconds = median wall "
+      "seed cube on the seed slope (coulomb contact), or the cloth over its sphere (scene "
+      "cloth: n x n particles), frame by frame: frame_seconds = median wall "
       "time of one frame's steps; errors against RK4 at frame / reference_steps (error_max: "
       "largest RMS particle distance over samples, com_error_max: largest centre-of-mass "
       "distance over frames); energies relative to |E0|; fewest_stable_steps: fewest steps per "
       "frame (of the ladder) stable at the seed material; stiffest_ks: largest ks of the ladder "
       "(kd proportional) stable at steps_per_frame",
       {"item",
+       "scene:s",
        "n",
        "particles",
        "springs",
@@ -179,9 +218,12 @@ Table run_budget(const BudgetOptions& o) {
        "peak_memory_bytes",
        "reason:s"});
   const int frames = static_cast<int>(std::lround(o.horizon / o.frame));
-  std::map<int, BudgetReference> references;
+  std::map<BudgetScene, BudgetReference> references;
+  std::vector<BudgetScene> scenes;
+  for (int n : o.sizes) scenes.push_back({false, n});
+  for (int n : o.cloth_sizes) scenes.push_back({true, n});
   long item = 0;
-  for (int n : o.sizes) {
+  for (const BudgetScene& n : scenes) {
     for (const BudgetSetup& setup : setups) {
       const long this_item = item++;
       if (!o.shard.owns(this_item)) continue;
@@ -199,7 +241,8 @@ Table run_budget(const BudgetOptions& o) {
           }
         }
       }
-      std::vector<Cell> row{static_cast<double>(this_item), static_cast<double>(n)};
+      std::vector<Cell> row{static_cast<double>(this_item), std::string(n.cloth ? "cloth" : "cube"),
+                            static_cast<double>(n.n)};
       SceneParts parts = budget_scene(o, n, o.ks, o.kd);
       const Model model = parts.model;
       row.insert(row.end(), {static_cast<double>(model.num_particles()),
@@ -260,7 +303,7 @@ Table run_budget(const BudgetOptions& o) {
       }
       // The stiffest ks of the ladder that stays stable at these steps per frame.
       Real stiffest = NAN;
-      if (ok && n <= o.ks_search_max_n) {
+      if (ok && !n.cloth && n.n <= o.ks_search_max_n) {
         for (Real ks : o.ks_ladder) {
           if (!stable(o, n, setup, steps, ks)) break;
           stiffest = ks;
@@ -271,9 +314,9 @@ Table run_budget(const BudgetOptions& o) {
                              energy_end, ok ? growth : NAN, fewest, stiffest, peak, reason});
       table.add_row(row);
       if (o.progress) {
-        *o.progress << "budget item " << this_item << ": n " << n << " " << setup.label << ", "
-                    << steps << " steps/frame: " << status << ", " << median(times) * 1e3
-                    << " ms/frame" << std::endl;
+        *o.progress << "budget item " << this_item << ": " << (n.cloth ? "cloth" : "cube") << " n "
+                    << n.n << " " << setup.label << ", " << steps << " steps/frame: " << status
+                    << ", " << median(times) * 1e3 << " ms/frame" << std::endl;
       }
     }
   }

@@ -1,10 +1,11 @@
 #pragma once
 // Which integrator for a frame budget: the seed cube (n per edge) falling onto the seed slope
-// (coulomb contact), advanced frame by frame (1/60 s) by each setup (an integrator, its options
-// and its steps per frame). Per size and setup: the cost of one frame (median over the run), the
-// error against a tight RK4 reference, the energy behaviour, the fewest steps per frame that are
-// stable at the seed material, and the stiffest ks of a ladder that stays stable at the setup's
-// steps per frame (docs/benchmarks.md).
+// (coulomb contact), and optionally the cloth of scenes/cloth_on_sphere.json (nu = nv = n)
+// falling over its sphere, advanced frame by frame (1/60 s) by each setup (an integrator, its
+// options and its steps per frame). Per scene, size and setup: the cost of one frame (median
+// over the run), the error against a tight RK4 reference, the energy behaviour, the fewest steps
+// per frame that are stable at the seed material, and (cubes) the stiffest ks of a ladder that
+// stays stable at the setup's steps per frame (docs/benchmarking.md).
 #include <ostream>
 #include <string>
 #include <vector>
@@ -23,12 +24,16 @@ struct BudgetSetup {
 };
 
 // symplectic_euler and rk4 (steps per frame searched), implicit_euler, projective_dynamics
-// (5, 10 and 20 iterations, 10 with Chebyshev) and xpbd (1, 5 and 20 substeps), one step per
-// frame each.
+// (5, 10 and 20 iterations, 10 with Chebyshev), xpbd (1, 5 and 20 substeps) and vbd (10 sweeps,
+// contact_hardness 100), one step per frame each.
 std::vector<BudgetSetup> default_budget_setups();
 
 struct BudgetOptions {
   std::vector<int> sizes{10, 20, 40};
+  // Cloths measured after the cubes: scenes_dir/cloth_on_sphere.json with nu = nv = each size
+  // (empty: none). The ks ladder is not searched for them (stiffest_ks is NAN).
+  std::vector<int> cloth_sizes;
+  std::string scenes_dir;           // the folder of cloth_on_sphere.json
   std::vector<BudgetSetup> setups;  // empty: default_budget_setups()
   std::vector<std::string> labels;  // only the setups with these labels (empty: all)
   Real frame = 1.0 / 60;            // s
@@ -48,7 +53,7 @@ struct BudgetOptions {
   void validate() const;
 };
 
-// Table "budget": one row per (size, setup) work item owned by the shard.
+// Table "budget": one row per (scene, size, setup) work item owned by the shard.
 Table run_budget(const BudgetOptions& options);
 
 }  // namespace jelly::bench

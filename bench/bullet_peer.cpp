@@ -229,8 +229,9 @@ int main(int argc, char** argv) {
                    setups.end());
     }
     o.progress = &std::cerr;
-    const Table table = run_peer_budget(o, setups);
+    // Taken before the run: its date and load are the start's (write_outputs adds the end's).
     Metadata metadata = run_metadata(std::vector<std::string>(argv, argv + argc));
+    const Table table = run_peer_budget(o, setups);
     write_outputs("bullet", {table}, metadata, out, Shard{}, std::cout);
   } catch (const InputError& e) {
     std::cerr << "error: " << e.what() << "\n";

@@ -1,4 +1,4 @@
-// Broad and narrow phase of body-body contact (docs/contact.md, docs/benchmarks.md): two n^3
+// Broad and narrow phase of body-body contact (docs/contact.md, "What contact costs"): two n^3
 // cubes side by side, their facing layers overlapping by 1 % of the contact distance (n^2
 // contact pairs), one BodyContact::resolve per iteration on a fresh copy of the state (the copy
 // is not timed). Counters: particles, pairs, ns per particle, and the broad phase alone.

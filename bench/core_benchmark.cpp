@@ -57,8 +57,8 @@ BENCHMARK(BM_ComputeForcesBanded)
     ->ArgsProduct({{10, 20, 40}, {1, 2}})
     ->Unit(benchmark::kMicrosecond);
 
-// What two threads can gain on this machine, apart from jelly's code (docs/benchmarks.md, "What
-// the host gives two threads"): two passes over the 3 n^3 entries of the n^3 cube's vectors on
+// What two threads can gain on this machine, apart from jelly's code (docs/threads.md,
+// "Measurements"): two passes over the 3 n^3 entries of the n^3 cube's vectors on
 // range(1) threads, split as the particle loops are (parallel::for_ranges). BM_StreamingPass is
 // rk4's update between two stages (7 vectors: the step's x and v, the stage's acceleration,
 // position and velocity, the two sums of slopes): little arithmetic per byte, so memory and cache

@@ -1,5 +1,5 @@
 // jelly-bench: which integrator to use for which jelly, and why. Subcommands stability, accuracy,
-// speed, seed, budget and merge; see docs/benchmarks.md.
+// speed, seed, budget and merge; see docs/benchmarking.md.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -16,6 +16,10 @@
 #include <jelly/bench/stability.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
+
+#ifndef JELLY_BENCH_SCENES_DIR
+#define JELLY_BENCH_SCENES_DIR "scenes"
+#endif
 
 namespace {
 
@@ -86,7 +90,7 @@ int main(int argc, char** argv) {
   stability_cmd->add_option("--contact", contact, "coulomb or seed")->capture_default_str();
   stability_cmd
       ->add_option("--energy-tolerance", stability.energy_tolerance,
-                   "energy cap tolerance (docs/benchmarks.md); < 0: no energy check")
+                   "energy cap tolerance (docs/benchmarking.md); < 0: no energy check")
       ->capture_default_str();
   stability_cmd->add_option("--dt-max", stability.bracket.dt_max, "largest dt tried (s)")
       ->capture_default_str();
@@ -163,6 +167,13 @@ int main(int argc, char** argv) {
   add_common(budget_cmd, common);
   budget_cmd->add_option("--sizes", budget.sizes, "cube sizes n")
       ->delimiter(',')
+      ->capture_default_str();
+  budget_cmd
+      ->add_option("--cloth", budget.cloth_sizes,
+                   "cloth sizes (nu = nv) of scenes/cloth_on_sphere.json, measured after the cubes")
+      ->delimiter(',');
+  budget.scenes_dir = JELLY_BENCH_SCENES_DIR;
+  budget_cmd->add_option("--scenes-dir", budget.scenes_dir, "the folder of cloth_on_sphere.json")
       ->capture_default_str();
   budget_cmd->add_option("--setups", budget.labels, "only these setups (labels, comma-separated)")
       ->delimiter(',');

@@ -5,6 +5,7 @@
 #include <jelly/bench/accuracy.hpp>
 #include <jelly/bench/csv_io.hpp>
 #include <jelly/bench/h5_writer.hpp>
+#include <jelly/bench/run_info.hpp>
 #include <jelly/bench/seed_table.hpp>
 
 namespace jelly::bench {
@@ -33,6 +34,11 @@ std::vector<Table> summary_tables(const std::string& command, const std::vector<
 void write_outputs(const std::string& command, const std::vector<Table>& tables, Metadata metadata,
                    const std::string& dir, const Shard& shard, std::ostream& out) {
   metadata["command"] = command;
+  // A merge keeps the shards' own load figures (read back with their metadata).
+  if (!metadata.count("load_average_end")) {
+    metadata["load_average_end"] = load_average();
+    metadata["date_utc_end"] = utc_now();
+  }
   metadata["shard"] = shard.text();
   std::filesystem::create_directories(dir);
   for (const Table& t : tables) {

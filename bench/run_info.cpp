@@ -25,6 +25,22 @@ std::string cpu_model() {
   return "unknown";
 }
 
+std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen;
+  if (!(in >> one >> five >> fifteen)) return "unknown";
+  return one + " " + five + " " + fifteen;
+}
+
+std::string utc_now() {
+  char date[64];
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return date;
+}
+
 Metadata run_metadata(const std::vector<std::string>& arguments) {
   Metadata m;
   m["cpu"] = cpu_model();
@@ -44,12 +60,8 @@ Metadata run_metadata(const std::vector<std::string>& arguments) {
   std::string command;
   for (const std::string& a : arguments) command += (command.empty() ? "" : " ") + a;
   m["command_line"] = command;
-  char date[64];
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  m["date_utc"] = date;
+  m["date_utc"] = utc_now();
+  m["load_average_start"] = load_average();
   return m;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The scenes jelly-bench measures: the seed cube (any n, seed pose) on the 20-degree slope or on
 // the seed elevator, and a contact-free deformed, spinning jelly for accuracy, each with the
-// energy cap of its divergence guard (docs/benchmarks.md).
+// energy cap of its divergence guard (docs/benchmarking.md).
 #include <memory>
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// The seed report's stability claims (docs/benchmarks.md, "Seed report claims") as a table: which
+// The seed report's stability claims (docs/benchmarking.md, "Seed report claims") as a table: which
 // integrators stay stable on the slope and the elevator with the report's own contact rules, at
 // the seed parameters and dt = 0.001, 0.0027 and 1/60, and at ks = 2400, kd = 120; the time of
 // divergence of those that do not; and a verdict on each claim. The rules run in both

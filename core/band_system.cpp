@@ -107,7 +107,7 @@ int band_blocks(int n, int fix, Real alpha, Real beta, Ends x, Ends v, Ends w,
 
 // Per slot t = B (p_a - p_b) = c1 (u . d) u + c2 d = e1 (e . d) e + c2 d, with e = x_a - x_b
 // (u = e / |e|) recomputed from the positions and e1 = c1 / |e|^2: 16 bytes per slot to read
-// instead of 40 (the product is bound by memory traffic at n = 40; docs/benchmarks.md), 8 with
+// instead of 40 (the product is bound by memory traffic at n = 40; docs/implicit.md), 8 with
 // the coefficients in single precision (C = float).
 template <class C>
 __attribute__((always_inline)) inline void band_products_loop(

@@ -320,6 +320,8 @@ def main():
             staged = os.path.relpath(os.path.join(root, name), docs)
             if name.endswith(".md"):
                 stager.copy_markdown(repo_path, staged)
+            elif name.endswith(".h5"):
+                continue  # jelly-bench's HDF5 beside the CSV files of docs/bench/: not committed
             else:
                 os.makedirs(os.path.join(stage, os.path.dirname(staged)), exist_ok=True)
                 shutil.copyfile(os.path.join(root, name), os.path.join(stage, staged))

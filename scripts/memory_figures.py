@@ -4,7 +4,7 @@
 Runs each integrator on cubes (n = 20, 40), a cloth and a tetrahedral body (a TetGen grid written
 to a temporary folder) for three steps without a recording, reads the peak resident size from
 `/usr/bin/time -f %M`, and the estimate from the message `jelly run` gives with max_particles = 1.
-Prints a Markdown table (docs/benchmarks.md, "Memory estimates").
+Prints a Markdown table (docs/scenes.md, "How close the memory estimate is", shows part of it).
 
   scripts/memory_figures.py --jelly build/cli/jelly [--integrators rk4,xpbd] [--cases cube20]
 """

@@ -56,6 +56,9 @@ def footer(fig, meta):
     text = "jelly %s, %s build, %s, %s cores; %s" % (
         meta.get("jelly_version", "?"), meta.get("build_type", "?"), meta.get("cpu", "?"),
         meta.get("cores", "?"), meta.get("date_utc", "?"))
+    if "load_average_start" in meta:
+        text += "; load average %s at the start, %s at the end" % (
+            meta["load_average_start"], meta.get("load_average_end", "?"))
     fig.text(0.01, 0.005, text, fontsize=6, color="0.4")
 
 
@@ -155,7 +158,12 @@ def plot_speed(rows, meta, out):
 
 def plot_budget(rows, meta, out):
     """Cost of a 1/60 s frame against the error to the RK4 reference, and the stiffest stable ks."""
-    sizes = sorted({int(r["n"]) for r in rows})
+    def what(r):  # ("cube", n) or ("cloth", n); tables before the cloth have cubes only
+        return (r.get("scene", "cube"), int(r["n"]))
+
+    def name(w):
+        return "cube n = %d" % w[1] if w[0] == "cube" else "cloth %d x %d" % (w[1], w[1])
+    sizes = sorted({what(r) for r in rows}, key=lambda w: (w[0] != "cube", w[1]))
     setups = []
     for r in rows:  # in the table's order
         if r["setup"] not in setups:
@@ -165,9 +173,9 @@ def plot_budget(rows, meta, out):
     labelled = set()
     for i, setup in enumerate(setups):
         for j, n in enumerate(sizes):
-            sel = [r for r in rows if r["setup"] == setup and int(r["n"]) == n
+            sel = [r for r in rows if r["setup"] == setup and what(r) == n
                    and r["status"] in COMPLETED and finite(r["frame_seconds_mean"])
-                   and finite(r["error_max"])]
+                   and finite(r["error_max"]) and r["error_max"] > 0]  # 0: the reference
             for r in sel:
                 axes[0].loglog(r["frame_seconds_mean"] * 1e3, max(r["error_max"], 1e-9),
                                markers[j % len(markers)], color="C%d" % (i % 10),
@@ -179,17 +187,18 @@ def plot_budget(rows, meta, out):
     axes[0].set_xlabel("wall time of a 1/60 s frame (ms, mean over the run; indicative: shared CPU)")
     axes[0].set_ylabel("largest RMS particle distance to RK4 (m)")
     axes[0].set_title("cost and error; markers: " + ", ".join(
-        "%s n = %d" % (markers[j % len(markers)], n) for j, n in enumerate(sizes)), fontsize=8)
+        "%s %s" % (markers[j % len(markers)], name(n)) for j, n in enumerate(sizes)), fontsize=8)
     # The stiffest ks of the ladder each setup keeps stable at its steps per frame.
-    width = 0.8 / max(len(sizes), 1)
-    for j, n in enumerate(sizes):
+    cubes = [w for w in sizes if w[0] == "cube"]  # the cloth searches no ks ladder
+    width = 0.8 / max(len(cubes), 1)
+    for j, n in enumerate(cubes):
         ks = []
         for setup in setups:
-            sel = [r for r in rows if r["setup"] == setup and int(r["n"]) == n]
+            sel = [r for r in rows if r["setup"] == setup and what(r) == n]
             value = sel[0]["stiffest_ks"] if sel else float("nan")
             ks.append(value if finite(value) and value > 0 else float("nan"))
-        axes[1].bar([k + (j - (len(sizes) - 1) / 2) * width for k in range(len(setups))], ks,
-                    width=width, label="n = %d" % n)
+        axes[1].bar([k + (j - (len(cubes) - 1) / 2) * width for k in range(len(setups))], ks,
+                    width=width, label=name(n))
     axes[1].set_yscale("log")
     axes[1].set_xticks(range(len(setups)))
     axes[1].set_xticklabels(setups, rotation=45, ha="right", fontsize=7)
@@ -200,7 +209,8 @@ def plot_budget(rows, meta, out):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=6)
     fig.suptitle("which integrator for a 1/60 s frame: the seed cube falling onto the seed slope "
-                 "(coulomb contact)", fontsize=9)
+                 "(coulomb contact)" + (", the cloth over its sphere" if len(cubes) < len(sizes)
+                                        else ""), fontsize=9)
     footer(fig, meta)
     fig.tight_layout(rect=(0, 0.03, 1, 1))
     fig.savefig(out, dpi=80)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Issue 17's speed and memory goals measured in one go, over alternating rounds, with each goal's
 # figures (every round's, their range and median) and whether the median meets it
-# (docs/benchmarks.md, "Issue 17's speed goals: where they stand"). The figures in docs/ come from
+# (docs/benchmarking.md, "Speed goals in rounds"). The figures in docs/ come from
 # shared 2-core virtual machines whose speed changes from minute to minute; this script is how to
 # measure the same goals on another machine.
 #
@@ -20,8 +20,7 @@
 # --quick: small cubes and few steps, to check that the script runs (its figures are not the
 # goals'). Default: 3 rounds, output under out/scale_goals of the current directory (each run's
 # CSV or log, rounds.csv with every figure, summary.txt); a DIR that is not empty is refused
-# unless --overwrite (which removes the round folders, rounds.csv and summary.txt in it). Takes
-# about 50 s per round on the 2-core machine of docs/.
+# unless --overwrite (which removes the round folders, rounds.csv and summary.txt in it).
 #
 # Environment: JELLY_BENCH and JELLY, the programs (default: build/bench/jelly-bench and
 # build/cli/jelly of this checkout). Run it with nothing else running. Exit codes: 0 (whether
@@ -147,7 +146,7 @@ for r in $(seq "$rounds"); do
       --out "$dir/implicit_$n"
     record "$r" "implicit_speedup_n$n" "$(speedup "$dir/implicit_$n/speed.csv")"
   done
-  # The implicit scene of docs/benchmarks.md: the cube lowered onto the slope.
+  # The implicit goal's scene: the cube lowered onto the slope.
   slope=("$scene" --integrator implicit_euler --dt "$frame" --set "cube.n=$large"
     --set "terrains[0].contact.model=coulomb" --set "cube.origin=[-2.2222222,0.7,-2.2222222]"
     --threads 2 -q)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A jelly-bench sweep as a Slurm job array: one shard per array task, then the merge
-# (docs/benchmarks.md, "Sweeps on a Slurm cluster").
+# (docs/benchmarking.md, "Sweeps on a Slurm cluster").
 #
 #   scripts/slurm_bench.sh submit N OUT COMMAND [ARGS...]
 #       submits an array of N tasks (task i runs `jelly-bench COMMAND ARGS --shard i/N

@@ -16,7 +16,7 @@ struct DivergenceGuard {
   Real max_distance = 1e4;  // m
   // Cap on the total energy (kinetic + elastic + gravitational, J); infinite = not checked.
   // jelly-bench sets it to the initial energy plus the work terrains can do plus a tolerance
-  // (docs/benchmarks.md); checking it costs one pass over the springs per step.
+  // (docs/benchmarking.md); checking it costs one pass over the springs per step.
   Real max_energy = std::numeric_limits<Real>::infinity();
 
   void validate() const;

@@ -2,9 +2,9 @@
 // What the band loops of the force loop (core/detail/spring_bands.hpp) and of the matrix-free
 // system (core/detail/band_system.hpp) share: the attribute that gives a loop one copy per
 // instruction set, chosen when the library is loaded (GCC's function multi-versioning: AVX2
-// where the CPU has it, the x86-64 baseline SSE2 elsewhere; AVX-512 is not among them:
-// docs/benchmarks.md, "The force loop"), and the loops that add a band's per-slot terms to the
-// particles at the slots' first or second ends.
+// where the CPU has it, the x86-64 baseline SSE2 elsewhere; AVX-512 is not among them: it
+// measured no faster, `git show 38c2702:docs/benchmarks.md`, "The force loop"), and the loops
+// that add a band's per-slot terms to the particles at the slots' first or second ends.
 #include <jelly/core/types.hpp>
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)

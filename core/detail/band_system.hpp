@@ -6,7 +6,7 @@
 // products A p = M p + sum over springs of +-B (p_a - p_b) computed band by band like the
 // force loop (vectorised, threaded by particle ranges: the same bits for any thread count).
 // 16 bytes per spring (8 in single precision) instead of about 220 for the full compressed-column
-// matrix (docs/implicit.md, "Matrix-free CG"; docs/benchmarks.md has the products' times).
+// matrix (docs/implicit.md, "Matrix-free CG").
 #include <vector>
 
 #include <jelly/core/definiteness.hpp>

@@ -4,7 +4,7 @@
 // stored densely over a range of first particles, with positions, velocities and forces
 // transposed to one array per coordinate. Within a band the loop reads particles a and a + offset
 // from contiguous memory, so the compiler vectorises sqrt, division and all (AVX2 where the CPU
-// has it, chosen at run time); docs/benchmarks.md ("The force loop") has its measurements.
+// has it, chosen at run time); docs/performance.md has its measurements.
 // Slots of a band that are not springs have zero coefficients.
 //
 // Same forces as compute_forces up to rounding (another summation order). A model whose springs

@@ -144,4 +144,40 @@ TEST_F(BenchCli, CoresAreTheProcessAffinity) {
                              std::to_string(std::thread::hardware_concurrency()) + "\n"));
 }
 
+// budget --cloth: the cloth of scenes/cloth_on_sphere.json is measured after the cubes, a row
+// per setup marked scene "cloth" with its n x n particles and no ks ladder; the CSV records the
+// load average at the start and the end. A bad size or scene folder is bad input.
+TEST_F(BenchCli, BudgetMeasuresTheClothAfterTheCubes) {
+  const fs::path out = dir_ / "cloth";
+  const Result r =
+      bench("budget --quick --cloth 6 --setups rk4,implicit_euler --out '" + out.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = read_file(out / "budget.csv");
+  EXPECT_THAT(csv, HasSubstr("\n# load_average_start: "));
+  EXPECT_THAT(csv, HasSubstr("\n# load_average_end: "));
+  EXPECT_THAT(csv, HasSubstr("\nitem,scene,n,particles,springs,setup,"));
+  // Items 0 and 1: the n = 4 cube; 2 and 3: the 6 x 6 cloth (36 particles), both completed.
+  EXPECT_THAT(csv, HasSubstr("\n0,cube,4,64,"));
+  EXPECT_THAT(csv, HasSubstr("\n2,cloth,6,36,"));
+  EXPECT_THAT(csv, HasSubstr("\n3,cloth,6,36,"));
+  std::istringstream lines(csv);
+  std::string line;
+  int cloth_rows = 0;
+  while (std::getline(lines, line)) {
+    if (line.find(",cloth,") == std::string::npos) continue;
+    ++cloth_rows;
+    EXPECT_THAT(line, HasSubstr(",completed,")) << line;
+    EXPECT_THAT(line, HasSubstr(",nan,")) << "no ks ladder for the cloth: " << line;
+  }
+  EXPECT_EQ(cloth_rows, 2);
+
+  for (const std::string args :
+       {"budget --quick --cloth 1", "budget --quick --cloth 6 --scenes-dir /nonexistent"}) {
+    const Result bad = bench(args + " --out '" + (dir_ / "bad").string() + "'");
+    EXPECT_EQ(bad.code, 2) << args << ": " << bad.err;
+    EXPECT_THAT(bad.err, StartsWith("error: ")) << args;
+  }
+  EXPECT_THAT(bench("budget --quick --cloth 1").err, HasSubstr("--cloth"));
+}
+
 }  // namespace

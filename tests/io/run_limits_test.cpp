@@ -78,8 +78,8 @@ TEST(MemoryEstimate, GrowsWithTheCubeAndTheImplicitSolver) {
     return estimate_memory_bytes(cube_particle_count(n), cube_spring_count(n), integrator,
                                  recording);
   };
-  // The measured peaks of `jelly run` at n = 40 (scripts/memory_figures.py; docs/benchmarks.md,
-  // "Memory estimates"), each estimate within 2x of its peak.
+  // The measured peaks of `jelly run` at n = 40 (scripts/memory_figures.py; docs/scenes.md,
+  // "How close the memory estimate is"), each estimate within 2x of its peak.
   const auto within_2x = [](double estimate, double measured) {
     return estimate > measured / 2 && estimate < measured * 2;
   };

@@ -90,7 +90,7 @@ TEST_P(MeshEveryIntegrator, BounceOnAMovingMeshBoxKeepsTheRestitutionLaw) {
 // A jelly dropped into a bowl (inner radius 1 m) slides to its bottom and rests there: it never
 // sinks more than 1 mm into the mesh, and in the end neither moves nor jitters. (For two explicit
 // integrators at 1 ms and, below, implicit_euler at a game's step: a mesh query costs
-// microseconds, docs/benchmarks.md.)
+// microseconds, docs/contact.md "What contact costs".)
 class MeshBowl : public ::testing::TestWithParam<std::string> {};
 INSTANTIATE_TEST_SUITE_P(Explicit, MeshBowl, ::testing::Values("symplectic_euler", "rk4"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
