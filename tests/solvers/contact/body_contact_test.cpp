@@ -6,11 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <random>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include <jelly/core/errors.hpp>
@@ -106,7 +104,7 @@ Model two_cubes(Real gap, int n = 4, Real edge = 0.3) {
 // momentum too without friction (friction's torque between particle centres is the one change),
 // no energy gained.
 TEST(BodyContact, ResponseConservesMomentum) {
-  const Model model = two_cubes(-0.04);  // overlapping by 4 cm
+  const Model model = two_cubes(-0.01);  // overlapping by 1 cm
   std::mt19937 rng(3);
   std::uniform_real_distribution<Real> u(-1, 1);
   State before = rest_state(model);
@@ -130,9 +128,8 @@ TEST(BodyContact, ResponseConservesMomentum) {
     if (mu == 0) {
       EXPECT_LT((l1 - l0).norm(), 1e-12 * scale) << mu;
     }
-    // No energy gained, and the overlap shrinks: the particles' projection would crush the
-    // springs behind 4 cm of interpenetration by more energy than the collision had, so the
-    // response takes as much of it as the energy allows (the next steps take the rest).
+    // No energy gained, and the overlap is gone (as much of it by the particles' projection as
+    // the energy allows, the rest by translations of the bodies).
     EXPECT_LE(total_energy(model, s), total_energy(model, before) * (1 + 1e-12)) << mu;
     const auto deepest = [&](const VecX& x) {
       Real worst = 0;
@@ -140,7 +137,7 @@ TEST(BodyContact, ResponseConservesMomentum) {
         worst = std::min(worst, (particle(x, j) - particle(x, i)).norm() - 0.1);
       return worst;
     };
-    EXPECT_GT(deepest(s.x), 0.5 * deepest(before.x)) << mu;
+    EXPECT_GT(deepest(s.x), -0.01 * 0.1) << mu;  // to the iterations' accuracy
   }
 }
 
@@ -237,121 +234,73 @@ Simulator head_on(const std::string& integrator, Real dt, Real restitution, int 
   return sim;
 }
 
-// The integrators whose body contact is the after-step response, stable at a game's steps.
+// The integrators whose body contact is the after-step response and which are stable at a
+// game's steps (the explicit ones diverge there on these cubes).
 std::vector<std::string> after_step_integrators() {
-  return {"implicit_euler", "projective_dynamics", "vbd", "xpbd"};
-}
-
-// The largest total energy over a run of the head-on collision, relative to the start, and how
-// many steps had contact pairs.
-std::pair<Real, long> head_on_energy(const std::string& integrator, Real dt, Real restitution,
-                                     Real end) {
-  Simulator sim = head_on(integrator, dt, restitution);
-  const Real e0 = total_energy(sim.model(), sim.state());
-  Real worst = 0;
-  long touching = 0;
-  while (sim.state().t < end - 0.5 * dt) {
-    EXPECT_TRUE(sim.step().ok);
-    worst = std::max(worst, total_energy(sim.model(), sim.state()) / e0);
-    touching += sim.body_contact().pairs().empty() ? 0 : 1;
-  }
-  return {worst, touching};
+  return {"arkode_dirk", "arkode_erk", "implicit_euler", "projective_dynamics", "vbd", "xpbd"};
 }
 
 // The after-step response never adds energy to a frictionless, inelastic collision at a game's
-// steps (sequential impulses with a plain projection reached 1.16-1.19 E0 at 1/60 s: the
-// projection compressed the springs behind the contact while the particles behind kept their
-// speed).
+// steps: the total energy never rises above its start (the pairs taken one after another with
+// the particles' projection reached 1.16-1.19 E0 at 1/60 s: docs/contact.md).
 TEST(BodyContact, AfterStepHeadOnCollisionNeverGainsEnergy) {
   for (const std::string& integrator : after_step_integrators())
     for (const Real dt : {1.0 / 60, 1.0 / 30}) {
-      const auto [worst, touching] = head_on_energy(integrator, dt, 0, 1.0);
-      std::printf("%s dt %.4f: max E/E0 = %.6f, %ld contact steps\n", integrator.c_str(), dt, worst,
-                  touching);
-      EXPECT_GT(touching, 0) << integrator << " " << dt;
-      EXPECT_LE(worst, 1 + 1e-9) << integrator << " " << dt;
-    }
-}
-
-TEST(BodyContact, MeasureVbdMirror) {
-  for (const std::string& integrator : {"vbd", "xpbd", "implicit_euler"}) {
-    const CubeSpec a = testing::small_cube(4, 0.3, Vec3(-0.15, 0, 0));
-    const Model model = build_cube(a);
-    State s = rest_state(model);
-    for (int i = 0; i < model.num_particles(); ++i) particle(s.v, i) = Vec3(4 * s.x[3 * i], 0, 0);
-    Simulator sim = make_sim(model, s, integrator, 1.0 / 60);
-    Real asymmetry = 0;
-    while (sim.state().t < 0.5) {
-      ASSERT_TRUE(sim.step().ok);
-      for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-          for (int k = 0; k < 4; ++k) {
-            const Vec3 xl = particle(sim.state().x, (i * 4 + j) * 4 + k);
-            const Vec3 xr = particle(sim.state().x, ((3 - i) * 4 + j) * 4 + k);
-            asymmetry = std::max({asymmetry, std::abs(xl.x() + xr.x()), std::abs(xl.y() - xr.y()),
-                                  std::abs(xl.z() - xr.z())});
-          }
-    }
-    std::printf("MEASURE mirror without contact %s: %.3g\n", integrator.c_str(), asymmetry);
-  }
-}
-
-TEST(BodyContact, MeasureEveryIntegrator) {
-  for (const std::string& integrator : integrator_names()) {
-    if (integrator == "implicit_euler_adaptive") continue;
-    for (const Real dt : {1.0 / 60, 1.0 / 30}) {
+      SCOPED_TRACE(integrator + " at dt = " + std::to_string(dt));
       Simulator sim = head_on(integrator, dt, 0);
       const Real e0 = total_energy(sim.model(), sim.state());
       Real worst = 0;
-      bool ok = true;
-      while (ok && sim.state().t < 1.0) {
-        ok = sim.step().ok;
+      long touching = 0;
+      while (sim.state().t < 1.0 - 0.5 * dt) {
+        ASSERT_TRUE(sim.step().ok);
         worst = std::max(worst, total_energy(sim.model(), sim.state()) / e0);
+        touching += sim.body_contact().pairs().empty() ? 0 : 1;
       }
-      std::printf("MEASURE %s dt %.4f: ok %d max E/E0 = %.9f\n", integrator.c_str(), dt, ok, worst);
+      EXPECT_GT(touching, 0);
+      EXPECT_LE(worst, 1 + 1e-9);
     }
-    for (const Real kd : {50.0, 0.0}) {
-      Simulator sim = head_on(integrator, 1e-3, 1, 1, kd);
-      const Real e0 = total_energy(sim.model(), sim.state());
-      Real worst = 0, lowest = 1e9;
-      bool ok = true;
-      while (ok && sim.state().t < 0.3) {
-        ok = sim.step().ok;
-        const Real e = total_energy(sim.model(), sim.state()) / e0;
-        worst = std::max(worst, e);
-        lowest = std::min(lowest, e);
-      }
-      std::printf("MEASURE %s e=1 kd %g: ok %d E/E0 in [%.6f, %.6f] end %.6f\n", integrator.c_str(),
-                  kd, ok, lowest, worst, total_energy(sim.model(), sim.state()) / e0);
-    }
-  }
 }
 
-// With restitution 1 the collision keeps its energy (to 1 %) at 1 ms.
+// With restitution 1 and no dampers, at 1 ms: the integrators that keep energy (rk4, ARKODE's
+// explicit and implicit Runge-Kutta) keep the collision's energy to 1 %; the others lose what
+// their own damping takes, and none ever gains more than round-off.
 TEST(BodyContact, AfterStepElasticCollisionKeepsItsEnergy) {
-  for (const std::string& integrator : after_step_integrators()) {
-    Simulator sim = head_on(integrator, 1e-3, 1);
+  for (const std::string& integrator : {"arkode_dirk", "arkode_erk", "implicit_euler",
+                                        "projective_dynamics", "rk4", "vbd", "xpbd"}) {
+    SCOPED_TRACE(integrator);
+    Simulator sim = head_on(integrator, 1e-3, 1, 1, 0);
     const Real e0 = total_energy(sim.model(), sim.state());
     Real worst = 0, lowest = 1e9;
+    long touching = 0;
     while (sim.state().t < 0.3) {
       ASSERT_TRUE(sim.step().ok);
       const Real e = total_energy(sim.model(), sim.state()) / e0;
       worst = std::max(worst, e);
       lowest = std::min(lowest, e);
+      touching += sim.body_contact().pairs().empty() ? 0 : 1;
     }
-    std::printf("%s restitution 1: E/E0 in [%.6f, %.6f]\n", integrator.c_str(), lowest, worst);
-    EXPECT_LE(worst, 1.01) << integrator;
+    EXPECT_GT(touching, 0);
+    EXPECT_LE(worst, 1 + 1e-9);
+    const std::string name = integrator;
+    if (name == "rk4" || name.rfind("arkode", 0) == 0) {
+      EXPECT_GT(lowest, 0.99);
+    }
   }
 }
 
-// The mirrored collision stays mirror-symmetric at 1/60 s (pairs taken one after another broke
-// it from the third contact step on).
+// The mirrored collision stays mirror-symmetric, positions and velocities to 1e-12, at 1/60 s
+// (pairs taken one after another broke it from the third contact step on). Not vbd: its sweeps
+// colour by colour are not mirror-symmetric themselves (a cube stretched symmetrically, without
+// contact, loses its symmetry by millimetres).
 TEST(BodyContact, AfterStepMirroredCollisionStaysSymmetric) {
-  for (const std::string& integrator : after_step_integrators()) {
+  for (const std::string& integrator : {"implicit_euler", "projective_dynamics", "xpbd"}) {
+    SCOPED_TRACE(integrator);
     Simulator sim = head_on(integrator, 1.0 / 60, 0);
     Real asymmetry = 0;
+    long touching = 0;
     while (sim.state().t < 0.5) {
       ASSERT_TRUE(sim.step().ok);
+      touching += sim.body_contact().pairs().empty() ? 0 : 1;
       for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j)
           for (int k = 0; k < 4; ++k) {
@@ -363,8 +312,8 @@ TEST(BodyContact, AfterStepMirroredCollisionStaysSymmetric) {
                                   std::abs(vl.y() - vr.y()), std::abs(vl.z() - vr.z())});
           }
     }
-    std::printf("%s: asymmetry %.3g\n", integrator.c_str(), asymmetry);
-    EXPECT_LT(asymmetry, 1e-12) << integrator;
+    EXPECT_GT(touching, 0);
+    EXPECT_LT(asymmetry, 1e-12);
   }
 }
 
