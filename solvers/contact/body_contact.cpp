@@ -421,7 +421,10 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
       start_.x = state.x;
       start_.v = state.v;
       // The energy at the start of the step bounds the energy after the contact: the
-      // particles' projection as far as it keeps within it.
+      // particles' projection as far as it keeps within it. If even the translations exceed it
+      // (the step itself gained energy: work of pins or external forces, an integrator that
+      // does not dissipate; or gravity's work on lifted bodies), the translations are taken:
+      // the overlap is still removed, with the least elastic work.
       const Real budget = total_energy(model, before);
       const Real scale = std::max(std::abs(budget), kinetic_energy(model, before.v));
       const auto fits = [&](Real share) {
