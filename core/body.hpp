@@ -40,6 +40,9 @@ struct BodyPart {
   Real spacing = 0;  // typical distance between neighbouring particles (m)
   std::vector<ParticleGroup> groups;
   VolumeElements volume;  // local particle indices
+  // A sheet without volume (cloth): its particles keep their contact radius from terrains and
+  // obstacles by default (Body::thickness), so the surface they span stays outside them.
+  bool sheet = false;
 
   int num_particles() const { return static_cast<int>(mass.size()); }
 };
@@ -51,6 +54,9 @@ struct Body {
   int first_spring = 0, num_springs = 0;
   Real spacing = 0;  // typical distance between neighbouring particles (m)
   Real radius = 0;   // contact radius of its particles (m)
+  // The distance its particles keep from terrains and obstacles (m), in every contact model and
+  // integrator: a sheet's contact radius by default, 0 for a body with volume.
+  Real thickness = 0;
   // The body's motion at the start (initial_state): every particle moves with
   // velocity + angular_velocity x (x - c), c the body's centre of mass at rest.
   Vec3 velocity = Vec3::Zero();          // m/s

@@ -25,6 +25,7 @@ int Model::add_body(const std::string& name, BodyPart part, Real radius) {
   body.num_springs = part.springs.size();
   body.spacing = part.spacing;
   body.radius = radius > 0 ? radius : 0.5 * part.spacing;
+  body.thickness = part.sheet ? body.radius : 0;
   body.surface = std::move(part.surface);
   body.surface.shift_particles(first);
   body.groups = std::move(part.groups);

@@ -29,7 +29,8 @@ struct Model {
   int num_bodies() const { return static_cast<int>(bodies.size()); }
 
   // Appends a body built by a builder: its particles and springs after the existing ones.
-  // `radius` <= 0 takes half the part's spacing. Returns the body's index. Throws InputError
+  // `radius` <= 0 takes half the part's spacing; the body's thickness is its radius for a sheet
+  // (BodyPart::sheet), else 0. Returns the body's index. Throws InputError
   // for a duplicate or empty name or an inconsistent part.
   int add_body(const std::string& name, BodyPart part, Real radius = 0);
   // The body named `name`, or nullptr.

@@ -119,6 +119,11 @@ void BodySpec::validate(const std::string& prefix) const {
   material.validate(prefix);
   require(std::isfinite(radius) && radius >= 0, prefix + "radius", radius,
           "a finite radius >= 0 m (0 = half the lattice spacing)");
+  if (thickness) {
+    require(std::isfinite(*thickness) && *thickness >= 0, prefix + "thickness", *thickness,
+            "a finite distance >= 0 m (the default: the contact radius for a cloth, 0 for a body "
+            "with volume)");
+  }
   require(velocity.allFinite(), prefix + "velocity", velocity.transpose(),
           "finite components (m/s)");
   require(angular_velocity.allFinite(), prefix + "angular_velocity", angular_velocity.transpose(),
@@ -141,6 +146,7 @@ BodySpec BodySpec::read(JsonFields& f) {
   b.material.particle_mass = f.number_or("particle_mass", b.material.particle_mass);
   b.material.density = f.number_or("density", b.material.density);
   b.radius = f.number_or("radius", b.radius);
+  if (f.value("thickness")) b.thickness = f.number("thickness");
   b.velocity = f.vec3_or("velocity", b.velocity);
   b.angular_velocity = f.vec3_or("angular_velocity", b.angular_velocity);
   if (const Json* color = f.value("color")) b.color = json_vec3(*color, f.path("color"));
@@ -196,6 +202,7 @@ Json BodySpec::to_json() const {
   j["particle_mass"] = material.particle_mass;
   j["density"] = material.density;
   j["radius"] = radius;
+  if (thickness) j["thickness"] = *thickness;
   if (!velocity.isZero()) j["velocity"] = json_of(velocity);
   if (!angular_velocity.isZero()) j["angular_velocity"] = json_of(angular_velocity);
   if (color) j["color"] = json_of(*color);
@@ -277,6 +284,7 @@ void add_body(Model& model, const BodySpec& spec, const std::string& prefix) {
   model.bodies[index].velocity = spec.velocity;
   model.bodies[index].angular_velocity = spec.angular_velocity;
   model.bodies[index].color = spec.color;
+  if (spec.thickness) model.bodies[index].thickness = *spec.thickness;
   const Body& body = model.bodies[index];
   // The body's particles are new: no pin holds them yet. Each may be in one of its pins only
   // (two would give it two paths).

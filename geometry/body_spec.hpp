@@ -51,6 +51,9 @@ struct BodySpec {
   PolymorphicValue<BodyShape> shape;  // the kind's own parameters
   Material material;
   Real radius = 0;  // contact radius of its particles (m); 0 = half the lattice spacing
+  // The distance its particles keep from terrains and obstacles (m); none = the contact radius
+  // for a cloth, 0 for a body with volume.
+  std::optional<Real> thickness;
   Vec3 velocity = Vec3::Zero();          // m/s at the start, every particle
   Vec3 angular_velocity = Vec3::Zero();  // rad/s at the start, about the centre of mass
   std::vector<PinSpec> pins;
@@ -61,7 +64,7 @@ struct BodySpec {
   // Throws InputError naming `prefix`field ("bodies[0].").
   void validate(const std::string& prefix) const;
   // A scene's body object: kind, name, the kind's keys, springs, particle_mass, density, radius,
-  // pins, forces, color.
+  // thickness, pins, forces, color.
   static BodySpec read(JsonFields& fields);
   Json to_json() const;
 };

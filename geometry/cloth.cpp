@@ -24,6 +24,7 @@ BodyPart ClothShape::build(const Material& material, const std::string& prefix) 
   const auto index = [&](int i, int j) { return i * nv + j; };
   BodyPart part;
   part.kind = "cloth";
+  part.sheet = true;
   part.spacing = std::min(du, dv);
   part.mass.resize(nu * nv);
   part.position.resize(3 * nu * nv);

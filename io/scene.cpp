@@ -61,10 +61,12 @@ void Scene::set_cube(const CubeSpec& cube, int index) {
           "the index of a body of the scene");
   const std::string name = bodies[index].name;
   const Real radius = bodies[index].radius;
+  const std::optional<Real> thickness = bodies[index].thickness;
   std::vector<PinSpec> pins = std::move(bodies[index].pins);
   std::vector<ExternalForceSpec> forces = std::move(bodies[index].forces);
   bodies[index] = cube_body(cube, name);
   bodies[index].radius = radius;
+  bodies[index].thickness = thickness;
   bodies[index].pins = std::move(pins);
   bodies[index].forces = std::move(forces);
   gravity = cube.gravity;

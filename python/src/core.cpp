@@ -176,7 +176,7 @@ py::tuple model_state(const Model& md) {
     for (const ParticleGroup& g : b.groups) groups.append(py::make_tuple(g.name, g.particles));
     bodies.append(py::make_tuple(b.name, b.kind, b.first_particle, b.num_particles, b.first_spring,
                                  b.num_springs, b.spacing, b.radius, b.velocity, b.angular_velocity,
-                                 surface_state(b.surface), groups, b.color));
+                                 surface_state(b.surface), groups, b.color, b.thickness));
   }
   std::vector<std::string> paths;
   for (const Path& p : md.pins.paths) paths.push_back(p.to_json().dump());
@@ -227,6 +227,11 @@ Model model_from_state(const py::tuple& t) {
       body.groups.push_back({group[0].cast<std::string>(), group[1].cast<std::vector<int>>()});
     }
     body.color = b[12].cast<std::optional<Vec3>>();
+    // (A Model pickled before bodies had a thickness: the default of its kind.)
+    if (b.size() > 13)
+      body.thickness = b[13].cast<Real>();
+    else
+      body.thickness = body.kind == "cloth" ? body.radius : 0;
     md.bodies.push_back(std::move(body));
   }
   const auto pins = t[5].cast<py::tuple>();
@@ -405,6 +410,10 @@ void bind_core(py::module_& m) {
       .def_readonly("spacing", &Body::spacing,
                     "Typical distance between neighbouring particles (m).")
       .def_readonly("radius", &Body::radius, "Contact radius of its particles (m).")
+      .def_readonly("thickness", &Body::thickness,
+                    "The distance its particles keep from terrains and obstacles (m): the scene "
+                    "key thickness; by default the contact radius for a cloth, 0 for a body "
+                    "with volume.")
       .def_property_readonly(
           "particles",
           [](const Body& b) {

@@ -3,14 +3,26 @@
 // Particles are spheres of their body's contact radius. After every step (for every integrator,
 // after the terrains' contact) a broad phase (a spatial hash, linear in the number of particles)
 // finds the pairs closer than the sum of their radii: pairs of different bodies, and with
-// self-contact pairs of one body that no spring joins. Each such pair is resolved with
-// equal and opposite impulses: the overlap is projected out along the line of centres (weighted
-// by inverse mass), the approach along it is absorbed or, above a resting speed, reflected with
-// restitution, and Coulomb friction bounded by mu times the normal impulse slows the sliding.
-// Pinned particles count as infinitely heavy. Linear momentum is conserved exactly; angular
-// momentum is conserved exactly by the normal response and the projection (the projection's
-// lever is compensated), and changed by friction only (by the torque of a tangential impulse
-// between two particle centres, which the particles cannot take up as spin).
+// self-contact pairs of one body that no spring joins. The pairs are resolved with equal and
+// opposite impulses, all pairs of a pass from one state (Jacobi: no pair sees another's result
+// within a pass, so mirrored inputs give mirrored results and the order of the pairs does not
+// matter), each particle's mass shared among its pairs (mass splitting):
+//  1. velocity passes: the approach along the line of centres is absorbed or, above a resting
+//     speed, reflected with at most the given restitution, and Coulomb friction bounded by mu
+//     times the normal impulse slows the sliding. Split, each pass is a set of separate
+//     two-particle collisions followed by inelastic merges: it never adds kinetic energy;
+//  2. projection passes: the overlap is taken out along the line of centres (weighted by
+//     inverse mass). Moving a particle into its own body compresses the springs behind it
+//     while the particles there keep their speed, which adds energy the collision never had
+//     (docs/contact.md). So the projection is also computed as translations of whole bodies
+//     (no spring changes length), and the state takes the particles' projection as far as the
+//     total energy stays at or below the energy at the start of the step (bisection on a blend
+//     of the two): an integrator that loses energy keeps losing it through the contact.
+// Pinned particles count as infinitely heavy (and a body with pins is not translated). Linear
+// momentum is conserved exactly; angular momentum is conserved exactly by the normal response
+// and the projection (the projection's lever is taken back by the smallest tangential pair
+// impulses), and changed by friction only (by the torque of a tangential impulse between two
+// particle centres, which the particles cannot take up as spin).
 #include <string>
 #include <vector>
 
@@ -40,7 +52,8 @@ struct BodyContactParams {
 class BodyContact {
  public:
   struct Stats {
-    long pairs = 0;             // contact pairs resolved, summed over the steps
+    long pairs = 0;    // contact pairs resolved, summed over the steps
+    long limited = 0;  // steps whose projection was limited to keep the energy (translations)
     double broad_seconds = 0;   // time in the broad phase
     double narrow_seconds = 0;  // time filtering and resolving the pairs
     long steps = 0;
@@ -84,6 +97,14 @@ class BodyContact {
   // Keeps the broad phase's pairs that may touch: other bodies, or (self-contact) no spring.
   void filter(const Model& model);
   bool joined(int i, int j) const;
+  // resolve()'s passes: the velocity passes (returns whether a pair approached), and the
+  // projection of the overlaps at state.x into particle moves (moved_) and into body
+  // translations plus the self-contact pairs' particle moves (shifted_).
+  bool velocity_passes(const State& before, State& state, Real h);
+  void projection_passes(const Model& model, const VecX& x);
+  // The state for the blend `share` (1: the particles' projection, 0: the translations) from
+  // x, v: positions x + blend, velocities v with the projection's lever taken back.
+  void blend(const Model& model, Real share, const VecX& x, const VecX& v, State& out);
 
   BodyContactParams params_;
   BroadPhase broad_;
@@ -94,6 +115,15 @@ class BodyContact {
   std::vector<int> neighbour_start_, neighbours_;  // CSR, sorted
   std::vector<BroadPhase::Pair> candidates_, contacts_;
   Stats stats_;
+  // resolve()'s work arrays (sized once per model).
+  std::vector<int> share_;               // [N] pairs of a particle in this pass
+  std::vector<Vec3> impulse_, back_;     // [pairs]
+  std::vector<char> touching_;           // [pairs]
+  VecX moved_, shifted_;                 // [3N]
+  std::vector<Vec3> body_shift_;         // [bodies]
+  std::vector<Real> body_inverse_mass_;  // [bodies] 0 with a pin
+  std::vector<int> body_share_;          // [bodies]
+  State start_;                          // after the velocity passes
 };
 
 }  // namespace jelly

@@ -1,5 +1,6 @@
 // The coulomb contact model: projection out of the surface, then an impulse on the relative
 // velocity; implicit_euler's solve and the position-based integrators hold it as constraints.
+#include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 
 namespace jelly {
@@ -14,10 +15,12 @@ class CoulombModel final : public TerrainContactModel {
   int resolve_after_step(const AfterStepContact& step, int begin, int end,
                          std::vector<CarriedContact>& /*carried*/) const override {
     int count = 0;
-    for (int i = begin; i < end; ++i)
-      count +=
-          resolve(step.terrain, step.params, step.state.t, step.h, particle(step.before.x, i),
-                  particle(step.before.v, i), particle(step.state.x, i), particle(step.state.v, i));
+    thickness::for_ranges(step.model, begin, end, [&](int first, int last, Real gap) {
+      for (int i = first; i < last; ++i)
+        count += resolve(step.terrain, step.params, step.state.t, step.h, gap,
+                         particle(step.before.x, i), particle(step.before.v, i),
+                         particle(step.state.x, i), particle(step.state.v, i));
+    });
     return count;
   }
 
@@ -29,10 +32,11 @@ class CoulombModel final : public TerrainContactModel {
   // step, so the tangential displacement it removes is taken back too: a sticking particle keeps
   // its tangential position relative to the surface (x_before + u h), a sliding one loses
   // h dv_t. Without that, the velocity-level friction leaves a creep of h a_t / 2 per unit time.
-  static bool resolve(const Terrain& terrain, const ContactParams& c, Real t, Real h,
+  // The particle keeps `gap` (its body's thickness) from the surface.
+  static bool resolve(const Terrain& terrain, const ContactParams& c, Real t, Real h, Real gap,
                       const Vec3& x_before, const Vec3& v_before, Eigen::Ref<Vec3> x,
                       Eigen::Ref<Vec3> v) {
-    const Real d = terrain.signed_distance(x, t);
+    const Real d = terrain.signed_distance(x, t) - gap;
     if (d >= 0 || !terrain.can_contact(x, t)) return false;
     const Vec3 n = terrain.normal(x, t);
     const Vec3 u = terrain.surface_velocity(x, t);

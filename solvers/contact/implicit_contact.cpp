@@ -8,6 +8,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>
+#include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 
 namespace jelly {
@@ -92,14 +93,14 @@ void ImplicitContact::subtract_sliding_friction(const Contact& c, VecX& rhs) con
   particle(rhs, c.particle) -= c.viscosity * tangential(v0 - c.surface_velocity, c.normal);
 }
 
-int ImplicitContact::penetrated_terrain(const Terrains& terrains, const Vec3& p,
+int ImplicitContact::penetrated_terrain(const Terrains& terrains, const Vec3& p, Real gap,
                                         Real tolerance) const {
   int best = -1;
   Real deepest = -tolerance;
   for (int k = 0; k < static_cast<int>(terrains.size()); ++k) {
     const Terrain& terrain = *terrains[k];
     if (!uses_coulomb(terrain) || !terrain.can_contact(p, t1_)) continue;
-    const Real d = terrain.signed_distance(p, t1_);
+    const Real d = terrain.signed_distance(p, t1_) - gap;
     if (d < deepest) {
       deepest = d;
       best = k;
@@ -123,7 +124,7 @@ ImplicitContact::Contact ImplicitContact::make_contact(const Terrains& terrains,
   c.terrain = k;
   c.normal = terrain.normal(x0, t1_);
   c.surface_velocity = terrain.surface_velocity(x0, t1_);
-  c.target_normal = -terrain.signed_distance(x0, t1_) / h_;
+  c.target_normal = -(terrain.signed_distance(x0, t1_) - gap_[i]) / h_;
   c.approach = -(particle(v0_, i) - c.surface_velocity).dot(c.normal);
   // Stick or slide as a lone particle would: the normal velocity change dv_n the contact needs
   // bounds the friction impulse (mu_s m dv_n for sticking, mu m dv_n sliding).
@@ -154,9 +155,10 @@ void ImplicitContact::find_penetrating(const Terrains& terrains, Position&& posi
       threads_, static_cast<long>(slot_.size()),
       [&](long begin, long end) {
         for (long i = begin; i < end; ++i) {
-          penetrating_[i] = slot_[i] >= 0 ? -1
-                                          : penetrated_terrain(
-                                                terrains, position(static_cast<int>(i)), tolerance);
+          penetrating_[i] =
+              slot_[i] >= 0
+                  ? -1
+                  : penetrated_terrain(terrains, position(static_cast<int>(i)), gap_[i], tolerance);
         }
       },
       parallel::kMinParticlesPerThread);
@@ -165,6 +167,7 @@ void ImplicitContact::find_penetrating(const Terrains& terrains, Position&& posi
 bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, const State& s0,
                                  const VecX& f, Real h, int threads) {
   threads_ = threads;
+  thickness::fill(model, gap_);
   const bool any = std::any_of(terrains.begin(), terrains.end(),
                                [](const auto& terrain) { return uses_coulomb(*terrain); });
   projected_ = 0;
@@ -218,7 +221,7 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
       const Contact& old = contacts_[slot_[i]];
       const Terrain& terrain = *terrains[old.terrain];
       if (uses_coulomb(terrain) && terrain.can_contact(predicted, t1_) &&
-          terrain.signed_distance(predicted, t1_) <= kTouchTolerance) {
+          terrain.signed_distance(predicted, t1_) - gap_[i] <= kTouchTolerance) {
         Contact c = make_contact(terrains, i, old.terrain, v1, model.mass[i]);
         c.mode = old.mode;
         c.viscosity = old.viscosity;
@@ -227,7 +230,8 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
       }
     }
     // A last contact that let go may still be predicted below its surface.
-    const int k = slot_[i] >= 0 ? penetrated_terrain(terrains, predicted, 0) : penetrating_[i];
+    const int k =
+        slot_[i] >= 0 ? penetrated_terrain(terrains, predicted, gap_[i], 0) : penetrating_[i];
     if (k >= 0) next_.push_back(make_contact(terrains, i, k, v1, model.mass[i]));
   }
   contacts_.swap(next_);
@@ -533,7 +537,7 @@ void ImplicitContact::finish(const Model& model, const Terrains& terrains, State
     const Terrain& terrain = *terrains[k];
     const Vec3 n = terrain.normal(x, t1_);
     const Vec3 u = terrain.surface_velocity(x, t1_);
-    x -= terrain.signed_distance(x, t1_) * n;
+    x -= (terrain.signed_distance(x, t1_) - gap_[i]) * n;
     auto v = particle(s1.v, i);
     const Real vn = (v - u).dot(n);
     if (vn < 0) v -= vn * n;

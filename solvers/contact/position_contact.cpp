@@ -5,6 +5,7 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>
+#include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 
 namespace jelly {
@@ -42,6 +43,7 @@ bool PositionContact::begin(const Model& model, const Terrains& terrains, const 
   }
   frozen_ = false;
   if (coulomb_.empty()) return false;
+  thickness::fill(model, gap_);
   t1_ = s0.t + h;
   h_ = h;
   x0_ = s0.x;
@@ -49,12 +51,12 @@ bool PositionContact::begin(const Model& model, const Terrains& terrains, const 
   return true;
 }
 
-int PositionContact::deepest(const Vec3& p, Real* distance) const {
+int PositionContact::deepest(const Vec3& p, Real gap, Real* distance) const {
   int best = -1;
   Real d_best = 0;
   for (int k : coulomb_) {
     const Terrain& terrain = *(*terrains_)[k];
-    const Real d = terrain.signed_distance(p, t1_);
+    const Real d = terrain.signed_distance(p, t1_) - gap;
     if (d < d_best && terrain.can_contact(p, t1_)) {
       d_best = d;
       best = k;
@@ -79,7 +81,7 @@ void PositionContact::activate(int i, int terrain, const Vec3& p) {
 Vec3 PositionContact::anchor(int i) const {
   const Slot& s = slot_[i];
   const Vec3 a = particle(x0_, i) + h_ * s.surface_velocity;
-  return a - (*terrains_)[s.terrain]->signed_distance(a, t1_) * s.normal;
+  return a - ((*terrains_)[s.terrain]->signed_distance(a, t1_) - gap_[i]) * s.normal;
 }
 
 void PositionContact::constrain_residual(const VecX& x, VecX& r) {
@@ -133,7 +135,7 @@ void PositionContact::project(VecX& x) {
     auto xi = particle(x, i);
     if (s.mode == Mode::kFree) {
       Real d;
-      const int k = deepest(xi, &d);
+      const int k = deepest(xi, gap_[i], &d);
       if (k < 0) continue;
       activate(i, k, xi);
     } else if (s.mode == Mode::kSlide && !frozen_) {
@@ -148,7 +150,7 @@ void PositionContact::project(VecX& x) {
     if (s.mode == Mode::kStick) {
       xi = anchor(i);
     } else {
-      xi -= terrain.signed_distance(xi, t1_) * s.normal;
+      xi -= (terrain.signed_distance(xi, t1_) - gap_[i]) * s.normal;
     }
   }
 }
@@ -158,7 +160,7 @@ void PositionContact::project_with_friction(VecX& x) {
   for (int i = 0; i < n; ++i) {
     auto xi = particle(x, i);
     Real d;
-    const int k = deepest(xi, &d);
+    const int k = deepest(xi, gap_[i], &d);
     if (k < 0) continue;
     Slot& s = slot_[i];
     if (s.mode == Mode::kFree) {

@@ -2,6 +2,7 @@
 // step a particle within epsilon and approaching has its normal velocity reflected; during the
 // next step its contact and friction forces act (carried contacts, ContactSolver::add_forces).
 #include <jelly/solvers/contact/detail/seed_rules.hpp>
+#include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 
 namespace jelly {
@@ -15,14 +16,16 @@ class SeedModel final : public TerrainContactModel {
   int resolve_after_step(const AfterStepContact& step, int begin, int end,
                          std::vector<CarriedContact>& carried) const override {
     int count = 0;
-    for (int i = begin; i < end; ++i) {
-      Vec3 n;
-      if (!seed_rules::reflect(step.terrain, step.params, step.model.mass[i], step.state.t,
-                               particle(step.state.x, i), particle(step.state.v, i), n))
-        continue;
-      ++count;
-      carried.push_back({i, n, step.params.friction});
-    }
+    thickness::for_ranges(step.model, begin, end, [&](int first, int last, Real gap) {
+      for (int i = first; i < last; ++i) {
+        Vec3 n;
+        if (!seed_rules::reflect(step.terrain, step.params, step.model.mass[i], step.state.t, gap,
+                                 particle(step.state.x, i), particle(step.state.v, i), n))
+          continue;
+        ++count;
+        carried.push_back({i, n, step.params.friction});
+      }
+    });
     return count;
   }
 };

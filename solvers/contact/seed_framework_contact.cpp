@@ -3,6 +3,7 @@
 // only: a reflection inside an implicit solve's right-hand side is not a function of the state
 // it iterates on).
 #include <jelly/solvers/contact/detail/seed_rules.hpp>
+#include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 
 namespace jelly {
@@ -19,11 +20,13 @@ class SeedFrameworkModel final : public TerrainContactModel {
   int resolve_after_step(const AfterStepContact& step, int begin, int end,
                          std::vector<CarriedContact>& /*carried*/) const override {
     int count = 0;
-    for (int i = begin; i < end; ++i) {
-      Vec3 n, u;
-      count += seed_rules::touches(step.terrain, step.params, step.state.t,
-                                   particle(step.state.x, i), particle(step.state.v, i), n, u);
-    }
+    thickness::for_ranges(step.model, begin, end, [&](int first, int last, Real gap) {
+      for (int i = first; i < last; ++i) {
+        Vec3 n, u;
+        count += seed_rules::touches(step.terrain, step.params, step.state.t, gap,
+                                     particle(step.state.x, i), particle(step.state.v, i), n, u);
+      }
+    });
     return count;
   }
 
@@ -33,17 +36,20 @@ class SeedFrameworkModel final : public TerrainContactModel {
   void apply_in_evaluation(const Model& model, const Terrain& terrain, Real t, const VecX& x,
                            VecX& v, VecX& f) const override {
     const ContactParams& c = terrain.contact();
-    for (int i = 0; i < model.num_particles(); ++i) {
-      auto vi = particle(v, i);
-      Vec3 n;
-      if (!seed_rules::reflect(terrain, c, model.mass[i], t, particle(x, i), vi, n)) continue;
-      auto fi = particle(f, i);
-      const Real fn = fi.dot(n);
-      if (fn >= 0) continue;
-      // The tangential velocity is the one before the reflection (which keeps it).
-      const Vec3 vt = vi - vi.dot(n) * n;
-      fi += -fn * n + c.friction * fn * vt;
-    }
+    thickness::for_ranges(model, 0, model.num_particles(), [&](int first, int last, Real gap) {
+      for (int i = first; i < last; ++i) {
+        auto vi = particle(v, i);
+        Vec3 n;
+        if (!seed_rules::reflect(terrain, c, model.mass[i], t, gap, particle(x, i), vi, n))
+          continue;
+        auto fi = particle(f, i);
+        const Real fn = fi.dot(n);
+        if (fn >= 0) continue;
+        // The tangential velocity is the one before the reflection (which keeps it).
+        const Vec3 vt = vi - vi.dot(n) * n;
+        fi += -fn * n + c.friction * fn * vt;
+      }
+    });
   }
 };
 

@@ -5,6 +5,7 @@
 
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 #include <jelly/terrain/terrain.hpp>
 
@@ -146,10 +147,11 @@ void Vbd::update_particle(const Model& model, const AnchorSprings* anchors, Real
       hess.diagonal().array() += spring.stiffness + spring.damping * inv_h;
     }
   }
-  // Penalty contact: E = k d^2 / 2 below a coulomb surface at t1 (d < 0), force -k d n.
+  // Penalty contact: E = k d^2 / 2 below a coulomb surface at t1 (d < 0; d less the particle's
+  // thickness), force -k d n.
   for (const Terrain* terrain : penalty_terrains_) {
     if (!terrain->can_contact(xi, t1)) continue;
-    const Real d = terrain->signed_distance(xi, t1);
+    const Real d = terrain->signed_distance(xi, t1) - gap_[i];
     if (d >= 0) continue;
     const Vec3 normal = terrain->normal(xi, t1);
     const Real k = options_.contact_hardness * inertia;
@@ -209,6 +211,7 @@ StepResult Vbd::do_step(const Dynamics& dynamics, State& s, Real h) {
       if (terrain_contact_model(*terrain).constrains_solves())
         penalty_terrains_.push_back(terrain.get());
   }
+  if (!penalty_terrains_.empty()) thickness::fill(model, gap_);
   const AnchorSprings* anchors = dynamics.anchors();
   if (anchors) {
     anchor_next_.assign(anchors->size(), -1);

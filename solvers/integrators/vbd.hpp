@@ -54,6 +54,7 @@ class Vbd final : public Integrator {
   std::vector<int> anchor_first_;                 // [N]: first anchor spring of a particle, or -1
   std::vector<int> anchor_next_;                  // [A]: the particle's next anchor spring, or -1
   std::vector<const Terrain*> penalty_terrains_;  // the coulomb terrains of this step
+  VecX gap_;  // [N]: each particle's thickness against them (contact/detail/thickness.hpp)
   VecX x0_, y_, previous_, before_previous_, f_;
   long sweeps_ = 0;
 };

@@ -80,6 +80,27 @@ def test_closed_surfaces_enclose_the_body_volume(spec, volume):
     assert enclosed_volume(vertices, triangles) == pytest.approx(volume, rel=1e-12)
 
 
+def test_thickness_defaults_to_the_cloths_radius_and_is_kept_from_terrains():
+    cloth = {"kind": "cloth", "name": "c", "nu": 5, "nv": 5, "size_u": 1, "size_v": 1,
+             "position": [0, 0.3, 0], "particle_mass": 0.01}
+    cube = {"kind": "cube", "name": "k", "n": 3, "edge_length": 0.5, "origin": [3, 0.1, 0]}
+    floor = {"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0],
+             "contact": {"model": "coulomb", "restitution": 0}}
+    sim = jelly.Simulator(scene_of([cloth, cube], [floor], integrator="implicit_euler",
+                                   dt=1 / 60))
+    c, k = sim.model.bodies
+    assert c.thickness == c.radius == pytest.approx(0.125)
+    assert k.thickness == 0
+    import pickle
+    assert pickle.loads(pickle.dumps(sim.model)).bodies[0].thickness == c.thickness
+    sim.run_until(1.0)
+    assert c.x(sim.state)[:, 1] == pytest.approx(c.thickness, abs=1e-6)
+    set_scene = scene_of([dict(cloth, thickness=0.02)])
+    assert jelly.Simulator(set_scene).model.bodies[0].thickness == 0.02
+    with pytest.raises(jelly.InputError, match=r"bodies\[0\]\.thickness = -1"):
+        jelly.Simulator(scene_of([dict(cloth, thickness=-1)]))
+
+
 def test_cloth_surface_is_its_flat_sheet():
     sim = jelly.Simulator(scene_of([{"kind": "cloth", "name": "c", "nu": 6, "nv": 4,
                                      "size_u": 2, "size_v": 1.5, "position": [0, 3, 0]}]))

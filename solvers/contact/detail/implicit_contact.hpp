@@ -3,7 +3,8 @@
 //
 // A particle that the step would carry into a coulomb terrain becomes a velocity constraint of
 // the linear system: its normal velocity is prescribed so that it ends the step on the surface
-// (n.v1 = -d(x0, t1) / h), and, while it sticks, its tangential velocity is the surface's. The
+// (n.v1 = -d(x0, t1) / h, d the distance to the surface less the particle's thickness,
+// detail/thickness.hpp), and, while it sticks, its tangential velocity is the surface's. The
 // system is filtered as in Baraff & Witkin 1998 (section 5.3): with S_i the projector onto the
 // free directions of particle i, the solve is (S A S + C + I - S) y = S (b - C w0 - A z),
 // dv = y + z, with z the prescribed components and C the sliding friction (below); this keeps
@@ -157,8 +158,9 @@ class ImplicitContact {
   template <class Impulse, class Unconstrain>
   bool update_impl(const Terrains& terrains, const VecX& dv, bool commit, bool screening,
                    Impulse&& impulse, Unconstrain&& unconstrain_matrix);
-  // The coulomb terrain that position p (at time t1) penetrates deepest, or -1.
-  int penetrated_terrain(const Terrains& terrains, const Vec3& p, Real tolerance) const;
+  // The coulomb terrain whose surface, offset by `gap` (the particle's thickness), position p (at
+  // time t1) penetrates deepest by more than `tolerance`, or -1.
+  int penetrated_terrain(const Terrains& terrains, const Vec3& p, Real gap, Real tolerance) const;
   // penetrating_[i] = penetrated_terrain(terrains, position(i), tolerance) for the particles
   // without a contact (slot_[i] < 0; -1 for the others), on threads_.
   template <class Position>
@@ -167,6 +169,7 @@ class ImplicitContact {
   Real t1_ = 0, h_ = 0;
   const Model* model_ = nullptr;  // of the current step
   VecX x0_, v0_;
+  VecX gap_;  // [N]: each particle's thickness (detail/thickness.hpp), set by begin_step
   std::vector<Contact> contacts_, next_;
   std::vector<Bounce> bounces_;    // finish(): the contacts that bounce
   std::vector<int> slot_;          // [N]: index into contacts_ or -1

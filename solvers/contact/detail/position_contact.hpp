@@ -1,8 +1,9 @@
 #pragma once
 // Internal (not installed). Coulomb contact for the position-based integrators
 // (projective_dynamics, xpbd; docs/realtime.md): particles are kept on the coulomb terrains'
-// surfaces by projection at the end of the (sub)step t1, with Coulomb friction, and bounce after it
-// with restitution, within the energy the step lost. Two ways to use it:
+// surfaces (their thickness above them, detail/thickness.hpp) by projection at the end of the
+// (sub)step t1, with Coulomb friction, and bounce after it with restitution, within the energy the
+// step lost. Two ways to use it:
 //  * projective dynamics (constrain_residual + project, per iteration): the inward normal part of
 //    a contact's residual r = f - M (v1 - v0) / h is the contact force (it is removed before the
 //    global solve, so the fixed point balances every force exactly); a sticking contact's whole
@@ -80,10 +81,12 @@ class PositionContact {
     Real friction_used = 0;              // xpbd: tangential correction of this substep
     Vec3 friction = Vec3::Zero();        // sliding: the friction force of the last iteration
   };
-  // The coulomb terrain that p penetrates deepest at t1, and its signed distance; -1 if none.
-  int deepest(const Vec3& p, Real* distance) const;
+  // The coulomb terrain whose surface, offset by `gap` (the particle's thickness), p penetrates
+  // deepest at t1, and its signed distance to that offset surface; -1 if none.
+  int deepest(const Vec3& p, Real gap, Real* distance) const;
   void activate(int i, int terrain, const Vec3& p);
-  // The sticking position of particle i: its start position moved with the surface, on it.
+  // The sticking position of particle i: its start position moved with the surface, on it (its
+  // thickness above it).
   Vec3 anchor(int i) const;
 
   const Model* model_ = nullptr;
@@ -92,6 +95,7 @@ class PositionContact {
   Real t1_ = 0, h_ = 0;
   bool frozen_ = false;
   VecX x0_, v0_;
+  VecX gap_;                 // [N]: each particle's thickness (detail/thickness.hpp)
   std::vector<Slot> slot_;   // [N]
   std::vector<int> active_;  // particles whose mode is not kFree
   std::vector<Bounce> bounces_;

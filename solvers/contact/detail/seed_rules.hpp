@@ -7,11 +7,11 @@
 
 namespace jelly::seed_rules {
 
-// Within epsilon of the surface and moving towards it (relative velocity). Gives the surface's
-// normal and velocity.
-inline bool touches(const Terrain& terrain, const ContactParams& c, Real t, const Vec3& x,
+// Within epsilon of the surface (offset by the particle's `gap`, its body's thickness) and
+// moving towards it (relative velocity). Gives the surface's normal and velocity.
+inline bool touches(const Terrain& terrain, const ContactParams& c, Real t, Real gap, const Vec3& x,
                     const Vec3& v, Vec3& n, Vec3& u) {
-  if (terrain.signed_distance(x, t) >= c.epsilon || !terrain.can_contact(x, t)) return false;
+  if (terrain.signed_distance(x, t) - gap >= c.epsilon || !terrain.can_contact(x, t)) return false;
   n = terrain.normal(x, t);
   u = terrain.surface_velocity(x, t);
   return (v - u).dot(n) < 0;
@@ -20,10 +20,10 @@ inline bool touches(const Terrain& terrain, const ContactParams& c, Real t, cons
 // Within epsilon and approaching, the normal velocity u1 becomes
 // (m1 u1 + m2 u2 + m2 e (u2 - u1)) / (m1 + m2), u2 the surface's; a fixed plane (m2 infinite)
 // gives u2 + e (u2 - u1) = -e u1. The tangential velocity is kept.
-inline bool reflect(const Terrain& terrain, const ContactParams& c, Real m1, Real t,
+inline bool reflect(const Terrain& terrain, const ContactParams& c, Real m1, Real t, Real gap,
                     Eigen::Ref<const Vec3> x, Eigen::Ref<Vec3> v, Vec3& normal) {
   Vec3 n, u;
-  if (!touches(terrain, c, t, x, v, n, u)) return false;
+  if (!touches(terrain, c, t, gap, x, v, n, u)) return false;
   const Real u1 = v.dot(n);
   const Real u2 = u.dot(n);
   const Real m2 = terrain.mass();
