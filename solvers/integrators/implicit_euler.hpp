@@ -80,6 +80,23 @@ class ImplicitEuler final : public Integrator {
   const VecX& last_velocity_change() const;
   // Whether the last step's solve held contact pairs between bodies.
   bool last_step_had_body_contact() const;
+  // An active contact pair between bodies of the last step's final linear solve
+  // (docs/gradients.md), as the adjoint holds it fixed: the impulse on j (on i the opposite) is
+  //   -(kappa mass / h) (gap0 + h normal.w1) normal - c P_t w1,  w1 = v1_j - v1_i,
+  // with c = kappa mass while it sticks, `viscosity` while it slides
+  // (solvers/contact/detail/implicit_body_contact.hpp).
+  struct SolvedPair {
+    int i = 0, j = 0;
+    Vec3 normal = Vec3::UnitY();  // from x_i0 to x_j0
+    Real gap0 = 0;                // |x_j0 - x_i0| - (r_i + r_j)
+    Real mass = 0;                // reduced mass (a pinned partner is infinitely heavy)
+    Real approach = 0;            // -(w0 . normal) at the start of the step
+    Real kappa = 0;
+    bool slide = false;
+    Real viscosity = 0;  // sliding only
+  };
+  // The active pairs of the last step's final solve (empty when it had none).
+  const std::vector<SolvedPair>& last_pairs() const;
 
  protected:
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;
