@@ -495,7 +495,9 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
   if (!(scale > 0)) scale = 1;
   const bool constrained = contact_active_ && contact_.has_constraints();
   converged_ = false;
-  record_pairs();  // the pairs' terms of every Newton iterate (their friction as last updated)
+  // The constraints and pairs of every Newton iterate (their friction as last updated).
+  record_constraints(constrained, *contact_terrains_);
+  record_pairs();
   for (int k = 1;; ++k) {
     x1_ = s.x + h * v1_;
     dynamics.forces(s.t + h, x1_, v1_, f_);

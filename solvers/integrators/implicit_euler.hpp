@@ -73,7 +73,9 @@ class ImplicitEuler final : public Integrator {
     // friction viscosity comes from it).
     Vec3 impulse = Vec3::Zero();
   };
-  // The constraints of the last step's final solve (empty when it had none).
+  // The constraints of the last step's final solve (empty when it had none); with
+  // newton_iterations > 1, of its Newton iterates (the friction as the last solve updated it;
+  // impulse zero).
   const std::vector<SolvedConstraint>& last_constraints() const;
   // The last step's velocity change dv (v1 = v0 + dv before the contacts' end of step and the
   // pins); with newton_iterations > 1, v1 - v0 of the last Newton iterate.
