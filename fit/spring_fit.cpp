@@ -70,6 +70,7 @@ bool replay_window(const Trajectory& trajectory, const Model& model, const Windo
   options.dt = trajectory.dt;
   Simulator sim(model, start,
                 make_fit_integrator(trajectory.integrator, trajectory.integrator_options), options);
+  sim.set_body_contact(trajectory.body_contact);
   for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
   const Eigen::Index n = model.num_dofs();
   for (int k = w.first + 1; k <= w.last; ++k) {
@@ -229,8 +230,9 @@ Model model_with(const Trajectory& trajectory, const std::vector<FitParameter>& 
 }
 
 // The cost 1/2 sum |x_replay - x_recorded|^2 over the windows and its gradient in the
-// log-coefficients: one adjoint pass per window. A refusal of the adjoint (contact between bodies
-// appearing at some coefficients) is kept in `refused` and fails the evaluation.
+// log-coefficients: one adjoint pass per window. A refusal of the adjoint (what it does not
+// differentiate, e.g. contact between bodies resolved after the step) is kept in `refused` and
+// fails the evaluation.
 class AdjointCost final : public ceres::FirstOrderFunction {
  public:
   AdjointCost(const Trajectory& trajectory, const std::vector<FitParameter>& free,
