@@ -151,6 +151,26 @@ TEST(FitAdjoint, RecoversKsAndKdThroughContactBetweenBodies) {
   EXPECT_NEAR(result.at("kd").value, 20, 0.01 * 20) << result.report();
 }
 
+// The windows' adjoint passes shared between threads: the same fit, bit for bit, on 1, 2 and 3
+// threads.
+TEST(FitAdjoint, ThreadsOverWindowsGiveTheSameFit) {
+  const Trajectory recording = implicit_recording(true);
+  FitOptions options;
+  options.gradients = FitGradients::kAdjoint;
+  options.compute_covariance = false;
+  options.max_iterations = 8;
+  const FitResult one = fit_recording(recording, options);
+  for (const int threads : {1, 2, 3}) {
+    options.num_threads = threads;
+    const FitResult many = fit_recording(recording, options);
+    EXPECT_EQ(many.gradient_path, "adjoint");
+    EXPECT_EQ(many.final_cost, one.final_cost) << threads;
+    EXPECT_EQ(many.at("ks").value, one.at("ks").value) << threads;
+    EXPECT_EQ(many.at("kd").value, one.at("kd").value) << threads;
+    EXPECT_EQ(many.adjoint_passes, one.adjoint_passes) << threads;
+  }
+}
+
 TEST(FitAdjoint, NumericNamesAreParsed) {
   EXPECT_EQ(fit_gradients_from_name("auto", "gradients"), FitGradients::kAuto);
   EXPECT_EQ(fit_gradients_from_name("adjoint", "gradients"), FitGradients::kAdjoint);
