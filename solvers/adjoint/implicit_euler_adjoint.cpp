@@ -8,6 +8,7 @@
 
 #include <optional>
 
+#include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseLU>
 
 #include <jelly/core/detail/band_system.hpp>
@@ -88,6 +89,11 @@ void adjoint_filter_system(SparseMatrix& a, const std::vector<Constraint>& cons,
     }
   }
 }
+
+// Newton's backward solve: a sparse LU of the exact (non-symmetric) Jacobian up to this many
+// unknowns (as "auto" picks CHOLMOD below the same size), BiCGSTAB with a Jacobi
+// preconditioner to cg_tolerance above (an LU's fill grows too fast in 3D).
+constexpr int kNewtonDirectMaxDofs = 1000;
 
 // a -> S a S + C + I - S for a matrix of any symmetry (Newton's exact Jacobian): every block
 // (i, j) with a constrained particle i or j becomes S_i a_ij S_j, a constrained diagonal block
@@ -393,6 +399,8 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   // wind's terms) at (x1, v1), its damper term non-symmetric, transposed in a sparse LU.
   const bool newton = options.newton_iterations > 1;
   std::optional<Eigen::SparseLU<SparseMatrix>> lu;
+  std::optional<Eigen::BiCGSTAB<SparseMatrix, Eigen::DiagonalPreconditioner<Real>>> bicgstab;
+  SparseMatrix transposed;
   SparseMatrix k_matrix, d_matrix;
   JacobianOptions exact_options;
   exact_options.definiteness = DefinitenessFix::kNone;
@@ -404,9 +412,16 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     filtered = jacobian->make_matrix();
     k_matrix = jacobian->make_matrix();
     d_matrix = jacobian->make_matrix();
-    lu.emplace();
-    lu->analyzePattern(filtered);
-    out.backward_solver = "sparse_lu";
+    if (n <= kNewtonDirectMaxDofs) {
+      lu.emplace();
+      lu->analyzePattern(filtered);
+      out.backward_solver = "sparse_lu";
+    } else {
+      bicgstab.emplace();
+      bicgstab->setTolerance(options.cg_tolerance);
+      bicgstab->setMaxIterations(options.cg_max_iterations);
+      out.backward_solver = "bicgstab_jacobi";
+    }
   } else if (ie->linear_solver_name() == "cg_jacobi_matrix_free") {
     // (the forward step assembles its matrix when bodies may touch)
     if (!pair_blocks.empty())
@@ -633,12 +648,23 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       if (newton) {
         std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
         adjoint_filter_general(filtered, cons, slot);
-        lu->factorize(filtered);
-        if (lu->info() == Eigen::Success) mu = lu->transpose().solve(dvb);
-        if (lu->info() != Eigen::Success || !mu.allFinite())
+        bool ok = false;
+        std::string why;
+        if (lu) {
+          lu->factorize(filtered);
+          if (lu->info() == Eigen::Success) mu = lu->transpose().solve(dvb);
+          ok = lu->info() == Eigen::Success;
+          why = "the Newton step's Jacobian is singular (" + lu->lastErrorMessage() + ")";
+        } else {
+          transposed = filtered.transpose();
+          bicgstab->compute(transposed);
+          mu = bicgstab->solve(dvb);
+          ok = bicgstab->info() == Eigen::Success;
+          why = "BiCGSTAB did not reach cg_tolerance in cg_max_iterations";
+        }
+        if (!ok || !mu.allFinite())
           throw std::runtime_error("gradient: the backward solve of step " + std::to_string(k) +
-                                   " failed: the Newton step's Jacobian is singular (" +
-                                   lu->lastErrorMessage() + ")");
+                                   " failed: " + why);
       } else if (free) {
         free->projectors.resize(9 * cons.size());
         free->viscosities.resize(cons.size());

@@ -71,7 +71,7 @@ struct GradientResult {
   // adjoint is of the converged step, so it is approximate there).
   long newton_unconverged_steps = 0;
   // "cholmod", "ldlt", "cg_jacobi", "cg_lagged_cholmod", "cg_jacobi_matrix_free" or (Newton)
-  // "sparse_lu"
+  // "sparse_lu" (up to 1000 unknowns), "bicgstab_jacobi"
   std::string backward_solver;
   double forward_seconds = 0, backward_seconds = 0;
 };
