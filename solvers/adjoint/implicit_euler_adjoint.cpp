@@ -358,9 +358,11 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     if (!counted[k]) {  // (a segment run again from its checkpoint is not counted twice)
       counted[k] = 1;
       if (!integrator->last_converged()) ++out.newton_unconverged_steps;
-      const long projected = body_projections();
-      if (projected != projected_so_far) ++out.pair_projected_steps;
-      projected_so_far = projected;
+      if (integrator->last_step_had_body_contact()) {  // (only candidates can be projected)
+        const long projected = body_projections();
+        if (projected != projected_so_far) ++out.pair_projected_steps;
+        projected_so_far = projected;
+      }
       for (const BodyPair& p : r.pairs) {
         pair_blocks.emplace_back(p.i, p.j);
         ++out.pair_steps;
