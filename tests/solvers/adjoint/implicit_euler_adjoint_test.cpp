@@ -455,6 +455,29 @@ TEST(ImplicitEulerAdjoint, NewtonWithCubesInContactAgreesWithFiniteDifferences) 
   }
 }
 
+// Newton above 1000 unknowns: the backward solve is BiCGSTAB (to a tight cg_tolerance here).
+TEST(ImplicitEulerAdjoint, NewtonWithBiCgStabAgreesWithFiniteDifferences) {
+  AdjointCase c;
+  c.steps = 4;
+  Model model = build_cube(testing::small_cube(7, 0.6));
+  model.mass.setConstant(0.02);
+  model.springs.set_coefficients(SpringType::kStructural, {400, 4});
+  const State s0 = jittered(rest_state(model), 1e-2, 0.3);
+  c.make = [model, s0] {
+    ImplicitEulerOptions o;
+    o.newton_iterations = 60;
+    o.newton_tolerance = 1e-10;
+    o.cg_tolerance = 1e-13;
+    SimulatorOptions so;
+    so.dt = 0.01;
+    return Simulator(model, s0, std::make_unique<ImplicitEuler>(o), so);
+  };
+  const GradientResult g = gradient_of(c);
+  EXPECT_EQ(g.backward_solver, "bicgstab_jacobi");
+  EXPECT_EQ(g.newton_unconverged_steps, 0);
+  check_every_kind(c, 0, {SpringType::kStructural});
+}
+
 // CG forward and backward (tight tolerance): the gradient agrees to CG's accuracy.
 TEST(ImplicitEulerAdjoint, ConjugateGradientsBackwardAgreesWithFiniteDifferences) {
   AdjointCase c = cube_on_slope();
