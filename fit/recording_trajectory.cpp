@@ -33,6 +33,7 @@ Trajectory trajectory_from_recording(const Recording& recording) {
   t.integrator = scene.integrator.name;
   t.integrator_options = scene.integrator.options;
   t.dt = scene.integrator.dt;
+  t.body_contact = scene.body_contact;
   t.validate();
   return t;
 }

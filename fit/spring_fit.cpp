@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -17,6 +18,7 @@
 #include <ceres/gradient_problem_solver.h>
 #include <Eigen/Dense>
 
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/fit/detail/window_adjoint.hpp>
 #include <jelly/fit/implicit_euler_ceres.hpp>
@@ -70,6 +72,7 @@ bool replay_window(const Trajectory& trajectory, const Model& model, const Windo
   options.dt = trajectory.dt;
   Simulator sim(model, start,
                 make_fit_integrator(trajectory.integrator, trajectory.integrator_options), options);
+  sim.set_body_contact(trajectory.body_contact);
   for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
   const Eigen::Index n = model.num_dofs();
   for (int k = w.first + 1; k <= w.last; ++k) {
@@ -229,39 +232,59 @@ Model model_with(const Trajectory& trajectory, const std::vector<FitParameter>& 
 }
 
 // The cost 1/2 sum |x_replay - x_recorded|^2 over the windows and its gradient in the
-// log-coefficients: one adjoint pass per window. A refusal of the adjoint (contact between bodies
-// appearing at some coefficients) is kept in `refused` and fails the evaluation.
+// log-coefficients: one adjoint pass per window, the windows shared between up to `threads`
+// threads (each takes the next window not yet taken; every window's result is kept and the sums
+// are taken in window order, so the result is the same for any thread count). A refusal of the
+// adjoint (what it does not differentiate, e.g. contact between bodies resolved after the step)
+// is kept in `refused` (the first window's, in window order) and fails the evaluation.
 class AdjointCost final : public ceres::FirstOrderFunction {
  public:
   AdjointCost(const Trajectory& trajectory, const std::vector<FitParameter>& free,
-              const std::vector<Window>& windows)
-      : trajectory_(&trajectory), free_(&free), windows_(&windows) {}
+              const std::vector<Window>& windows, int threads)
+      : trajectory_(&trajectory), free_(&free), windows_(&windows), threads_(threads) {}
 
   int NumParameters() const override { return static_cast<int>(free_->size()); }
 
   bool Evaluate(const double* log_k, double* cost, double* gradient) const override {
     const Model model = model_with(*trajectory_, *free_, log_k);
+    const int count = static_cast<int>(windows_->size());
+    std::vector<GradientResult> results(count);
+    std::vector<std::string> refusals(count);
+    std::vector<char> failed(count, 0);
+    std::vector<std::exception_ptr> errors(count);  // anything else: rethrown below
+    std::atomic<int> next{0};
+    parallel::run(std::min(threads_, count), [&](int, int) {
+      for (int k = next++; k < count; k = next++) {
+        const Window& w = (*windows_)[k];
+        const WindowFrameLoss loss = [&](int frame, const VecX& x, VecX& dl_dx) {
+          dl_dx = x - trajectory_->positions[frame];
+          return 0.5 * dl_dx.squaredNorm();
+        };
+        try {
+          results[k] = fit_window_gradient(*trajectory_, model, w.first, w.last,
+                                           trajectory_->state(w.first), loss);
+        } catch (const InputError& e) {
+          refusals[k] = e.what();
+        } catch (const std::runtime_error&) {
+          failed[k] = 1;  // a step or backward solve failed at these coefficients
+        } catch (...) {
+          errors[k] = std::current_exception();
+        }
+      }
+    });
+    for (const std::exception_ptr& e : errors)
+      if (e) std::rethrow_exception(e);
+    passes += count;
     *cost = 0;
     if (gradient != nullptr) std::fill(gradient, gradient + free_->size(), 0.0);
-    for (const Window& w : *windows_) {
-      const WindowFrameLoss loss = [&](int frame, const VecX& x, VecX& dl_dx) {
-        dl_dx = x - trajectory_->positions[frame];
-        return 0.5 * dl_dx.squaredNorm();
-      };
-      GradientResult g;
-      try {
-        ++passes;
-        g = fit_window_gradient(*trajectory_, model, w.first, w.last, trajectory_->state(w.first),
-                                loss);
-      } catch (const InputError& e) {
-        refused = e.what();
+    for (int k = 0; k < count; ++k) {
+      if (!refusals[k].empty()) {
+        refused = refusals[k];
         return false;
-      } catch (const std::runtime_error&) {
-        return false;  // a step or backward solve failed at these coefficients
       }
-      if (!std::isfinite(g.loss)) return false;
-      *cost += g.loss;
-      if (gradient != nullptr) add_log_gradient(model, *free_, log_k, g, gradient);
+      if (failed[k] || !std::isfinite(results[k].loss)) return false;
+      *cost += results[k].loss;
+      if (gradient != nullptr) add_log_gradient(model, *free_, log_k, results[k], gradient);
     }
     return true;
   }
@@ -273,6 +296,7 @@ class AdjointCost final : public ceres::FirstOrderFunction {
   const Trajectory* trajectory_;
   const std::vector<FitParameter>* free_;
   const std::vector<Window>* windows_;
+  int threads_;
 };
 
 // The weights of Trajectory::state's finite-difference velocity at frame k: v = sum_j w_j
@@ -631,7 +655,7 @@ bool fit_with_adjoint(const Trajectory& trajectory, const FitOptions& options,
   if (std::string why = adjoint_refusal(trajectory, options); !why.empty()) return refuse(why);
   const std::vector<FitParameter>& free = options.free;
   const int p_count = static_cast<int>(free.size());
-  auto* function = new AdjointCost(trajectory, free, windows);
+  auto* function = new AdjointCost(trajectory, free, windows, options.num_threads);
   ceres::GradientProblem problem(function);  // owns it
   // A probe at the start: what the adjoint refuses shows at once (anchors, wind, ...).
   {

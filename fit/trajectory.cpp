@@ -96,7 +96,8 @@ Terrains Trajectory::make_terrains() const { return terrains ? terrains() : Terr
 Trajectory simulate_trajectory(const Model& model, const State& initial, TerrainFactory terrains,
                                const std::string& integrator, Real dt, Real frame_interval,
                                Real duration, bool record_velocities,
-                               const IntegratorOptions& integrator_options) {
+                               const IntegratorOptions& integrator_options,
+                               const BodyContactParams& body_contact) {
   require(std::isfinite(frame_interval) && frame_interval >= dt, "frame_interval", frame_interval,
           "a finite interval >= dt");
   require(std::isfinite(duration) && duration > 0, "duration", duration, "a finite time > 0 s");
@@ -106,12 +107,14 @@ Trajectory simulate_trajectory(const Model& model, const State& initial, Terrain
   trajectory.integrator = integrator;
   trajectory.integrator_options = integrator_options;
   trajectory.dt = dt;
+  trajectory.body_contact = body_contact;
   const long steps_per_frame = std::lround(frame_interval / dt);
   require(std::abs(frame_interval / dt - static_cast<Real>(steps_per_frame)) < 1e-6,
           "frame_interval", frame_interval, "a whole number of steps of dt");
   SimulatorOptions options;
   options.dt = dt;
   Simulator sim(model, initial, make_fit_integrator(integrator, integrator_options), options);
+  sim.set_body_contact(body_contact);
   for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
   auto record = [&] {
     trajectory.times.push_back(sim.state().t);

@@ -7,6 +7,7 @@
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 
@@ -20,10 +21,12 @@ struct Trajectory {
   // Masses, springs (a, b, rest length, type) and gravity. The coefficients ks and kd are the
   // starting guess of a fit unless FitOptions::initial names other values.
   Model model;
-  std::vector<Real> times;         // [T] s, strictly increasing
-  std::vector<VecX> positions;     // [T] frames of 3N positions (m)
-  std::vector<VecX> velocities;    // empty, or [T] frames of 3N velocities (m/s)
-  TerrainFactory terrains;         // empty = no terrain
+  std::vector<Real> times;       // [T] s, strictly increasing
+  std::vector<VecX> positions;   // [T] frames of 3N positions (m)
+  std::vector<VecX> velocities;  // empty, or [T] frames of 3N velocities (m/s)
+  TerrainFactory terrains;       // empty = no terrain
+  // Contact between bodies (and within one) as the recording ran it; every replay uses it.
+  BodyContactParams body_contact;
   std::string integrator = "rk4";  // the integrator the recording was made with
   IntegratorOptions integrator_options;
   Real dt = 0.001;  // s; every frame interval is a whole number of steps
@@ -47,6 +50,7 @@ struct Trajectory {
 Trajectory simulate_trajectory(const Model& model, const State& initial, TerrainFactory terrains,
                                const std::string& integrator, Real dt, Real frame_interval,
                                Real duration, bool record_velocities = true,
-                               const IntegratorOptions& integrator_options = {});
+                               const IntegratorOptions& integrator_options = {},
+                               const BodyContactParams& body_contact = {});
 
 }  // namespace jelly

@@ -20,6 +20,7 @@ GradientResult fit_window_gradient(const Trajectory& trajectory, const Model& mo
   options.threads = 1;
   Simulator sim(model, start,
                 make_fit_integrator(trajectory.integrator, trajectory.integrator_options), options);
+  sim.set_body_contact(trajectory.body_contact);
   for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
   // The step after which each compared frame is reached; frame_at[step] = recording frame or -1.
   GradientProblem problem;

@@ -42,8 +42,9 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
     checkpoint_every: 0 keeps every step's state (9N doubles per step); S > 0 keeps a snapshot
     every S steps and runs each segment again during the backward pass (one more forward run,
     memory for S steps).
-    Returns (value, {path: array}). Warns when sliding or bouncing contacts made the gradient
-    approximate (their friction viscosity and restitution are held fixed).
+    Returns (value, {path: array}). Warns when sliding or bouncing contacts (terrain or between
+    bodies) made the gradient approximate (a friction viscosity or restitution held fixed), and
+    when a Newton step did not converge.
     """
     sim = _jelly.Simulator(scene)
     steps = _steps(float(duration), sim.options.dt)
@@ -69,12 +70,22 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
 
     raw = _jelly._gradient(sim, steps, frame_loss, list(frames or []), pins,
                            targets.reshape(-1, 3), int(checkpoint_every))
-    for count, what in ((raw["slide_steps"], "sliding contact's friction viscosity (set by its "
-                         "prediction or an earlier solve of the step)"),
-                        (raw["bounce_steps"], "bouncing contact's restitution")):
+    held = (
+        (raw["slide_steps"], "particle-step(s) held a sliding contact's friction viscosity fixed "
+         "(set by its prediction or an earlier solve of the step)"),
+        (raw["bounce_steps"], "particle-step(s) held a bouncing contact's restitution fixed"),
+        (raw["pair_slide_steps"], "pair-step(s) of contact between bodies held a sliding pair's "
+         "friction viscosity fixed (set by its prediction or an earlier solve of the step)"),
+        (raw["pair_bounce_steps"], "pair-step(s) of contact between bodies held a bouncing "
+         "pair's restitution fixed"),
+        (raw["pair_projected_steps"], "step(s) held the projection of an overlap between bodies "
+         "deeper than 0.5 % of the radii fixed"),
+        (raw["newton_unconverged_steps"], "step(s) stopped Newton's iterations above "
+         "newton_tolerance (the adjoint is of the converged step)"))
+    for count, what in held:
         if count:
-            warnings.warn(f"jelly.gradient: {count} particle-step(s) held a {what} fixed; the "
-                          "gradient there is approximate (docs/gradients.md)", stacklevel=2)
+            warnings.warn(f"jelly.gradient: {count} {what}; the gradient there is approximate "
+                          "(docs/gradients.md)", stacklevel=2)
     out = {}
     for path, (body, what) in zip(wrt, requests):
         if isinstance(what, tuple) and what[0] == "force":

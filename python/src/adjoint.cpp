@@ -90,6 +90,11 @@ void bind_adjoint(py::module_& m) {
         out["contact_steps"] = g.contact_steps;
         out["slide_steps"] = g.slide_steps;
         out["bounce_steps"] = g.bounce_steps;
+        out["pair_steps"] = g.pair_steps;
+        out["pair_slide_steps"] = g.pair_slide_steps;
+        out["pair_bounce_steps"] = g.pair_bounce_steps;
+        out["pair_projected_steps"] = g.pair_projected_steps;
+        out["newton_unconverged_steps"] = g.newton_unconverged_steps;
         out["backward_solver"] = g.backward_solver;
         out["forward_seconds"] = g.forward_seconds;
         out["backward_seconds"] = g.backward_seconds;

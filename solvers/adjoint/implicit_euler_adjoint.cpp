@@ -4,8 +4,12 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <tuple>
 
 #include <optional>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseLU>
 
 #include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/clock.hpp>
@@ -14,6 +18,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/detail/friction.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>
@@ -26,6 +31,7 @@ namespace {
 
 using Mat3 = Eigen::Matrix3d;
 using Constraint = ImplicitEuler::SolvedConstraint;
+using BodyPair = ImplicitEuler::SolvedPair;
 using ConstraintKind = ImplicitEuler::SolvedConstraint::Kind;
 
 // The projector S_c onto the free directions of a constrained particle (zero for a pin or a
@@ -84,6 +90,39 @@ void adjoint_filter_system(SparseMatrix& a, const std::vector<Constraint>& cons,
   }
 }
 
+// Newton's backward solve: a sparse LU of the exact (non-symmetric) Jacobian up to this many
+// unknowns (as "auto" picks CHOLMOD below the same size), BiCGSTAB with a Jacobi
+// preconditioner to cg_tolerance above (an LU's fill grows too fast in 3D).
+constexpr int kNewtonDirectMaxDofs = 1000;
+
+// a -> S a S + C + I - S for a matrix of any symmetry (Newton's exact Jacobian): every block
+// (i, j) with a constrained particle i or j becomes S_i a_ij S_j, a constrained diagonal block
+// S a S + C + I - S.
+void adjoint_filter_general(SparseMatrix& a, const std::vector<Constraint>& cons,
+                            const std::vector<int>& slot) {
+  if (cons.empty()) return;
+  const int* outer = a.outerIndexPtr();
+  const int* rows = a.innerIndexPtr();
+  const int np = static_cast<int>(a.cols() / 3);
+  for (int j = 0; j < np; ++j) {
+    for (int at = outer[3 * j]; at < outer[3 * j + 1]; at += 3) {
+      const int i = rows[at] / 3;
+      if (slot[i] < 0 && slot[j] < 0) continue;
+      const AdjointBlock bij = adjoint_block(a, i, j);
+      const Mat3 block = adjoint_read(a, bij);
+      const Mat3 si = slot[i] >= 0 ? adjoint_free_projector(cons[slot[i]]) : Mat3::Identity();
+      const Mat3 sj = slot[j] >= 0 ? adjoint_free_projector(cons[slot[j]]) : Mat3::Identity();
+      Mat3 f = si * block * sj;
+      if (i == j) {
+        const Constraint& c = cons[slot[i]];
+        const Real viscosity = c.kind == ConstraintKind::kSlide ? c.viscosity : 0.0;
+        f += viscosity * sj + Mat3::Identity() - sj;
+      }
+      adjoint_write(a, bij, f);
+    }
+  }
+}
+
 // The solver of the backward pass: the forward step's own kind (a direct factorization, or CG
 // with the same preconditioner).
 std::unique_ptr<LinearSolver> adjoint_backward_solver(std::string_view forward,
@@ -138,15 +177,94 @@ struct StepRecord {
   Real t = 0;     // the time at the start of the step
   VecX x, v, dv;  // the state at the start of the step, and its velocity change
   std::vector<Constraint> constraints;
+  std::vector<BodyPair> pairs;  // the active contact pairs between bodies of the final solve
 };
+
+// Adds the coupling block H = kappa m n n^T + c P_t of each pair to `a` (+H at (i, i) and
+// (j, j), -H at (i, j) and (j, i)), as ImplicitBodyContact::add_terms does; `a`'s pattern holds
+// the pairs' blocks.
+void adjoint_add_pair_blocks(SparseMatrix& a, const std::vector<BodyPair>& pairs) {
+  for (const BodyPair& p : pairs) {
+    const Mat3 nn = p.normal * p.normal.transpose();
+    const Real c = p.slide ? p.viscosity : p.kappa * p.mass;
+    const Mat3 block = (p.kappa * p.mass) * nn + c * (Mat3::Identity() - nn);
+    for (const auto& [r, q, sign] : {std::tuple{p.i, p.i, 1.0}, std::tuple{p.j, p.j, 1.0},
+                                     std::tuple{p.i, p.j, -1.0}, std::tuple{p.j, p.i, -1.0}}) {
+      const AdjointBlock b = adjoint_block(a, r, q);
+      adjoint_write(a, b, adjoint_read(a, b) + sign * block);
+    }
+  }
+}
+
+// A sliding pair's friction viscosity `value` at the step after r, if r's final solve set it
+// (ImplicitBodyContact::update on the pair `p` as that solve held it, recomputed with the same
+// arithmetic): adds cbar dvalue/d(...) to the adjoints of r's velocity change, initial state and
+// masses and returns true; false (nothing added) when it came from elsewhere (a new pair's
+// prediction, a solve before the last, or the run's start).
+bool adjoint_trace_pair_viscosity(const BodyPair& p, Real value, Real cbar, Real mu, Real mu_s,
+                                  Real h, const StepRecord& r, const VecX& inverse_mass,
+                                  const std::vector<int>& particle_body, VecX& dvb, VecX& v0b,
+                                  VecX& x0b, std::vector<Real>& mass_bar) {
+  using friction::tangential;
+  const Vec3& n = p.normal;
+  const Vec3 w1 =
+      particle(r.v, p.j) + particle(r.dv, p.j) - particle(r.v, p.i) - particle(r.dv, p.i);
+  const Real c = p.slide ? p.viscosity : p.kappa * p.mass;
+  const Real gap1 = p.gap0 + h * n.dot(w1);
+  const Vec3 q = (-(p.kappa * p.mass / h) * gap1) * n - c * tangential(w1, n);
+  const Real pn = q.dot(n);
+  if (!(pn >= 0)) return false;
+  const Real km = p.kappa * p.mass, bn = n.dot(w1);
+  const Vec3 wt = tangential(w1, n);
+  const Real speed = wt.norm();
+  if (!(speed > 0)) return false;
+  Vec3 d_w, d_n;
+  Real d_gap;
+  if (p.slide) {  // c = mu p_n / |w1_t|
+    if (!(mu > 0)) return false;
+    const Real set = mu * pn / std::max(speed, 1e-300);
+    if ((mu_s > 0 && set >= friction::kStickViscosity * p.mass) || set != value) return false;
+    d_w = -(mu * km / speed) * n - (value / (speed * speed)) * wt;
+    d_gap = -(mu / speed) * (km / h);
+    d_n = -(mu * km / speed) * w1 + (value * bn / (speed * speed)) * wt;
+  } else {  // stick -> slide: c = mu p_n m / (p_t - mu p_n), p_t = kappa m |w1_t|
+    const Real pt = tangential(q, n).norm();
+    if (!(pt > mu_s * pn)) return false;
+    const Real force = mu * pn;
+    if (!(pt > force)) return false;
+    const Real set = force * p.mass / (pt - force);
+    if (set != value) return false;
+    const Real d = pt - force;
+    const Real a_pn = (mu * p.mass / d) * (1 + force / d), a_pt = -value / d;
+    d_w = -(a_pn * km) * n + (a_pt * km / speed) * wt;
+    d_gap = -a_pn * km / h;
+    d_n = -(a_pn * km) * w1 - (a_pt * km * bn / speed) * wt;
+  }
+  // value is proportional to the pair's mass m (p_n, p_t and m all are).
+  const Real d_m = value / p.mass;
+  const Vec3 gw = cbar * d_w;
+  particle(dvb, p.j) += gw;
+  particle(v0b, p.j) += gw;
+  particle(dvb, p.i) -= gw;
+  particle(v0b, p.i) -= gw;
+  const Real length = (particle(r.x, p.j) - particle(r.x, p.i)).norm();
+  const Vec3 gd = cbar * (d_gap * n + tangential(d_n, n) / length);
+  particle(x0b, p.j) += gd;
+  particle(x0b, p.i) -= gd;
+  for (const int k : {p.i, p.j})
+    mass_bar[particle_body[k]] += cbar * d_m * p.mass * p.mass * inverse_mass[k] * inverse_mass[k];
+  return true;
+}
 
 void adjoint_check_supported(const Simulator& sim, const ImplicitEuler& ie) {
   const ImplicitEulerOptions& o = ie.options();
-  require(o.newton_iterations == 1, "integrator.newton_iterations", o.newton_iterations,
-          "1 for gradients (the adjoint differentiates the linearized step)");
   require(sim.forces().empty(), "added forces", sim.forces().size(),
           "none for gradients (forces' parameters are not differentiated yet)");
   require(sim.anchors().empty(), "anchors", sim.anchors().size(), "none for gradients");
+  require(o.contact == ImplicitContactMode::kImplicit || !sim.body_contact().active(sim.model()),
+          "integrator.contact", "\"after_step\"",
+          "\"implicit\" for gradients of a run with contact between bodies (resolved after the "
+          "step, it is not differentiated)");
   for (int k = 0; k < static_cast<int>(sim.terrains().size()); ++k) {
     const ContactParams& c = sim.terrains()[k]->contact();
     require(c.model == ContactModel::kCoulomb && o.contact == ImplicitContactMode::kImplicit,
@@ -206,6 +324,18 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
             "loss at frame " + std::to_string(frame), value, "finite values and derivatives");
     out.loss += value;
   };
+  // Contact between bodies: the union of the pairs' blocks (the backward matrix's pattern), and
+  // what the adjoint holds (the end of step's projection of deep overlaps, restitution).
+  std::vector<std::pair<int, int>> pair_blocks;
+  std::vector<char> counted(steps, 0);
+  const Real restitution = sim.body_contact().params().restitution;
+  const Real resting_speed = sim.body_contact().params().resting_speed;
+  const auto body_projections = [&]() -> long {
+    const Statistics stats = sim.integrator().statistics();
+    const auto it = stats.find("body_contact_projected");
+    return it == stats.end() ? 0 : static_cast<long>(it->second);
+  };
+  long projected_so_far = body_projections();
   // Step k of the run, recorded into r.
   const auto forward_step = [&](int k, StepRecord& r) {
     r.t = sim.state().t;
@@ -222,11 +352,23 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       throw std::runtime_error("gradient: step " + std::to_string(k) +
                                " failed: " + result.message);
     const auto* integrator = dynamic_cast<const ImplicitEuler*>(&sim.integrator());
-    if (integrator->last_step_had_body_contact())
-      throw InputError("gradient: contact between bodies at step " + std::to_string(k) +
-                       " is not differentiated yet");
     r.dv = integrator->last_velocity_change();
     r.constraints = integrator->last_constraints();
+    r.pairs = integrator->last_pairs();
+    if (!counted[k]) {  // (a segment run again from its checkpoint is not counted twice)
+      counted[k] = 1;
+      if (!integrator->last_converged()) ++out.newton_unconverged_steps;
+      if (integrator->last_step_had_body_contact()) {  // (only candidates can be projected)
+        const long projected = body_projections();
+        if (projected != projected_so_far) ++out.pair_projected_steps;
+        projected_so_far = projected;
+      }
+      for (const BodyPair& p : r.pairs) {
+        pair_blocks.emplace_back(p.i, p.j);
+        ++out.pair_steps;
+        if (restitution > 0 && p.approach > resting_speed) ++out.pair_bounce_steps;
+      }
+    }
   };
   evaluate(0);
   for (int k = 0; k < steps; ++k) {
@@ -252,11 +394,44 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   std::optional<SpringJacobian> jacobian;
   SparseMatrix a, filtered;
   std::unique_ptr<LinearSolver> solver;
-  if (ie->linear_solver_name() == "cg_jacobi_matrix_free") {
+  std::sort(pair_blocks.begin(), pair_blocks.end());
+  pair_blocks.erase(std::unique(pair_blocks.begin(), pair_blocks.end()), pair_blocks.end());
+  // Newton (newton_iterations > 1): the adjoint of the converged step, by the implicit function
+  // theorem at the last iterate v1: the exact Jacobian J = M - h D - h^2 K (+ the pairs' and the
+  // wind's terms) at (x1, v1), its damper term non-symmetric, transposed in a sparse LU.
+  const bool newton = options.newton_iterations > 1;
+  std::optional<Eigen::SparseLU<SparseMatrix>> lu;
+  std::optional<Eigen::BiCGSTAB<SparseMatrix, Eigen::DiagonalPreconditioner<Real>>> bicgstab;
+  SparseMatrix transposed;
+  SparseMatrix k_matrix, d_matrix;
+  JacobianOptions exact_options;
+  exact_options.definiteness = DefinitenessFix::kNone;
+  exact_options.exact_damper = true;
+  VecX x1(n), v1(n);
+  if (newton) {
+    jacobian.emplace(model, pair_blocks);
+    a = jacobian->make_matrix();
+    filtered = jacobian->make_matrix();
+    k_matrix = jacobian->make_matrix();
+    d_matrix = jacobian->make_matrix();
+    if (n <= kNewtonDirectMaxDofs) {
+      lu.emplace();
+      lu->analyzePattern(filtered);
+      out.backward_solver = "sparse_lu";
+    } else {
+      bicgstab.emplace();
+      bicgstab->setTolerance(options.cg_tolerance);
+      bicgstab->setMaxIterations(options.cg_max_iterations);
+      out.backward_solver = "bicgstab_jacobi";
+    }
+  } else if (ie->linear_solver_name() == "cg_jacobi_matrix_free") {
+    // (the forward step assembles its matrix when bodies may touch)
+    if (!pair_blocks.empty())
+      throw std::logic_error("gradient: contact pairs between bodies on the matrix-free path");
     free.emplace(model, options.cg_tolerance >= 1e-6);
     out.backward_solver = "cg_jacobi_matrix_free";
   } else {
-    jacobian.emplace(model);
+    jacobian.emplace(model, pair_blocks);
     a = jacobian->make_matrix();
     filtered = jacobian->make_matrix();
     solver = adjoint_backward_solver(ie->linear_solver_name(), options, out.backward_solver);
@@ -276,6 +451,9 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
               particle_body.begin() + body.end_particle(), b);
   }
   std::vector<int> slot(np, -1);
+  // The inverse masses the body contact gives its pairs (0 for pins).
+  VecX inverse_mass = model.mass.cwiseInverse();
+  for (int k = 0; k < model.pins.size(); ++k) inverse_mass[model.pins.particles[k]] = 0;
   // The sliding contacts of the step after the current one: dL/d(their viscosity), to be traced
   // to the current step's solve.
   struct PendingViscosity {
@@ -283,6 +461,15 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     Real cbar, value;
   };
   std::vector<PendingViscosity> pending;
+  // The same for the sliding contact pairs between bodies of the step after the current one.
+  struct PendingPairViscosity {
+    int i, j;
+    Real cbar, value;
+  };
+  std::vector<PendingPairViscosity> pending_pairs;
+  std::vector<int> pair_order;  // the current step's pairs sorted by (i, j)
+  const Real pair_mu = sim.body_contact().params().friction;
+  const Real pair_mu_s = sim.body_contact().params().static_friction;
   out.force_vector.assign(model.external_forces.size(), Vec3::Zero());
   out.force_drag.assign(model.external_forces.size(), 0.0);
   out.force_gust.assign(model.external_forces.size(), 0.0);
@@ -327,17 +514,33 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         auto w = particle(vb, c.particle);
         w -= c.normal * c.normal.dot(w);
       }
-      // x1 = x0 + h v1, v1 = v0 + dv.
+      // x1 = x0 + h v1, v1 = v0 + dv (Newton: v1 is the unknown, v0 enters through M (v1 - v0)).
       x0b = xb;
       dvb = vb + h * xb;
-      v0b = dvb;
+      if (newton)
+        v0b.setZero();
+      else
+        v0b = dvb;
       // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
       // mu.
-      if (free) {
+      if (newton) {
+        v1 = r.v + r.dv;
+        x1 = r.x + h * v1;
+        jacobian->assemble(model, x1, v1, exact_options, k_matrix, d_matrix, threads);
+        const Real* dv_values = d_matrix.valuePtr();
+        const Real* k_values = k_matrix.valuePtr();
+        Real* a_values = a.valuePtr();
+        for (Eigen::Index q = 0; q < a.nonZeros(); ++q)
+          a_values[q] = -h * dv_values[q] - (h * h) * k_values[q];
+        for (int i = 0; i < np; ++i)
+          for (int d = 0; d < 3; ++d) jacobian->add_to_diagonal(a, 3 * i + d, model.mass[i]);
+        adjoint_add_pair_blocks(a, r.pairs);
+      } else if (free) {
         if (!free->band.assemble(model, r.x, r.v, options.definiteness, h, h * h, r.v, kw, threads))
           throw std::runtime_error("gradient: a spring collapsed at step " + std::to_string(k));
       } else {
         jacobian->assemble_system(model, r.x, r.v, jacobian_options, h, h * h, a, r.v, kw);
+        adjoint_add_pair_blocks(a, r.pairs);
       }
       // The forces (and the wind's drag in A) are taken at the end of the step, t + h.
       const Real t1 = r.t + h;
@@ -358,6 +561,15 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       // speed, and p through e: e^T (A dv - b) adds A e to dvb, and -e to lambda in phi below.
       e_vec.setZero();
       bool traced_any = false;
+      // (Newton: the viscosities came from the linearized solve before the iterations, which is
+      // not recorded: held.)
+      if (newton) {
+        for (const PendingViscosity& pv : pending)
+          if (pv.value != 0) ++out.slide_steps;
+        pending.clear();
+        out.pair_slide_steps += static_cast<long>(pending_pairs.size());
+        pending_pairs.clear();
+      }
       for (const PendingViscosity& pv : pending) {
         const int ci = slot[pv.particle];
         const Constraint* c = ci >= 0 ? &cons[ci] : nullptr;
@@ -400,6 +612,31 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         traced_any = traced_any || traced;
         if (!traced && pv.value != 0) ++out.slide_steps;
       }
+      // The next step's sliding pairs' viscosities that this step's final solve set
+      // (ImplicitBodyContact::update, from the pair's impulse q(w1), an explicit function of this
+      // step's x0 (n, gap0), w1 = v1_j - v1_i and masses): a sliding pair's c = mu p_n / |w1_t|, a
+      // sticking one's switch to sliding c = mu p_n m / (p_t - mu p_n), p_n = -kappa m g1 / h.
+      // Recomputed here as the forward step computed it, and traced when it is the value the
+      // next step used.
+      if (!pending_pairs.empty()) {
+        pair_order.resize(r.pairs.size());
+        for (size_t q = 0; q < r.pairs.size(); ++q) pair_order[q] = static_cast<int>(q);
+        const auto key = [&](int q) { return std::make_pair(r.pairs[q].i, r.pairs[q].j); };
+        std::sort(pair_order.begin(), pair_order.end(),
+                  [&](int a1, int b1) { return key(a1) < key(b1); });
+        for (const PendingPairViscosity& pv : pending_pairs) {
+          const auto found =
+              std::lower_bound(pair_order.begin(), pair_order.end(), std::make_pair(pv.i, pv.j),
+                               [&](int q, const std::pair<int, int>& k2) { return key(q) < k2; });
+          const bool traced =
+              found != pair_order.end() && key(*found) == std::make_pair(pv.i, pv.j) &&
+              adjoint_trace_pair_viscosity(r.pairs[*found], pv.value, pv.cbar, pair_mu, pair_mu_s,
+                                           h, r, inverse_mass, particle_body, dvb, v0b, x0b,
+                                           out.particle_mass);
+          if (!traced) ++out.pair_slide_steps;
+        }
+        pending_pairs.clear();
+      }
       if (traced_any) {
         if (free)
           free->band.multiply(e_vec, a_e, threads);
@@ -410,7 +647,27 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
       // mu.
       LinearResult solved;
-      if (free) {
+      if (newton) {
+        std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
+        adjoint_filter_general(filtered, cons, slot);
+        bool ok = false;
+        std::string why;
+        if (lu) {
+          lu->factorize(filtered);
+          if (lu->info() == Eigen::Success) mu = lu->transpose().solve(dvb);
+          ok = lu->info() == Eigen::Success;
+          why = "the Newton step's Jacobian is singular (" + lu->lastErrorMessage() + ")";
+        } else {
+          transposed = filtered.transpose();
+          bicgstab->compute(transposed);
+          mu = bicgstab->solve(dvb);
+          ok = bicgstab->info() == Eigen::Success;
+          why = "BiCGSTAB did not reach cg_tolerance in cg_max_iterations";
+        }
+        if (!ok || !mu.allFinite())
+          throw std::runtime_error("gradient: the backward solve of step " + std::to_string(k) +
+                                   " failed: " + why);
+      } else if (free) {
         free->projectors.resize(9 * cons.size());
         free->viscosities.resize(cons.size());
         for (size_t ci = 0; ci < cons.size(); ++ci) {
@@ -441,7 +698,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         solved = solver->factorize(filtered);
         if (solved.ok()) solved = solver->solve(dvb, mu);
       }
-      if (!solved.ok())
+      if (!newton && !solved.ok())
         throw std::runtime_error("gradient: the backward solve of step " + std::to_string(k) +
                                  " failed: " + solved.message);
       lambda = mu;
@@ -450,29 +707,36 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       // The prescribed velocity changes z (and the sliding friction's C w0): their adjoint is
       // dvb - A lambda at the constrained particles.
       if (!cons.empty()) {
-        if (free)
+        if (newton)
+          a_lambda.noalias() = a.transpose() * lambda;
+        else if (free)
           free->band.multiply(lambda, a_lambda, threads);
         else
           a_lambda.noalias() = a * lambda;
       }
+      // (Newton: v1 of a constrained particle is prescribed whatever v0 (z = ... - v0 cancels
+      // v1 = v0 + dv); the free ones see v0 through M (v1 - v0) only.)
+      if (newton)
+        for (int i = 0; i < np; ++i) particle(v0b, i) += model.mass[i] * particle(lambda, i);
       for (const Constraint& c : cons) {
         const int i = c.particle;
         const Vec3 zb = particle(dvb, i) - particle(a_lambda, i);
         const Vec3& nn = c.normal;
         switch (c.kind) {
           case ConstraintKind::kPin: {  // z = v_path - v0
-            particle(v0b, i) -= zb;
+            if (!newton) particle(v0b, i) -= zb;
             const int p = driven[i];
             if (p >= 0) vel_bar[p] += zb;
             break;
           }
           case ConstraintKind::kStick:  // z = u_t + (-d(x0) / h) n - v0
-            particle(v0b, i) -= zb;
+            if (!newton) particle(v0b, i) -= zb;
             particle(x0b, i) -= (nn.dot(zb) / h) * nn;
             break;
           case ConstraintKind::kSlide: {  // z = (-d(x0) / h - v0.n) n; rhs -= c P_t (v0 - u)
-            particle(v0b, i) -= nn.dot(zb) * nn;
             particle(x0b, i) -= (nn.dot(zb) / h) * nn;
+            if (newton) break;  // (Newton's friction is -c P_t (v1 - u): no v0)
+            particle(v0b, i) -= nn.dot(zb) * nn;
             const Vec3 l = particle(lambda, i);
             particle(v0b, i) -= c.viscosity * (l - l.dot(nn) * nn);
             break;
@@ -532,7 +796,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
               const Vec3 l = particle(lambda, i);
               sum += (h * force.drag) * l;
               out.force_drag[e] += h * l.dot(w - particle(r.v, i) - particle(r.dv, i));
-              particle(v0b, i) -= (h * force.drag) * l;
+              if (!newton) particle(v0b, i) -= (h * force.drag) * l;
             }
             break;
           case ExternalForceKind::kPoint:
@@ -547,7 +811,31 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       //   phi / h = -ks (L - l0) a - kd a (c + be) - h ks a g + h s E,
       //   a = l.u, be = e.u, g = q.u, c = w.u, E = a g - l.q,
       //   s = ks (1 - l0/L) + kd c / L, each term as the definiteness fix clamps it.
-      for (int sp = 0; sp < springs.size(); ++sp) {
+      // Newton: phi = lambda^T (h f(x1, v1) - M (v1 - v0)) with v1 held, f_a = -(ks (L - l0)
+      // + kd w.u) u per spring at x1 = x0 + h v1: exact (no definiteness fix).
+      for (int sp = 0; newton && sp < springs.size(); ++sp) {
+        const int ia = springs.a[sp], ib = springs.b[sp];
+        const Vec3 d = particle(x1, ia) - particle(x1, ib);
+        const Real length = d.norm();
+        const Real l0 = rest[sp];
+        if (!(length > kDegenerateLength * l0)) continue;  // collapsed: not differentiated
+        const Real ks = springs.ks[sp], kd = springs.kd[sp];
+        const Real inv = 1 / length;
+        const Vec3 u = d * inv;
+        const Vec3 l = particle(lambda, ia) - particle(lambda, ib);
+        const Vec3 w = particle(v1, ia) - particle(v1, ib);
+        const Real al = l.dot(u), c = w.dot(u);
+        const Real magnitude = ks * (length - l0) + kd * c;
+        const Vec3 grad_d =
+            -h * ((ks * u + kd * (w - c * u) * inv) * al + magnitude * (l - al * u) * inv);
+        particle(x0b, ia) += grad_d;
+        particle(x0b, ib) -= grad_d;
+        const size_t at = static_cast<size_t>(kSpringTypeCount) * spring_body[sp] +
+                          static_cast<size_t>(springs.type[sp]);
+        out.ks[at] -= h * (length - l0) * al;
+        out.kd[at] -= h * c * al;
+      }
+      for (int sp = 0; !newton && sp < springs.size(); ++sp) {
         const int ia = springs.a[sp], ib = springs.b[sp];
         const Vec3 d = particle(r.x, ia) - particle(r.x, ib);
         const Real length = d.norm();
@@ -594,6 +882,38 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         out.ks[at] += h * grad_ks;
         out.kd[at] += h * grad_kd;
       }
+      // Contact pairs between bodies: phi gains Lambda . q(w1), Lambda = lambda_j - lambda_i,
+      // with the impulse on j q(w1) = -(kappa m / h) g1 n - c P_t w1, g1 = gap0 + h n.w1,
+      // w1 = v1_j - v1_i, n and gap0 from x0 (n = d / |d|, gap0 = |d| - reach, d = x_j0 - x_i0),
+      // m = 1 / (w_i + w_j) from the masses, c = kappa m while the pair sticks (held while it
+      // slides: the viscosity comes from the previous solve).
+      for (const BodyPair& p : r.pairs) {
+        const Vec3& nn = p.normal;
+        const Vec3 lam = particle(lambda, p.j) - particle(lambda, p.i);
+        const Vec3 w1 =
+            particle(r.v, p.j) + particle(r.dv, p.j) - particle(r.v, p.i) - particle(r.dv, p.i);
+        const Real km = p.kappa * p.mass;
+        const Real c = p.slide ? p.viscosity : km;
+        const Real al = lam.dot(nn), bn = nn.dot(w1), g1 = p.gap0 + h * bn;
+        const Real tangential = lam.dot(w1) - al * bn;  // Lambda . P_t w1
+        if (!newton) {                                  // (Newton: w1 is the unknown's)
+          const Vec3 grad_w = -km * al * nn - c * (lam - al * nn);
+          particle(v0b, p.j) += grad_w;
+          particle(v0b, p.i) -= grad_w;
+        }
+        const Real length = (particle(r.x, p.j) - particle(r.x, p.i)).norm();
+        const Vec3 grad_n = -(km / h) * (h * al * w1 + g1 * lam) + c * (bn * lam + al * w1);
+        const Vec3 grad_d = (-(km / h) * al) * nn + (grad_n - nn.dot(grad_n) * nn) / length;
+        particle(x0b, p.j) += grad_d;
+        particle(x0b, p.i) -= grad_d;
+        const Real grad_m = -(p.kappa / h) * g1 * al - (p.slide ? 0.0 : p.kappa * tangential);
+        for (const int q : {p.i, p.j}) {
+          const Real wq = inverse_mass[q];
+          out.particle_mass[particle_body[q]] += grad_m * p.mass * p.mass * wq * wq;
+        }
+        if (p.slide && p.viscosity != 0)
+          pending_pairs.push_back({p.i, p.j, -tangential, p.viscosity});
+      }
       for (const Constraint& c : cons) slot[c.particle] = -1;
       xb.swap(x0b);
       vb.swap(v0b);
@@ -605,6 +925,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   }
   for (const PendingViscosity& pv : pending)  // the first step's: set before the run
     if (pv.value != 0) ++out.slide_steps;
+  out.pair_slide_steps += static_cast<long>(pending_pairs.size());
   if (end_of_run) sim.restore(std::move(*end_of_run));
   out.initial_position = xb;
   out.initial_velocity = vb;

@@ -1,10 +1,11 @@
 #pragma once
 // Exact gradients through implicit_euler (docs/gradients.md): the discrete adjoint of the
-// linearized backward-Euler step, contact and pins included with each step's active set held
-// fixed. One forward run stores every step's state, velocity change and constraint set; one
-// backward pass solves each step's (filtered) system again, transposed, and gathers the gradient
-// of a loss on the states with respect to the springs' coefficients, the particle masses,
-// gravity, the external forces' parameters, the initial state and the targets of driven pins.
+// linearized backward-Euler step (or of the converged Newton step), terrain contact, contact
+// between bodies and pins included with each step's active set held fixed. One forward run stores
+// every step's state, velocity change and constraint set; one backward pass solves each step's
+// (filtered) system again, transposed, and gathers the gradient of a loss on the states with
+// respect to the springs' coefficients, the particle masses, gravity, the external forces'
+// parameters, the initial state and the targets of driven pins.
 #include <functional>
 #include <string>
 #include <vector>
@@ -59,16 +60,29 @@ struct GradientResult {
   long contact_steps = 0;
   long slide_steps = 0;
   long bounce_steps = 0;
-  std::string backward_solver;  // "cholmod", "ldlt" or "cg_jacobi"
+  // Contact pairs between bodies (inside the solve, each step's active pairs held): pair-steps,
+  // of which sliding with a friction viscosity (held), and bouncing (restitution after the solve,
+  // held); steps whose end projected an overlap deeper than 0.5 % of the radii (held).
+  long pair_steps = 0;
+  long pair_slide_steps = 0;
+  long pair_bounce_steps = 0;
+  long pair_projected_steps = 0;
+  // newton_iterations > 1: steps whose Newton iterations stopped above the tolerance (the
+  // adjoint is of the converged step, so it is approximate there).
+  long newton_unconverged_steps = 0;
+  // "cholmod", "ldlt", "cg_jacobi", "cg_lagged_cholmod", "cg_jacobi_matrix_free" or (Newton)
+  // "sparse_lu" (up to 1000 unknowns), "bicgstab_jacobi"
+  std::string backward_solver;
   double forward_seconds = 0, backward_seconds = 0;
 };
 
-// Runs `simulator` (implicit_euler with newton_iterations = 1, from its current state) for
-// problem.steps steps and returns the loss and its gradient; the simulator is left at the end
-// of the run. The forward states are kept in memory (9N doubles per step: x, v, dv), or
-// recomputed from checkpoints (GradientProblem::checkpoint_every).
-// Throws InputError for what the adjoint does not differentiate: another integrator, Newton
-// iterations, contact models other than coulomb inside the solve, contact between bodies,
+// Runs `simulator` (implicit_euler, from its current state) for problem.steps steps and returns
+// the loss and its gradient; the simulator is left at the end of the run. The forward states are
+// kept in memory (9N doubles per step: x, v, dv), or recomputed from checkpoints
+// (GradientProblem::checkpoint_every). With newton_iterations > 1 each step's adjoint is that of
+// its converged Newton iterate (implicit function theorem; exact Jacobian, sparse LU).
+// Throws InputError for what the adjoint does not differentiate: another integrator, contact
+// models other than coulomb inside the solve, contact between bodies resolved after the step,
 // added forces, anchor springs, or a malformed problem; std::runtime_error when a step or a
 // backward solve fails.
 GradientResult implicit_euler_gradient(Simulator& simulator, const GradientProblem& problem);

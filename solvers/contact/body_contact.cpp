@@ -62,6 +62,11 @@ bool BodyContact::active(const Model& model) const {
 
 void BodyContact::prepare(const Model& model) {
   const int n = model.num_particles();
+  // The inverse masses every time (Simulator::set_particle_mass changes them between steps; as
+  // cheap as the broad phase's pass over the particles, and no allocation once sized).
+  inverse_mass_.resize(n);
+  inverse_mass_ = model.mass.cwiseInverse();
+  for (int k = 0; k < model.pins.size(); ++k) inverse_mass_[model.pins.particles[k]] = 0;
   if (prepared_for_ == &model && prepared_particles_ == n &&
       prepared_springs_ == model.springs.size())
     return;
@@ -69,7 +74,6 @@ void BodyContact::prepare(const Model& model) {
   prepared_particles_ = n;
   prepared_springs_ = model.springs.size();
   radius_.resize(n);
-  inverse_mass_ = model.mass.cwiseInverse();
   body_.assign(n, -1);
   for (int b = 0; b < model.num_bodies(); ++b) {
     const Body& body = model.bodies[b];
@@ -82,7 +86,6 @@ void BodyContact::prepare(const Model& model) {
   for (int i = 0; i < n; ++i) {
     if (!(radius_[i] > 0)) radius_[i] = 0;  // a particle outside every body takes no part
   }
-  for (int k = 0; k < model.pins.size(); ++k) inverse_mass_[model.pins.particles[k]] = 0;
   // The springs' neighbours of each particle (CSR, sorted).
   neighbour_start_.assign(n + 1, 0);
   const Springs& s = model.springs;

@@ -84,6 +84,8 @@ struct ImplicitEuler::Impl {
   StepResult linearized_solve(const Dynamics& dynamics, const State& s, Real h);
   // solved_constraints_ = the contact set about to be solved (empty when unconstrained).
   void record_constraints(bool constrained, const Terrains& terrains);
+  // solved_pairs_ = the active pairs between bodies whose terms the system holds.
+  void record_pairs();
   // Newton corrections on the nonlinear backward-Euler equations from v1_.
   StepResult newton(const Dynamics& dynamics, const State& s, Real h);
   // Wind drag at time t: d(f)/d(v) = -drag on its particles, so A gains h drag on the diagonal
@@ -122,6 +124,9 @@ struct ImplicitEuler::Impl {
   std::vector<Real> residuals_;
   // The constraints of the last solve of the step (for the adjoint).
   std::vector<ImplicitEuler::SolvedConstraint> solved_constraints_;
+  // The active contact pairs between bodies whose terms the step's last solve held (for the
+  // adjoint).
+  std::vector<ImplicitEuler::SolvedPair> solved_pairs_;
   bool converged_ = true;
   long newton_iterations_ = 0;
   long newton_not_converged_ = 0;
@@ -148,6 +153,10 @@ const std::vector<ImplicitEuler::SolvedConstraint>& ImplicitEuler::last_constrai
 const VecX& ImplicitEuler::last_velocity_change() const { return impl_->dv_; }
 
 bool ImplicitEuler::last_step_had_body_contact() const { return impl_->bodies_active_; }
+
+const std::vector<ImplicitEuler::SolvedPair>& ImplicitEuler::last_pairs() const {
+  return impl_->solved_pairs_;
+}
 
 std::string_view ImplicitEuler::linear_solver_name() const {
   return impl_->system_ != nullptr ? impl_->system_->name() : std::string_view();
@@ -345,6 +354,25 @@ void ImplicitEuler::Impl::record_constraints(bool constrained, const Terrains& t
   }
 }
 
+void ImplicitEuler::Impl::record_pairs() {
+  solved_pairs_.clear();
+  if (!bodies_active_) return;
+  for (const ImplicitBodyContact::Pair& p : bodies_.pairs()) {
+    if (!p.active) continue;
+    ImplicitEuler::SolvedPair r;
+    r.i = p.i;
+    r.j = p.j;
+    r.normal = p.normal;
+    r.gap0 = p.gap0;
+    r.mass = p.mass;
+    r.approach = p.approach;
+    r.kappa = p.kappa;
+    r.slide = p.mode == ImplicitBodyContact::Mode::kSlide;
+    r.viscosity = r.slide ? p.viscosity : 0.0;
+    solved_pairs_.push_back(r);
+  }
+}
+
 StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const State& s, Real h) {
   const Model& model = dynamics.model();
   const int np = model.num_particles();
@@ -369,6 +397,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
   b_.resize(f_.size());
   for_each_entry(threads_, b_.size(), [&](long k) { b_[k] = h * (f_[k] + h * kw_[k]); });
   if (bodies_active_ && bodies_.any_active()) assembled_->refresh_pair_terms(bodies_, b_);
+  record_pairs();
   times_.assembly += seconds_since(start);
   terrains_seen_ = dynamics.terrains() != nullptr;
   // The terrains whose contact this solve resolves (none with contact = "after_step"); pinned
@@ -420,6 +449,7 @@ StepResult ImplicitEuler::Impl::linearized_solve(const Dynamics& dynamics, const
       // pairs' terms change.
       if (constrained && !terrain_changed) assembled_->unconstrain(contact_);
       assembled_->refresh_pair_terms(bodies_, b_);
+      record_pairs();
     }
   }
   have_dv_ = true;
@@ -445,6 +475,9 @@ StepResult ImplicitEuler::Impl::newton(const Dynamics& dynamics, const State& s,
   if (!(scale > 0)) scale = 1;
   const bool constrained = contact_active_ && contact_.has_constraints();
   converged_ = false;
+  // The constraints and pairs of every Newton iterate (their friction as last updated).
+  record_constraints(constrained, *contact_terrains_);
+  record_pairs();
   for (int k = 1;; ++k) {
     x1_ = s.x + h * v1_;
     dynamics.forces(s.t + h, x1_, v1_, f_);

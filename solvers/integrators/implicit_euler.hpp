@@ -66,13 +66,32 @@ class ImplicitEuler final : public Integrator {
     // friction viscosity comes from it).
     Vec3 impulse = Vec3::Zero();
   };
-  // The constraints of the last step's final solve (empty when it had none).
+  // The constraints of the last step's final solve (empty when it had none); with
+  // newton_iterations > 1, of its Newton iterates (the friction as the last solve updated it;
+  // impulse zero).
   const std::vector<SolvedConstraint>& last_constraints() const;
   // The last step's velocity change dv (v1 = v0 + dv before the contacts' end of step and the
   // pins); with newton_iterations > 1, v1 - v0 of the last Newton iterate.
   const VecX& last_velocity_change() const;
   // Whether the last step's solve held contact pairs between bodies.
   bool last_step_had_body_contact() const;
+  // An active contact pair between bodies of the last step's final linear solve
+  // (docs/gradients.md), as the adjoint holds it fixed: the impulse on j (on i the opposite) is
+  //   -(kappa mass / h) (gap0 + h normal.w1) normal - c P_t w1,  w1 = v1_j - v1_i,
+  // with c = kappa mass while it sticks, `viscosity` while it slides
+  // (solvers/contact/detail/implicit_body_contact.hpp).
+  struct SolvedPair {
+    int i = 0, j = 0;
+    Vec3 normal = Vec3::UnitY();  // from x_i0 to x_j0
+    Real gap0 = 0;                // |x_j0 - x_i0| - (r_i + r_j)
+    Real mass = 0;                // reduced mass (a pinned partner is infinitely heavy)
+    Real approach = 0;            // -(w0 . normal) at the start of the step
+    Real kappa = 0;
+    bool slide = false;
+    Real viscosity = 0;  // sliding only
+  };
+  // The active pairs of the last step's final solve (empty when it had none).
+  const std::vector<SolvedPair>& last_pairs() const;
 
  protected:
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;

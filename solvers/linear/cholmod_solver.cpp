@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <string>
 
 #include <jelly/core/detail/parallel.hpp>
@@ -204,6 +205,11 @@ LinearResult CholmodSolver::analyze(const SparseMatrix& a) {
   impl_->common.supernodal =
       a.rows() >= impl_->options.supernodal_min_rows ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
   {
+    // One analysis at a time in the process: METIS keeps its random generator's state in
+    // globals, so two orderings computed at once (fit windows or Ceres residual blocks on
+    // several threads) interleave it and come out as the timing makes them.
+    static std::mutex analysis;
+    const std::lock_guard<std::mutex> one_at_a_time(analysis);
     const parallel::SerialLibraries serial;
     impl_->factor = cholmod_analyze(&impl_->view, &impl_->common);
   }

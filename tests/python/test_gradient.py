@@ -1,6 +1,8 @@
 """jelly.gradient (the discrete adjoint of implicit_euler, docs/gradients.md) against central
 finite differences of the loss, and its messages for bad paths and shapes."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -153,3 +155,55 @@ def test_external_force_parameters_agree_with_finite_differences():
         jelly.gradient(forced_scene(), STEPS * DT, loss, ["bodies[0].forces[0].drag"])
     with pytest.raises(jelly.InputError, match="a force index below 2"):
         jelly.gradient(forced_scene(), STEPS * DT, loss, ["bodies[0].forces[2].gust"])
+
+
+def stacked_scene(overrides=None):
+    """A cube landing on another that rests on a sticky floor, moving sideways: frictionless
+    contact between the bodies inside the solve at every step."""
+    def cube(name, y, mass, ks, velocity):
+        return {"kind": "cube", "name": name, "n": 3, "edge_length": 0.3,
+                "origin": [0, y, 0], "particle_mass": mass, "velocity": velocity,
+                "springs": {t: {"ks": ks, "kd": 0.02 * ks} for t in
+                            ("structural", "shear", "bending")}}
+    scene = {
+        "bodies": [cube("lower", 0.002, 0.3, 800, [0, 0, 0]),
+                   cube("upper", 0.302 + 0.1505, 0.1, 300, [0.1, -0.05, 0])],
+        "gravity": [0, -9.8, 0],
+        "terrains": [{"kind": "plane", "point": [0, 0, 0], "normal": [0, 1, 0],
+                      "contact": {"model": "coulomb", "restitution": 0, "friction": 3,
+                                  "static_friction": 3}}],
+        "body_contact": {"restitution": 0, "friction": 0, "static_friction": 0},
+        "integrator": {"name": "implicit_euler", "dt": 0.01},
+        "duration": 0.1,
+    }
+    return jelly.Scene(scene, overrides or {})
+
+
+STACK_WEIGHTS = np.random.default_rng(4).uniform(-1, 1, (54, 3))
+
+
+def stack_loss(x, v):
+    return float((STACK_WEIGHTS * x).sum() + 0.05 * (v * v).sum()), STACK_WEIGHTS.copy(), 0.1 * v
+
+
+def test_contact_between_bodies_agrees_with_finite_differences():
+    wrt = ["bodies[1].springs.structural.ks", "bodies[0].mass", "bodies[1].velocity"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nothing held: frictionless pairs, no restitution
+        L, grads = jelly.gradient(stacked_scene(), 0.1, stack_loss, wrt)
+
+    def fd(overrides_of, eps):
+        plus = jelly.gradient(stacked_scene(overrides_of(eps)), 0.1, stack_loss, [])[0]
+        minus = jelly.gradient(stacked_scene(overrides_of(-eps)), 0.1, stack_loss, [])[0]
+        return (plus - minus) / (2 * eps)
+
+    checks = {
+        "bodies[1].springs.structural.ks":
+            fd(lambda e: {"bodies[1].springs.structural.ks": 300 + e}, 1e-4),
+        "bodies[0].mass": fd(lambda e: {"bodies[0].particle_mass": 0.3 + e}, 1e-7),
+    }
+    for path, expected in checks.items():
+        assert abs(float(grads[path]) - expected) <= 1e-5 * abs(expected), \
+            (path, grads[path], expected)
+    expected = fd(lambda e: {"bodies[1].velocity": [0.1 + e, -0.05, 0]}, 1e-7)
+    assert abs(grads["bodies[1].velocity"][0] - expected) <= 1e-5 * abs(expected)
