@@ -121,6 +121,8 @@ def instances(tmp_path):
         "H5Recorder": recorder, "ImplicitEulerOptions": jelly.ImplicitEulerOptions(),
         "Integrator": sim.integrator, "IntegratorOptions": jelly.IntegratorOptions(),
         "Model": model, "Observer": Watch(), "Pins": model.pins, "Plane": jelly.Plane.slope(20),
+        "ProjectiveDynamicsOptions": jelly.ProjectiveDynamicsOptions(),
+        "VbdOptions": jelly.VbdOptions(), "XpbdOptions": jelly.XpbdOptions(),
         "RecorderOptions": jelly.RecorderOptions(), "Recording": jelly.read_recording(path),
         "Rollout": jelly.rollout(scene, [{}], 0.01, every=0.005), "RunReport": report,
         "Scene": scene, "Simulator": sim, "SimulatorOptions": jelly.SimulatorOptions(),

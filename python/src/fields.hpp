@@ -1,0 +1,102 @@
+#pragma once
+// Python properties from a field table (core/detail/field_table.hpp): one property per field,
+// typed as the table says (int, float, bool, str), documented with its help, what is allowed,
+// its default and unit. A write converts the value as a scene's JSON would be read (a choice's
+// unknown name raises InputError naming the field's scene path); ranges are checked by
+// validate() and when the options are used, as a scene's are. The class attribute `_fields`
+// lists (name, Python type name) for the stub check (tests/python/test_module.py).
+#include <string>
+
+#include <jelly/core/detail/field_table.hpp>
+#include <jelly/core/json.hpp>
+
+#include "common.hpp"
+
+namespace jelly::python {
+
+inline const char* python_type_of(FieldType type) {
+  switch (type) {
+    case FieldType::kInteger:
+      return "int";
+    case FieldType::kNumber:
+      return "float";
+    case FieldType::kBoolean:
+      return "bool";
+    case FieldType::kString:
+    case FieldType::kChoice:
+      return "str";
+  }
+  return "object";
+}
+
+template <typename S>
+std::string field_docstring(const Field<S>& f) {
+  const S defaults{};
+  std::string doc = std::string(f.help) + ". Allowed: " + f.allowed;
+  if (!f.unit.empty()) doc += "; unit: " + std::string(f.unit);
+  Json out = Json::object();
+  f.write(defaults, out, f.name);
+  return doc + "; default " + out[std::string(f.name)].dump() + ".";
+}
+
+// Defines the table's fields as properties of `cls` (the table must outlive the module: the
+// tables are function-local statics).
+template <typename S, typename... Extra>
+void def_fields(py::class_<S, Extra...>& cls, const FieldTable<S>& table) {
+  py::list names;
+  for (const Field<S>& field : table.fields) {
+    const Field<S>* f = &field;
+    const FieldTable<S>* t = &table;
+    const auto get = [f](const S& s) -> py::object {
+      Json out = Json::object();
+      f->write(s, out, f->name);
+      const Json& v = out[std::string(f->name)];
+      switch (f->type) {
+        case FieldType::kInteger:
+          return py::int_(v.get<long long>());
+        case FieldType::kNumber:
+          return py::float_(v.get<double>());
+        case FieldType::kBoolean:
+          return py::bool_(v.get<bool>());
+        default:
+          return py::str(v.get<std::string>());
+      }
+    };
+    const auto set = [f, t](S& s, const py::object& value) {
+      const std::string path = json_child(std::string(t->path), f->name);
+      Json v;
+      try {
+        switch (f->type) {
+          case FieldType::kInteger:
+            if (py::isinstance<py::bool_>(value)) throw py::cast_error();
+            v = value.cast<long long>();
+            break;
+          case FieldType::kNumber:
+            if (py::isinstance<py::bool_>(value)) throw py::cast_error();
+            v = value.cast<double>();
+            break;
+          case FieldType::kBoolean:
+            if (!py::isinstance<py::bool_>(value)) throw py::cast_error();
+            v = value.cast<bool>();
+            break;
+          default:
+            if (!py::isinstance<py::str>(value)) throw py::cast_error();
+            v = value.cast<std::string>();
+            break;
+        }
+      } catch (const py::cast_error&) {
+        throw InputError(path, py::repr(value).cast<std::string>(),
+                         std::string("a Python ") + python_type_of(f->type) + ": " + f->allowed);
+      }
+      Json object = Json::object();
+      object[std::string(f->name)] = v;
+      JsonFields fields(object, std::string(t->path));
+      f->read(fields, s, f->name);
+    };
+    cls.def_property(std::string(field.name).c_str(), get, set, field_docstring(field).c_str());
+    names.append(py::make_tuple(std::string(field.name), python_type_of(field.type)));
+  }
+  cls.attr("_fields") = py::tuple(names);
+}
+
+}  // namespace jelly::python

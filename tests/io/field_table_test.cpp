@@ -1,0 +1,146 @@
+// Every field of every field table (core/detail/field_table.hpp) through a scene: a valid
+// value other than the default is read, written and read back unchanged, and a bad value of
+// each constrained field is refused with a message naming the field's JSON path.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <jelly/core/errors.hpp>
+#include <jelly/core/json.hpp>
+#include <jelly/io/detail/field_reference.hpp>
+#include <jelly/io/scene.hpp>
+
+namespace jelly {
+namespace {
+
+const char* const kScene = R"({
+  "terrains": [{"kind": "slope"}],
+  "integrator": {"name": "rk4"},
+  "duration": 1
+})";
+
+bool is_integer(const FieldDoc& f) { return f.type == "integer"; }
+
+// Values of the field's type other than its default that it allows.
+std::vector<Json> valid_values(const FieldDoc& f) {
+  const Json fallback = Json::parse(f.default_text);
+  std::vector<Json> out;
+  if (f.type == "choice") {
+    for (const std::string& c : f.choices) {
+      if (Json(c) != fallback) out.emplace_back(c);
+    }
+  } else if (f.type == "boolean") {
+    out.emplace_back(!fallback.get<bool>());
+  } else if (f.type == "string") {
+    out.emplace_back("a_round_trip_value");
+  } else {
+    const FieldRange& r = f.range;
+    const double d = fallback.get<double>();
+    std::vector<double> candidates{
+        r.lo, r.hi, r.lo + 1, r.hi - 1, 2 * d, d + 1, d / 2, (r.lo + r.hi) / 2, 0.5, 1, 3};
+    for (double c : candidates) {
+      if (!std::isfinite(c) || !r.contains(c) || c == d) continue;
+      if (is_integer(f)) {
+        if (c != std::floor(c)) continue;
+        out.emplace_back(static_cast<long long>(c));
+      } else {
+        out.emplace_back(c);
+      }
+      break;
+    }
+  }
+  return out;
+}
+
+// Values of the field's JSON type that its constraint refuses.
+std::vector<Json> bad_values(const FieldDoc& f) {
+  std::vector<Json> out;
+  if (f.type == "choice") {
+    out.emplace_back("no_such_name");
+  } else if (f.type == "integer" || f.type == "number") {
+    const FieldRange& r = f.range;
+    for (double c : {r.lo, r.lo - 1, r.hi, r.hi + 1, r.lo - 0.5, r.hi + 0.5}) {
+      if (!std::isfinite(c) || r.contains(c) || (is_integer(f) && c != std::floor(c))) continue;
+      if (is_integer(f)) {
+        out.emplace_back(static_cast<long long>(c));
+      } else {
+        out.emplace_back(c);
+      }
+    }
+  }
+  return out;
+}
+
+std::string set(const std::string& path, const FieldDoc& f, const Json& value) {
+  return path + "." + f.name + "=" + value.dump();
+}
+
+TEST(FieldTables, TheReferenceListsEveryIntegratorOptionTable) {
+  const std::vector<FieldTableDoc> tables = scene_field_tables();
+  ASSERT_GE(tables.size(), 5u);
+  for (const FieldTableDoc& t : tables) {
+    EXPECT_FALSE(t.fields.empty()) << t.name;
+    EXPECT_FALSE(t.used_by.empty()) << t.name;
+    for (const FieldDoc& f : t.fields) {
+      EXPECT_FALSE(f.help.empty()) << t.name << "." << f.name;
+      EXPECT_FALSE(f.allowed.empty()) << t.name << "." << f.name;
+      EXPECT_NO_THROW(Json::parse(f.default_text)) << t.name << "." << f.name;
+    }
+  }
+  const std::string markdown = field_tables_markdown(tables);
+  EXPECT_THAT(markdown, ::testing::HasSubstr("| `newton_iterations` | integer | `1` |"));
+  const Json json = Json::parse(field_tables_json(tables));
+  EXPECT_EQ(json.size(), tables.size());
+}
+
+TEST(FieldTables, EveryFieldRoundTripsThroughAScene) {
+  int checked = 0;
+  for (const FieldTableDoc& t : scene_field_tables()) {
+    const std::string name_override = "integrator.name=\"" + t.used_by.back() + "\"";
+    for (const FieldDoc& f : t.fields) {
+      const std::vector<Json> values = valid_values(f);
+      ASSERT_FALSE(values.empty()) << t.name << "." << f.name << ": no valid value to try";
+      for (const Json& value : values) {
+        SCOPED_TRACE(t.name + "." + f.name + " = " + value.dump());
+        const Scene scene = parse_scene(kScene, {name_override, set(t.path, f, value)});
+        const std::string written = scene_to_json(scene);
+        EXPECT_EQ(Json::parse(written)["integrator"]["options"][f.name], value);
+        const Scene again = parse_scene(written);
+        EXPECT_EQ(scene_to_json(again), written);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 30);
+}
+
+TEST(FieldTables, ABadValueOfEachConstrainedFieldIsRefusedNamingTheField) {
+  int checked = 0;
+  for (const FieldTableDoc& t : scene_field_tables()) {
+    for (const std::string& integrator : t.used_by) {
+      const std::string name_override = "integrator.name=\"" + integrator + "\"";
+      for (const FieldDoc& f : t.fields) {
+        const std::vector<Json> values = bad_values(f);
+        EXPECT_EQ(values.empty(), !f.constrained) << t.name << "." << f.name;
+        for (const Json& value : values) {
+          SCOPED_TRACE(integrator + ": " + f.name + " = " + value.dump());
+          try {
+            parse_scene(kScene, {name_override, set(t.path, f, value)});
+            ADD_FAILURE() << "accepted";
+          } catch (const InputError& e) {
+            EXPECT_THAT(e.what(), ::testing::StartsWith(t.path + "." + f.name + " = "));
+            EXPECT_THAT(e.what(), ::testing::HasSubstr(f.allowed));
+          }
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_GE(checked, 30);
+}
+
+}  // namespace
+}  // namespace jelly
