@@ -196,6 +196,8 @@ std::string json_field_string(JsonFields& f, std::string_view key, const std::st
   return f.string_or(key, fallback);
 }
 std::string json_field_path(const JsonFields& f, std::string_view key) { return f.path(key); }
+bool json_field_has(const JsonFields& f, std::string_view key) { return f.has(key); }
+void json_field_reject_unknown(const JsonFields& f) { f.reject_unknown(); }
 
 void json_field_put(Json& out, std::string_view key, long long value) {
   out[std::string(key)] = value;

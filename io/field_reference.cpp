@@ -1,7 +1,9 @@
 #include <jelly/io/detail/field_reference.hpp>
 
 #include <jelly/core/json.hpp>
+#include <jelly/solvers/contact/detail/body_contact_fields.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
+#include <jelly/terrain/detail/contact_fields.hpp>
 
 namespace jelly {
 
@@ -12,6 +14,8 @@ std::vector<FieldTableDoc> scene_field_tables() {
       document_fields(projective_dynamics_fields(), {"projective_dynamics"}),
       document_fields(xpbd_fields(), {"xpbd"}),
       document_fields(vbd_fields(), {"vbd"}),
+      document_fields(contact_params_fields()),
+      document_fields(body_contact_fields()),
   };
 }
 

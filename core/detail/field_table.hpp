@@ -91,6 +91,9 @@ struct FieldTable {
   std::vector<Field<S>> fields;
   // Rules between fields, after each field's own: throws InputError naming prefix + field.
   void (*check)(const S& s, const std::string& prefix) = nullptr;
+  // Defaults that depend on other fields, after the fields are read and before validation
+  // (json_field_has says whether a key was given).
+  void (*after_read)(JsonFields& fields, S& s) = nullptr;
 };
 
 // A field as the reference and other generic readers see it, without its struct.
@@ -113,6 +116,8 @@ Real json_field_number(JsonFields& f, std::string_view key, Real fallback);
 bool json_field_boolean(JsonFields& f, std::string_view key, bool fallback);
 std::string json_field_string(JsonFields& f, std::string_view key, const std::string& fallback);
 std::string json_field_path(const JsonFields& f, std::string_view key);
+bool json_field_has(const JsonFields& f, std::string_view key);
+void json_field_reject_unknown(const JsonFields& f);
 void json_field_put(Json& out, std::string_view key, long long value);
 void json_field_put(Json& out, std::string_view key, Real value);
 void json_field_put(Json& out, std::string_view key, bool value);
@@ -251,11 +256,15 @@ void validate_fields(const FieldTable<S>& table, const S& s, const std::string& 
   if (table.check) table.check(s, prefix);
 }
 
-// Reads the table's keys of `fields` into `s` (missing keys keep their values), then validates
-// with the fields' JSON paths.
+// Reads the table's keys of `fields` into `s` (missing keys keep their values), refuses any
+// other key when `reject_unknown` (else the caller reads more keys of the object), then
+// validates with the fields' JSON paths.
 template <typename S>
-void read_fields(const FieldTable<S>& table, JsonFields& fields, S& s, const std::string& prefix) {
+void read_fields(const FieldTable<S>& table, JsonFields& fields, S& s, const std::string& prefix,
+                 bool reject_unknown = false) {
   for (const Field<S>& f : table.fields) f.read(fields, s, f.name);
+  if (table.after_read) table.after_read(fields, s);
+  if (reject_unknown) json_field_reject_unknown(fields);
   validate_fields(table, s, prefix);
 }
 

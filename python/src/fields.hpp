@@ -40,13 +40,14 @@ std::string field_docstring(const Field<S>& f) {
 }
 
 // Defines the table's fields as properties of `cls` (the table must outlive the module: the
-// tables are function-local statics).
+// tables are function-local statics). Messages name `path`.<field> (default: the table's scene
+// path).
 template <typename S, typename... Extra>
-void def_fields(py::class_<S, Extra...>& cls, const FieldTable<S>& table) {
+void def_fields(py::class_<S, Extra...>& cls, const FieldTable<S>& table, const char* path = "") {
   py::list names;
+  const std::string prefix = *path ? std::string(path) : std::string(table.path);
   for (const Field<S>& field : table.fields) {
     const Field<S>* f = &field;
-    const FieldTable<S>* t = &table;
     const auto get = [f](const S& s) -> py::object {
       Json out = Json::object();
       f->write(s, out, f->name);
@@ -62,8 +63,8 @@ void def_fields(py::class_<S, Extra...>& cls, const FieldTable<S>& table) {
           return py::str(v.get<std::string>());
       }
     };
-    const auto set = [f, t](S& s, const py::object& value) {
-      const std::string path = json_child(std::string(t->path), f->name);
+    const auto set = [f, prefix](S& s, const py::object& value) {
+      const std::string field_path = json_child(prefix, f->name);
       Json v;
       try {
         switch (f->type) {
@@ -85,12 +86,12 @@ void def_fields(py::class_<S, Extra...>& cls, const FieldTable<S>& table) {
             break;
         }
       } catch (const py::cast_error&) {
-        throw InputError(path, py::repr(value).cast<std::string>(),
+        throw InputError(field_path, py::repr(value).cast<std::string>(),
                          std::string("a Python ") + python_type_of(f->type) + ": " + f->allowed);
       }
       Json object = Json::object();
       object[std::string(f->name)] = v;
-      JsonFields fields(object, std::string(t->path));
+      JsonFields fields(object, prefix);
       f->read(fields, s, f->name);
     };
     cls.def_property(std::string(field.name).c_str(), get, set, field_docstring(field).c_str());
