@@ -2,6 +2,7 @@
 
 #include <jelly/core/json.hpp>
 #include <jelly/solvers/contact/detail/body_contact_fields.hpp>
+#include <jelly/solvers/detail/run_fields.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
 #include <jelly/terrain/detail/contact_fields.hpp>
 
@@ -16,6 +17,8 @@ std::vector<FieldTableDoc> scene_field_tables() {
       document_fields(vbd_fields(), {"vbd"}),
       document_fields(contact_params_fields()),
       document_fields(body_contact_fields()),
+      document_fields(divergence_fields()),
+      document_fields(crush_fields()),
   };
 }
 

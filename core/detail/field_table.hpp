@@ -27,17 +27,19 @@ enum class FieldType { kInteger, kNumber, kBoolean, kString, kChoice };
 // "integer", "number", "boolean", "string", "choice".
 std::string_view field_type_name(FieldType type);
 
-// A numeric field's allowed interval; numbers must also be finite. `or_zero`: 0 is allowed
-// besides the interval (an "off" value).
+// A numeric field's allowed interval; numbers must also be finite unless `finite` is false
+// (an infinite limit that means "not checked"; never NaN). `or_zero`: 0 is allowed besides the
+// interval (an "off" value).
 struct FieldRange {
   double lo = -std::numeric_limits<double>::infinity();
   double hi = std::numeric_limits<double>::infinity();
   bool lo_open = false;
   bool hi_open = false;
   bool or_zero = false;
+  bool finite = true;
 
   bool contains(double v) const {
-    if (!std::isfinite(v)) return false;
+    if (std::isnan(v) || (finite && !std::isfinite(v))) return false;
     if (or_zero && v == 0) return true;
     return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
   }
@@ -57,6 +59,10 @@ inline FieldRange range_above(double lo) {
 inline FieldRange range_finite() { return {}; }
 inline FieldRange range_or_zero(FieldRange r) {
   r.or_zero = true;
+  return r;
+}
+inline FieldRange range_or_infinite(FieldRange r) {
+  r.finite = false;
   return r;
 }
 

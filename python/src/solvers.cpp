@@ -8,6 +8,7 @@
 #include <jelly/core/measures.hpp>
 #include <jelly/io/run_limits.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/detail/run_fields.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/run_report.hpp>
@@ -306,12 +307,12 @@ void bind_solvers(py::module_& m) {
                (i.is_adaptive() ? ", adaptive" : "") + ", " + std::to_string(i.steps()) + " steps>";
       });
 
-  py::class_<DivergenceGuard>(m, "DivergenceGuard",
-                              "What counts as diverged (scene key divergence).")
-      .def(py::init<>(), "The defaults: 500 m/s, 1e4 m, no energy cap.")
-      .def_readwrite("max_speed", &DivergenceGuard::max_speed, "m/s.")
-      .def_readwrite("max_distance", &DivergenceGuard::max_distance, "m from the origin.")
-      .def_readwrite("max_energy", &DivergenceGuard::max_energy, "J; inf = not checked.");
+  py::class_<DivergenceGuard> divergence(m, "DivergenceGuard",
+                                         "What counts as diverged (scene key divergence).");
+  divergence.def(py::init<>(), "The defaults: 500 m/s, 1e4 m, no energy cap.");
+  def_fields(divergence, divergence_fields());
+  divergence.def_readwrite("max_energy", &DivergenceGuard::max_energy,
+                           "J; inf = not checked (not a scene key).");
 
   py::class_<SimulatorOptions>(m, "SimulatorOptions",
                                "Time step, output interval and divergence limits.")
