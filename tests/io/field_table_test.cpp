@@ -17,16 +17,16 @@
 namespace jelly {
 namespace {
 
-const char* const kScene = R"({
+const char* const kFieldScene = R"({
   "terrains": [{"kind": "slope"}],
   "integrator": {"name": "rk4"},
   "duration": 1
 })";
 
-bool is_integer(const FieldDoc& f) { return f.type == "integer"; }
+bool is_integer_field(const FieldDoc& f) { return f.type == "integer"; }
 
 // Values of the field's type other than its default that it allows.
-std::vector<Json> valid_values(const FieldDoc& f) {
+std::vector<Json> field_valid_values(const FieldDoc& f) {
   const Json fallback = Json::parse(f.default_text);
   std::vector<Json> out;
   if (f.type == "choice") {
@@ -44,7 +44,7 @@ std::vector<Json> valid_values(const FieldDoc& f) {
         r.lo, r.hi, r.lo + 1, r.hi - 1, 2 * d, d + 1, d / 2, (r.lo + r.hi) / 2, 0.5, 1, 3};
     for (double c : candidates) {
       if (!std::isfinite(c) || !r.contains(c) || c == d) continue;
-      if (is_integer(f)) {
+      if (is_integer_field(f)) {
         if (c != std::floor(c)) continue;
         out.emplace_back(static_cast<long long>(c));
       } else {
@@ -57,15 +57,16 @@ std::vector<Json> valid_values(const FieldDoc& f) {
 }
 
 // Values of the field's JSON type that its constraint refuses.
-std::vector<Json> bad_values(const FieldDoc& f) {
+std::vector<Json> field_bad_values(const FieldDoc& f) {
   std::vector<Json> out;
   if (f.type == "choice") {
     out.emplace_back("no_such_name");
   } else if (f.type == "integer" || f.type == "number") {
     const FieldRange& r = f.range;
     for (double c : {r.lo, r.lo - 1, r.hi, r.hi + 1, r.lo - 0.5, r.hi + 0.5}) {
-      if (!std::isfinite(c) || r.contains(c) || (is_integer(f) && c != std::floor(c))) continue;
-      if (is_integer(f)) {
+      if (!std::isfinite(c) || r.contains(c) || (is_integer_field(f) && c != std::floor(c)))
+        continue;
+      if (is_integer_field(f)) {
         out.emplace_back(static_cast<long long>(c));
       } else {
         out.emplace_back(c);
@@ -76,19 +77,19 @@ std::vector<Json> bad_values(const FieldDoc& f) {
 }
 
 // A table's path in the test scene: "terrains[i].contact" -> "terrains[0].contact".
-std::string scene_path(const std::string& path) {
+std::string table_scene_path(const std::string& path) {
   std::string out = path;
   for (std::size_t at = out.find("[i]"); at != std::string::npos; at = out.find("[i]"))
     out.replace(at, 3, "[0]");
   return out;
 }
 
-std::string set(const std::string& path, const FieldDoc& f, const Json& value) {
-  return scene_path(path) + "." + f.name + "=" + value.dump();
+std::string field_override(const std::string& path, const FieldDoc& f, const Json& value) {
+  return table_scene_path(path) + "." + f.name + "=" + value.dump();
 }
 
 // The object at a scene path ("terrains[0].contact") of a written scene.
-const Json& at(const Json& scene, const std::string& path) {
+const Json& json_at(const Json& scene, const std::string& path) {
   const Json* j = &scene;
   std::size_t start = 0;
   while (start <= path.size()) {
@@ -106,7 +107,7 @@ const Json& at(const Json& scene, const std::string& path) {
 }
 
 // The integrators a table's options are tried with: its users, or the scene's own (rk4).
-std::vector<std::string> integrators_of(const FieldTableDoc& t) {
+std::vector<std::string> table_integrators(const FieldTableDoc& t) {
   return t.used_by.empty() ? std::vector<std::string>{"rk4"} : t.used_by;
 }
 
@@ -131,15 +132,16 @@ TEST(FieldTables, TheReferenceListsEveryIntegratorOptionTable) {
 TEST(FieldTables, EveryFieldRoundTripsThroughAScene) {
   int checked = 0;
   for (const FieldTableDoc& t : scene_field_tables()) {
-    const std::string name_override = "integrator.name=\"" + integrators_of(t).back() + "\"";
+    const std::string name_override = "integrator.name=\"" + table_integrators(t).back() + "\"";
     for (const FieldDoc& f : t.fields) {
-      const std::vector<Json> values = valid_values(f);
+      const std::vector<Json> values = field_valid_values(f);
       ASSERT_FALSE(values.empty()) << t.name << "." << f.name << ": no valid value to try";
       for (const Json& value : values) {
         SCOPED_TRACE(t.name + "." + f.name + " = " + value.dump());
-        const Scene scene = parse_scene(kScene, {name_override, set(t.path, f, value)});
+        const Scene scene =
+            parse_scene(kFieldScene, {name_override, field_override(t.path, f, value)});
         const std::string written = scene_to_json(scene);
-        EXPECT_EQ(at(Json::parse(written), scene_path(t.path))[f.name], value);
+        EXPECT_EQ(json_at(Json::parse(written), table_scene_path(t.path))[f.name], value);
         const Scene again = parse_scene(written);
         EXPECT_EQ(scene_to_json(again), written);
         ++checked;
@@ -152,18 +154,19 @@ TEST(FieldTables, EveryFieldRoundTripsThroughAScene) {
 TEST(FieldTables, ABadValueOfEachConstrainedFieldIsRefusedNamingTheField) {
   int checked = 0;
   for (const FieldTableDoc& t : scene_field_tables()) {
-    for (const std::string& integrator : integrators_of(t)) {
+    for (const std::string& integrator : table_integrators(t)) {
       const std::string name_override = "integrator.name=\"" + integrator + "\"";
       for (const FieldDoc& f : t.fields) {
-        const std::vector<Json> values = bad_values(f);
+        const std::vector<Json> values = field_bad_values(f);
         EXPECT_EQ(values.empty(), !f.constrained) << t.name << "." << f.name;
         for (const Json& value : values) {
           SCOPED_TRACE(integrator + ": " + f.name + " = " + value.dump());
           try {
-            parse_scene(kScene, {name_override, set(t.path, f, value)});
+            parse_scene(kFieldScene, {name_override, field_override(t.path, f, value)});
             ADD_FAILURE() << "accepted";
           } catch (const InputError& e) {
-            EXPECT_THAT(e.what(), ::testing::StartsWith(scene_path(t.path) + "." + f.name + " = "));
+            EXPECT_THAT(e.what(),
+                        ::testing::StartsWith(table_scene_path(t.path) + "." + f.name + " = "));
             EXPECT_THAT(e.what(), ::testing::HasSubstr(f.allowed));
           }
           ++checked;
