@@ -176,6 +176,8 @@ std::string_view field_type_name(FieldType type) {
       return "string";
     case FieldType::kChoice:
       return "choice";
+    case FieldType::kVec3:
+      return "vec3";
   }
   return "unknown";
 }
@@ -195,6 +197,9 @@ bool json_field_boolean(JsonFields& f, std::string_view key, bool fallback) {
 std::string json_field_string(JsonFields& f, std::string_view key, const std::string& fallback) {
   return f.string_or(key, fallback);
 }
+Vec3 json_field_vec3(JsonFields& f, std::string_view key, const Vec3& fallback) {
+  return f.vec3_or(key, fallback);
+}
 std::string json_field_path(const JsonFields& f, std::string_view key) { return f.path(key); }
 bool json_field_has(const JsonFields& f, std::string_view key) { return f.has(key); }
 void json_field_reject_unknown(const JsonFields& f) { f.reject_unknown(); }
@@ -207,12 +212,16 @@ void json_field_put(Json& out, std::string_view key, bool value) { out[std::stri
 void json_field_put(Json& out, std::string_view key, const std::string& value) {
   out[std::string(key)] = value;
 }
+void json_field_put(Json& out, std::string_view key, const Vec3& value) {
+  out[std::string(key)] = json_of(value);
+}
 
 // As require() shows values (errors.hpp), so that messages read as before the tables.
 std::string json_field_text(long long value) { return to_text(value); }
 std::string json_field_text(Real value) { return to_text(value); }
 std::string json_field_text(bool value) { return value ? "true" : "false"; }
 std::string json_field_text(const std::string& value) { return "\"" + value + "\""; }
+std::string json_field_text(const Vec3& value) { return to_text(value.transpose()); }
 
 std::string json_field_dump(const std::function<void(Json&)>& write, std::string_view key) {
   Json out = Json::object();

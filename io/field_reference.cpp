@@ -1,10 +1,12 @@
 #include <jelly/io/detail/field_reference.hpp>
 
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 #include <jelly/solvers/contact/detail/body_contact_fields.hpp>
 #include <jelly/solvers/detail/run_fields.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
 #include <jelly/terrain/detail/contact_fields.hpp>
+#include <jelly/terrain/detail/terrain_fields.hpp>
 
 namespace jelly {
 
@@ -15,6 +17,9 @@ std::vector<FieldTableDoc> scene_field_tables() {
       document_fields(projective_dynamics_fields(), {"projective_dynamics"}),
       document_fields(xpbd_fields(), {"xpbd"}),
       document_fields(vbd_fields(), {"vbd"}),
+      document_fields(cube_shape_fields(), {"cube"}),
+      document_fields(plane_fields(), {"plane"}),
+      document_fields(slope_fields(), {"slope"}),
       document_fields(contact_params_fields()),
       document_fields(body_contact_fields()),
       document_fields(divergence_fields()),

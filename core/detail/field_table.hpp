@@ -23,8 +23,8 @@
 
 namespace jelly {
 
-enum class FieldType { kInteger, kNumber, kBoolean, kString, kChoice };
-// "integer", "number", "boolean", "string", "choice".
+enum class FieldType { kInteger, kNumber, kBoolean, kString, kChoice, kVec3 };
+// "integer", "number", "boolean", "string", "choice", "vec3".
 std::string_view field_type_name(FieldType type);
 
 // A numeric field's allowed interval; numbers must also be finite unless `finite` is false
@@ -75,7 +75,7 @@ struct Field {
   std::string_view help;  // one line
   // What a message says is allowed ("an integer in [1, 100]"); for choices "one of ...".
   std::string allowed;
-  FieldRange range;          // numbers and integers
+  FieldRange range;          // numbers and integers; a vec3's length (finite components)
   bool constrained = false;  // whether some value of its type is refused
   // Reads key `name` of `fields` into the member when present (marking it known); converts,
   // and for a choice refuses an unknown name, with an InputError naming the field's JSON path.
@@ -111,7 +111,9 @@ struct FieldDoc {
 };
 struct FieldTableDoc {
   std::string name, path, title;
-  std::vector<std::string> used_by;  // e.g. the integrators that read it
+  // The integrators that read it (integrator.options), or the kind it is (terrains[i],
+  // bodies[i]); empty for the other paths.
+  std::vector<std::string> used_by;
   std::vector<FieldDoc> fields;
 };
 
@@ -121,6 +123,7 @@ long long json_field_long(JsonFields& f, std::string_view key, long long fallbac
 Real json_field_number(JsonFields& f, std::string_view key, Real fallback);
 bool json_field_boolean(JsonFields& f, std::string_view key, bool fallback);
 std::string json_field_string(JsonFields& f, std::string_view key, const std::string& fallback);
+Vec3 json_field_vec3(JsonFields& f, std::string_view key, const Vec3& fallback);
 std::string json_field_path(const JsonFields& f, std::string_view key);
 bool json_field_has(const JsonFields& f, std::string_view key);
 void json_field_reject_unknown(const JsonFields& f);
@@ -128,10 +131,12 @@ void json_field_put(Json& out, std::string_view key, long long value);
 void json_field_put(Json& out, std::string_view key, Real value);
 void json_field_put(Json& out, std::string_view key, bool value);
 void json_field_put(Json& out, std::string_view key, const std::string& value);
+void json_field_put(Json& out, std::string_view key, const Vec3& value);
 std::string json_field_text(long long value);
 std::string json_field_text(Real value);
 std::string json_field_text(bool value);
 std::string json_field_text(const std::string& value);
+std::string json_field_text(const Vec3& value);
 // The JSON text of the value `write` puts under `key` in an empty object (the reference's
 // defaults: shortest round-trip numbers).
 std::string json_field_dump(const std::function<void(Json&)>& write, std::string_view key);
@@ -220,6 +225,24 @@ Field<field_detail::StructOf<M>> string_field(std::string_view name, std::string
   };
   f.write = [](const S& s, Json& out, std::string_view key) { json_field_put(out, key, s.*M); };
   f.valid = [](const S&, const FieldRange&) { return true; };
+  f.text = [](const S& s) { return json_field_text(s.*M); };
+  return f;
+}
+
+// A Vec3 member, a JSON array [x, y, z] of finite numbers whose length is in `length` (any:
+// range_finite()).
+template <auto M>
+Field<field_detail::StructOf<M>> vec3_field(std::string_view name, std::string_view unit,
+                                            FieldRange length, std::string allowed,
+                                            std::string_view help) {
+  using S = field_detail::StructOf<M>;
+  static_assert(std::is_same_v<field_detail::ValueOf<M>, Vec3>);
+  Field<S> f{name, FieldType::kVec3, unit, help, std::move(allowed), length, length.bounded()};
+  f.read = [](JsonFields& j, S& s, std::string_view key) { s.*M = json_field_vec3(j, key, s.*M); };
+  f.write = [](const S& s, Json& out, std::string_view key) { json_field_put(out, key, s.*M); };
+  f.valid = [](const S& s, const FieldRange& r) {
+    return (s.*M).allFinite() && r.contains((s.*M).norm());
+  };
   f.text = [](const S& s) { return json_field_text(s.*M); };
   return f;
 }

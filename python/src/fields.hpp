@@ -25,6 +25,8 @@ inline const char* python_type_of(FieldType type) {
     case FieldType::kString:
     case FieldType::kChoice:
       return "str";
+    case FieldType::kVec3:
+      return "list";
   }
   return "object";
 }
@@ -59,6 +61,8 @@ void def_fields(py::class_<S, Extra...>& cls, const FieldTable<S>& table, const 
           return py::float_(v.get<double>());
         case FieldType::kBoolean:
           return py::bool_(v.get<bool>());
+        case FieldType::kVec3:
+          return py::cast(v.get<std::vector<double>>());
         default:
           return py::str(v.get<std::string>());
       }
@@ -79,6 +83,9 @@ void def_fields(py::class_<S, Extra...>& cls, const FieldTable<S>& table, const 
           case FieldType::kBoolean:
             if (!py::isinstance<py::bool_>(value)) throw py::cast_error();
             v = value.cast<bool>();
+            break;
+          case FieldType::kVec3:
+            v = value.cast<std::vector<double>>();
             break;
           default:
             if (!py::isinstance<py::str>(value)) throw py::cast_error();

@@ -18,6 +18,7 @@ namespace jelly {
 namespace {
 
 const char* const kFieldScene = R"({
+  "bodies": [{"kind": "cube", "n": 3}],
   "terrains": [{"kind": "slope"}],
   "integrator": {"name": "rk4"},
   "duration": 1
@@ -37,6 +38,8 @@ std::vector<Json> field_valid_values(const FieldDoc& f) {
     out.emplace_back(!fallback.get<bool>());
   } else if (f.type == "string") {
     out.emplace_back("a_round_trip_value");
+  } else if (f.type == "vec3") {
+    out.push_back(Json::array({0.25, -2.0, 3.5}));
   } else {
     const FieldRange& r = f.range;
     const double d = fallback.get<double>();
@@ -61,6 +64,8 @@ std::vector<Json> field_bad_values(const FieldDoc& f) {
   std::vector<Json> out;
   if (f.type == "choice") {
     out.emplace_back("no_such_name");
+  } else if (f.type == "vec3") {
+    if (f.range.lo > 0) out.push_back(Json::array({0.0, 0.0, 0.0}));  // a length > lo
   } else if (f.type == "integer" || f.type == "number") {
     const FieldRange& r = f.range;
     for (double c : {r.lo, r.lo - 1, r.hi, r.hi + 1, r.lo - 0.5, r.hi + 0.5}) {
@@ -106,9 +111,26 @@ const Json& json_at(const Json& scene, const std::string& path) {
   return *j;
 }
 
+std::vector<std::string> with_override(std::vector<std::string> overrides,
+                                       const std::string& more) {
+  overrides.push_back(more);
+  return overrides;
+}
+
+bool is_integrator_options(const FieldTableDoc& t) { return t.path == "integrator.options"; }
+
 // The integrators a table's options are tried with: its users, or the scene's own (rk4).
 std::vector<std::string> table_integrators(const FieldTableDoc& t) {
-  return t.used_by.empty() ? std::vector<std::string>{"rk4"} : t.used_by;
+  return is_integrator_options(t) ? t.used_by : std::vector<std::string>{"rk4"};
+}
+
+// The overrides that make the scene use the table: its integrator, or its kind of terrain or
+// body at index 0 (replacing the scene's slope or cube).
+std::vector<std::string> table_overrides(const FieldTableDoc& t, const std::string& integrator) {
+  std::vector<std::string> out{"integrator.name=\"" + integrator + "\""};
+  if (!is_integrator_options(t) && !t.used_by.empty())
+    out.push_back(table_scene_path(t.path) + ".kind=\"" + t.used_by.front() + "\"");
+  return out;
 }
 
 TEST(FieldTables, TheReferenceListsEveryIntegratorOptionTable) {
@@ -116,7 +138,8 @@ TEST(FieldTables, TheReferenceListsEveryIntegratorOptionTable) {
   ASSERT_GE(tables.size(), 5u);
   for (const FieldTableDoc& t : tables) {
     EXPECT_FALSE(t.fields.empty()) << t.name;
-    EXPECT_EQ(t.used_by.empty(), t.path != "integrator.options") << t.name;
+    const bool kind_table = t.path == "terrains[i]" || t.path == "bodies[i]";
+    EXPECT_EQ(t.used_by.empty(), !kind_table && !is_integrator_options(t)) << t.name;
     for (const FieldDoc& f : t.fields) {
       EXPECT_FALSE(f.help.empty()) << t.name << "." << f.name;
       EXPECT_FALSE(f.allowed.empty()) << t.name << "." << f.name;
@@ -132,14 +155,14 @@ TEST(FieldTables, TheReferenceListsEveryIntegratorOptionTable) {
 TEST(FieldTables, EveryFieldRoundTripsThroughAScene) {
   int checked = 0;
   for (const FieldTableDoc& t : scene_field_tables()) {
-    const std::string name_override = "integrator.name=\"" + table_integrators(t).back() + "\"";
+    std::vector<std::string> overrides = table_overrides(t, table_integrators(t).back());
     for (const FieldDoc& f : t.fields) {
       const std::vector<Json> values = field_valid_values(f);
       ASSERT_FALSE(values.empty()) << t.name << "." << f.name << ": no valid value to try";
       for (const Json& value : values) {
         SCOPED_TRACE(t.name + "." + f.name + " = " + value.dump());
         const Scene scene =
-            parse_scene(kFieldScene, {name_override, field_override(t.path, f, value)});
+            parse_scene(kFieldScene, with_override(overrides, field_override(t.path, f, value)));
         const std::string written = scene_to_json(scene);
         EXPECT_EQ(json_at(Json::parse(written), table_scene_path(t.path))[f.name], value);
         const Scene again = parse_scene(written);
@@ -155,14 +178,14 @@ TEST(FieldTables, ABadValueOfEachConstrainedFieldIsRefusedNamingTheField) {
   int checked = 0;
   for (const FieldTableDoc& t : scene_field_tables()) {
     for (const std::string& integrator : table_integrators(t)) {
-      const std::string name_override = "integrator.name=\"" + integrator + "\"";
+      std::vector<std::string> overrides = table_overrides(t, integrator);
       for (const FieldDoc& f : t.fields) {
         const std::vector<Json> values = field_bad_values(f);
         EXPECT_EQ(values.empty(), !f.constrained) << t.name << "." << f.name;
         for (const Json& value : values) {
           SCOPED_TRACE(integrator + ": " + f.name + " = " + value.dump());
           try {
-            parse_scene(kFieldScene, {name_override, field_override(t.path, f, value)});
+            parse_scene(kFieldScene, with_override(overrides, field_override(t.path, f, value)));
             ADD_FAILURE() << "accepted";
           } catch (const InputError& e) {
             EXPECT_THAT(e.what(),
