@@ -50,7 +50,7 @@ std::string field_tables_markdown(const std::vector<FieldTableDoc>& tables) {
   for (const FieldTableDoc& t : tables) {
     out += "## `" + t.path + "`";
     if (!t.used_by.empty()) out += " of " + used_by_text(t);
-    out += "\n\n" + t.title + "; C++ and Python: `" + t.name + "`.\n\n";
+    out += "\n\n" + t.title + "; C++ type `" + t.name + "`.\n\n";
     out += "| key | type | default | unit | allowed | what |\n|---|---|---|---|---|---|\n";
     for (const FieldDoc& f : t.fields) {
       out += "| `" + f.name + "` | " + f.type + " | `" + cell(f.default_text) + "` | " +
