@@ -1,7 +1,7 @@
 // jelly's commands on the command line: simulate scenes (run), describe recordings (info), fit
-// coefficients to a recording (fit), list what a scene can name (list), watch scenes and
-// recordings (view), render videos (render), export surfaces for other tools (export), fill
-// surfaces with tetrahedra (mesh).
+// coefficients to a recording (fit), list what a scene can name (list) and its options (fields),
+// watch scenes and recordings (view), render videos (render), export surfaces for other tools
+// (export), fill surfaces with tetrahedra (mesh).
 #include <charconv>
 #include <cstdio>
 #include <exception>
@@ -158,6 +158,15 @@ int run_jelly(int argc, char** argv) {
                                       "List the integrators, body and terrain kinds, contact "
                                       "models, forces and optional parts, one per line");
 
+  std::string fields_format = "markdown";
+  CLI::App* fields =
+      app.add_subcommand("fields",
+                         "Print every scene option's key, type, default, unit and constraint (the "
+                         "field tables: the scene-key reference)");
+  fields->add_option("--format", fields_format, "markdown or json")
+      ->check(CLI::IsMember({"markdown", "json"}))
+      ->capture_default_str();
+
   ViewArgs view_args;
   CLI::App* view = app.add_subcommand(
       "view", "Watch a scene live (JSON) or replay a recording (.h5) in a window");
@@ -296,6 +305,7 @@ int run_jelly(int argc, char** argv) {
     if (xdmf->parsed()) return xdmf_command(xdmf_args);
     if (fit->parsed()) return fit_command(fit_args);
     if (list->parsed()) return list_command();
+    if (fields->parsed()) return fields_command(fields_format);
     if (view->parsed()) return view_command(view_args);
     if (render->parsed()) return render_command(render_args);
     if (export_cmd->parsed()) return export_command(export_args);

@@ -55,6 +55,8 @@ struct FitArgs {
 int fit_command(const FitArgs& args);
 // jelly list: integrators, terrain kinds and contact models, one line each.
 int list_command();
+// jelly fields [--format markdown|json]: the field tables of the scene options.
+int fields_command(const std::string& format);
 
 struct ViewArgs {
   std::string file;  // a scene (JSON: live) or a recording (.h5: replay)

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 
+#include <jelly/core/detail/field_table.hpp>
 #include <jelly/core/errors.hpp>
 
 namespace jelly {
@@ -161,5 +162,71 @@ void JsonFields::reject_unknown() const {
 }
 
 Json json_of(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+// The helpers of the field tables' factories (core/detail/field_table.hpp).
+std::string_view field_type_name(FieldType type) {
+  switch (type) {
+    case FieldType::kInteger:
+      return "integer";
+    case FieldType::kNumber:
+      return "number";
+    case FieldType::kBoolean:
+      return "boolean";
+    case FieldType::kString:
+      return "string";
+    case FieldType::kChoice:
+      return "choice";
+    case FieldType::kVec3:
+      return "vec3";
+  }
+  return "unknown";
+}
+
+int json_field_integer(JsonFields& f, std::string_view key, int fallback) {
+  return f.integer_or(key, fallback);
+}
+long long json_field_long(JsonFields& f, std::string_view key, long long fallback) {
+  return f.long_or(key, fallback);
+}
+Real json_field_number(JsonFields& f, std::string_view key, Real fallback) {
+  return f.number_or(key, fallback);
+}
+bool json_field_boolean(JsonFields& f, std::string_view key, bool fallback) {
+  return f.boolean_or(key, fallback);
+}
+std::string json_field_string(JsonFields& f, std::string_view key, const std::string& fallback) {
+  return f.string_or(key, fallback);
+}
+Vec3 json_field_vec3(JsonFields& f, std::string_view key, const Vec3& fallback) {
+  return f.vec3_or(key, fallback);
+}
+std::string json_field_path(const JsonFields& f, std::string_view key) { return f.path(key); }
+bool json_field_has(const JsonFields& f, std::string_view key) { return f.has(key); }
+void json_field_reject_unknown(const JsonFields& f) { f.reject_unknown(); }
+
+void json_field_put(Json& out, std::string_view key, long long value) {
+  out[std::string(key)] = value;
+}
+void json_field_put(Json& out, std::string_view key, Real value) { out[std::string(key)] = value; }
+void json_field_put(Json& out, std::string_view key, bool value) { out[std::string(key)] = value; }
+void json_field_put(Json& out, std::string_view key, const std::string& value) {
+  out[std::string(key)] = value;
+}
+void json_field_put(Json& out, std::string_view key, const Vec3& value) {
+  out[std::string(key)] = json_of(value);
+}
+
+// As require() shows values (errors.hpp), so that messages read as before the tables.
+std::string json_field_text(long long value) { return to_text(value); }
+std::string json_field_text(Real value) { return to_text(value); }
+std::string json_field_text(bool value) { return value ? "true" : "false"; }
+std::string json_field_text(const std::string& value) { return "\"" + value + "\""; }
+std::string json_field_text(const Vec3& value) { return to_text(value.transpose()); }
+
+std::string json_field_dump(const std::function<void(Json&)>& write, std::string_view key) {
+  Json out = Json::object();
+  write(out);
+  return out[std::string(key)].dump();
+}
 
 }  // namespace jelly

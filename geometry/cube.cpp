@@ -4,6 +4,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {
 
@@ -28,11 +29,26 @@ std::int64_t cube_spring_count(std::int64_t n) {
   return 3 * n * n * m + 6 * n * m * m + 4 * m * m * m + 3 * n * n * (n - 2);
 }
 
+const FieldTable<CubeShape>& cube_shape_fields() {
+  using C = CubeShape;
+  static const FieldTable<C> table{
+      "CubeShape",
+      "bodies[i]",
+      "An n x n x n lattice of particles (the seed's cube), springs as the seed report's",
+      {
+          integer_field<&C::n>("n", "", range_closed(2, 400), "an integer in [2, 400]",
+                               "Particles per edge"),
+          number_field<&C::edge_length>("edge_length", "m", range_above(0), "a finite length > 0",
+                                        "Edge length of the cube"),
+          vec3_field<&C::origin>("origin", "m", range_finite(), "finite coordinates",
+                                 "Where particle (0, 0, 0) sits"),
+      },
+  };
+  return table;
+}
+
 void CubeShape::validate(const std::string& prefix) const {
-  require(n >= 2 && n <= 400, prefix + "n", n, "an integer in [2, 400]");
-  require(std::isfinite(edge_length) && edge_length > 0, prefix + "edge_length", edge_length,
-          "a finite length > 0");
-  require(origin.allFinite(), prefix + "origin", origin.transpose(), "finite coordinates");
+  validate_fields(cube_shape_fields(), *this, prefix);
 }
 
 BodyPart CubeShape::build(const Material& material, const std::string& prefix) const {
@@ -44,18 +60,11 @@ BodyPart CubeShape::build(const Material& material, const std::string& prefix) c
   return build_lattice(grid, material, "cube");
 }
 
-void CubeShape::write(Json& j) const {
-  j["n"] = n;
-  j["edge_length"] = edge_length;
-  j["origin"] = json_of(origin);
-}
+void CubeShape::write(Json& j) const { write_fields(cube_shape_fields(), *this, j); }
 
 std::unique_ptr<BodyShape> CubeShape::read(JsonFields& f) {
   auto s = std::make_unique<CubeShape>();
-  s->n = f.integer_or("n", s->n);
-  s->edge_length = f.number_or("edge_length", s->edge_length);
-  s->origin = f.vec3_or("origin", s->origin);
-  s->validate(f.prefix());
+  read_fields(cube_shape_fields(), f, *s, f.prefix());
   return s;
 }
 

@@ -7,6 +7,7 @@
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/detail/scene_override.hpp>
 #include <jelly/io/scene.hpp>
+#include <jelly/solvers/detail/run_fields.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
@@ -97,16 +98,11 @@ Scene scene_from_json(const Json& j, const std::string& base_directory) {
   s.output_interval = root.number_or("output_interval", s.output_interval);
   if (const Json* d = root.value("divergence")) {
     JsonFields f(*d, "divergence");
-    s.divergence.max_speed = f.number_or("max_speed", s.divergence.max_speed);
-    s.divergence.max_distance = f.number_or("max_distance", s.divergence.max_distance);
-    f.reject_unknown();
+    read_fields(divergence_fields(), f, s.divergence, f.prefix(), /*reject_unknown=*/true);
   }
   if (const Json* c = root.value("crush")) {
     JsonFields f(*c, "crush");
-    s.crush.min_volume_ratio = f.number_or("min_volume_ratio", s.crush.min_volume_ratio);
-    s.crush.max_inverted_fraction =
-        f.number_or("max_inverted_fraction", s.crush.max_inverted_fraction);
-    f.reject_unknown();
+    read_fields(crush_fields(), f, s.crush, f.prefix(), /*reject_unknown=*/true);
   }
   s.threads = root.integer_or("threads", s.threads);
   root.reject_unknown();
@@ -138,13 +134,13 @@ std::string scene_to_json(const Scene& s) {
                      {"options", integrator_options_json(s.integrator.name, s.integrator.options)}};
   j["duration"] = s.duration;
   j["output_interval"] = s.output_interval;
-  j["divergence"] = {{"max_speed", s.divergence.max_speed},
-                     {"max_distance", s.divergence.max_distance}};
+  j["divergence"] = Json::object();
+  write_fields(divergence_fields(), s.divergence, j["divergence"]);
   const CrushLimits defaults;
   if (s.crush.min_volume_ratio != defaults.min_volume_ratio ||
       s.crush.max_inverted_fraction != defaults.max_inverted_fraction) {
-    j["crush"] = {{"min_volume_ratio", s.crush.min_volume_ratio},
-                  {"max_inverted_fraction", s.crush.max_inverted_fraction}};
+    j["crush"] = Json::object();
+    write_fields(crush_fields(), s.crush, j["crush"]);
   }
   j["threads"] = s.threads;
   return j.dump(2) + "\n";

@@ -6,14 +6,39 @@
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/solvers/detail/run_fields.hpp>
 
 namespace jelly {
 
-void DivergenceGuard::validate() const {
-  require(max_speed > 0, "divergence.max_speed", max_speed, "a speed > 0 m/s");
-  require(max_distance > 0, "divergence.max_distance", max_distance, "a distance > 0 m");
-  require(!std::isnan(max_energy), "divergence.max_energy", max_energy,
+namespace {
+
+void check_max_energy(const DivergenceGuard& g, const std::string& prefix) {
+  require(!std::isnan(g.max_energy), prefix + "max_energy", g.max_energy,
           "an energy in J (infinite = not checked)");
+}
+
+}  // namespace
+
+const FieldTable<DivergenceGuard>& divergence_fields() {
+  using G = DivergenceGuard;
+  static const FieldTable<G> table{
+      "DivergenceGuard",
+      "divergence",
+      "What counts as diverged: a run that passes a limit stops with status diverged",
+      {
+          number_field<&G::max_speed>("max_speed", "m/s", range_or_infinite(range_above(0)),
+                                      "a speed > 0 m/s", "A faster particle stops the run"),
+          number_field<&G::max_distance>("max_distance", "m", range_or_infinite(range_above(0)),
+                                         "a distance > 0 m",
+                                         "A particle farther from the origin stops the run"),
+      },
+      &check_max_energy,
+  };
+  return table;
+}
+
+void DivergenceGuard::validate() const {
+  validate_fields(divergence_fields(), *this, "divergence.");
 }
 
 std::optional<std::string> DivergenceGuard::check(const State& s, int threads) const {

@@ -5,6 +5,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/solvers/detail/run_fields.hpp>
 
 namespace jelly {
 
@@ -31,14 +32,27 @@ std::string RunReport::brief() const {
   return out;
 }
 
-void CrushLimits::validate() const {
-  require(std::isfinite(min_volume_ratio) && min_volume_ratio >= 0 && min_volume_ratio <= 1,
-          "crush.min_volume_ratio", min_volume_ratio, "a number in [0, 1] (0: never by volume)");
-  require(std::isfinite(max_inverted_fraction) && max_inverted_fraction >= 0 &&
-              max_inverted_fraction <= 1,
-          "crush.max_inverted_fraction", max_inverted_fraction,
-          "a number in [0, 1] (1: never by inverted cells)");
+const FieldTable<CrushLimits>& crush_fields() {
+  using C = CrushLimits;
+  static const FieldTable<C> table{
+      "CrushLimits",
+      "crush",
+      "When a run that reaches its end ends completed_with_warnings naming a crushed body "
+      "(docs/output.md)",
+      {
+          number_field<&C::min_volume_ratio>(
+              "min_volume_ratio", "", range_closed(0, 1), "a number in [0, 1] (0: never by volume)",
+              "A body's volume below this fraction of its rest volume; 0 = never by volume"),
+          number_field<&C::max_inverted_fraction>(
+              "max_inverted_fraction", "", range_closed(0, 1),
+              "a number in [0, 1] (1: never by inverted cells)",
+              "More than this fraction of a body's cells (tetrahedra) inverted; 1 = never"),
+      },
+  };
+  return table;
 }
+
+void CrushLimits::validate() const { validate_fields(crush_fields(), *this, "crush."); }
 
 void report_crushed_bodies(const Model& model, const VecX& x, const CrushLimits& limits,
                            RunReport& report) {

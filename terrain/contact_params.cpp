@@ -4,6 +4,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/terrain/detail/contact_fields.hpp>
 
 namespace jelly {
 
@@ -26,41 +27,54 @@ ContactModel contact_model_from_name(std::string_view name, std::string_view fie
   return value_of(contact_models(), name, field);
 }
 
+namespace {
+
+void check_contact_friction(const ContactParams& c, const std::string& prefix) {
+  require(c.static_friction >= c.friction, prefix + "static_friction", c.static_friction,
+          "a finite number >= friction (" + to_text(c.friction) + ")");
+}
+
+}  // namespace
+
+const FieldTable<ContactParams>& contact_params_fields() {
+  using C = ContactParams;
+  static const FieldTable<C> table{
+      "ContactParams",
+      "terrains[i].contact",
+      "How a terrain answers a particle that touches it (docs/contact.md)",
+      {
+          choice_field<&C::model, &contact_models>("model", "The contact model"),
+          number_field<&C::restitution>("restitution", "", range_closed(0, 1), "a number in [0, 1]",
+                                        "Normal velocity kept, reversed, by a bounce"),
+          number_field<&C::friction>("friction", "", range_at_least(0), "a finite number >= 0",
+                                     "Kinetic mu (coulomb), the report's friction (seed)"),
+          number_field<&C::static_friction>(
+              "static_friction", "", range_finite(), "a finite number >= friction",
+              "Coulomb: sticking while |v_t| <= static_friction dv_n; >= friction"),
+          number_field<&C::epsilon>("epsilon", "m", range_above(0), "a finite distance > 0",
+                                    "Seed: contact distance"),
+          number_field<&C::resting_speed>("resting_speed", "m/s", range_at_least(0),
+                                          "a finite speed >= 0",
+                                          "Coulomb: the slowest approach that bounces"),
+      },
+      &check_contact_friction,
+  };
+  return table;
+}
+
 void ContactParams::validate(const std::string& prefix) const {
-  require(std::isfinite(restitution) && restitution >= 0 && restitution <= 1,
-          prefix + "restitution", restitution, "a number in [0, 1]");
-  require(std::isfinite(friction) && friction >= 0, prefix + "friction", friction,
-          "a finite number >= 0");
-  require(std::isfinite(static_friction) && static_friction >= friction, prefix + "static_friction",
-          static_friction, "a finite number >= friction (" + to_text(friction) + ")");
-  require(std::isfinite(epsilon) && epsilon > 0, prefix + "epsilon", epsilon,
-          "a finite distance > 0");
-  require(std::isfinite(resting_speed) && resting_speed >= 0, prefix + "resting_speed",
-          resting_speed, "a finite speed >= 0");
+  validate_fields(contact_params_fields(), *this, prefix);
 }
 
 ContactParams ContactParams::read(JsonFields& f) {
   ContactParams c;
-  c.model = contact_model_from_name(f.string_or("model", std::string(contact_model_name(c.model))),
-                                    f.path("model"));
-  c.restitution = f.number_or("restitution", c.restitution);
-  c.friction = f.number_or("friction", c.friction);
-  c.static_friction = f.number_or("static_friction", c.static_friction);
-  c.epsilon = f.number_or("epsilon", c.epsilon);
-  c.resting_speed = f.number_or("resting_speed", c.resting_speed);
-  f.reject_unknown();
-  c.validate(f.prefix());
+  read_fields(contact_params_fields(), f, c, f.prefix(), /*reject_unknown=*/true);
   return c;
 }
 
 Json ContactParams::to_json() const {
-  Json j;
-  j["model"] = std::string(contact_model_name(model));
-  j["restitution"] = restitution;
-  j["friction"] = friction;
-  j["static_friction"] = static_friction;
-  j["epsilon"] = epsilon;
-  j["resting_speed"] = resting_speed;
+  Json j = Json::object();
+  write_fields(contact_params_fields(), *this, j);
   return j;
 }
 

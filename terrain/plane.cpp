@@ -4,6 +4,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/terrain/detail/terrain_fields.hpp>
 
 namespace jelly {
 
@@ -25,49 +26,68 @@ Plane Plane::slope(Real angle_degrees, const Vec3& point, ContactParams contact)
 
 TriangleMesh Plane::render_mesh() const { return square_mesh(normal_, kRenderSize); }
 
+const FieldTable<PlaneSpec>& plane_fields() {
+  using P = PlaneSpec;
+  static const FieldTable<P> table{
+      "PlaneSpec",
+      "terrains[i]",
+      "A fixed plane through `point` with outward `normal`",
+      {
+          vec3_field<&P::point>("point", "m", range_finite(), "finite coordinates",
+                                "A point of the plane"),
+          vec3_field<&P::normal>("normal", "", range_above(1e-12), "a finite, non-zero vector",
+                                 "The outward normal (any length but zero)"),
+      },
+  };
+  return table;
+}
+
 void PlaneSpec::validate(const std::string& prefix) const {
-  require(point.allFinite(), prefix + "point", point.transpose(), "finite coordinates");
-  require(normal.allFinite() && normal.norm() > 1e-12, prefix + "normal", normal.transpose(),
-          "a finite, non-zero vector");
+  validate_fields(plane_fields(), *this, prefix);
 }
 
 std::unique_ptr<Terrain> PlaneSpec::make() const {
   return std::make_unique<Plane>(point, normal, contact);
 }
 
-void PlaneSpec::write(Json& object) const {
-  object["point"] = json_of(point);
-  object["normal"] = json_of(normal);
-}
+void PlaneSpec::write(Json& object) const { write_fields(plane_fields(), *this, object); }
 
 std::unique_ptr<TerrainSpec> PlaneSpec::read(JsonFields& f) {
   auto spec = std::make_unique<PlaneSpec>();
-  spec->point = f.vec3_or("point", spec->point);
-  spec->normal = f.vec3_or("normal", spec->normal);
-  spec->validate(f.prefix());
+  read_fields(plane_fields(), f, *spec, f.prefix());
   return spec;
 }
 
+const FieldTable<SlopeSpec>& slope_fields() {
+  using S = SlopeSpec;
+  static const FieldTable<S> table{
+      "SlopeSpec",
+      "terrains[i]",
+      "A plane through `point` tilted by `angle_degrees` about z: normal (sin a, cos a, 0)",
+      {
+          number_field<&S::angle_degrees>("angle_degrees", "degrees", range_open(-90, 90),
+                                          "an angle in (-90, 90) degrees",
+                                          "The tilt about the z axis"),
+          vec3_field<&S::point>("point", "m", range_finite(), "finite coordinates",
+                                "A point of the plane"),
+      },
+  };
+  return table;
+}
+
 void SlopeSpec::validate(const std::string& prefix) const {
-  require(std::isfinite(angle_degrees) && std::abs(angle_degrees) < 90, prefix + "angle_degrees",
-          angle_degrees, "an angle in (-90, 90) degrees");
-  require(point.allFinite(), prefix + "point", point.transpose(), "finite coordinates");
+  validate_fields(slope_fields(), *this, prefix);
 }
 
 std::unique_ptr<Terrain> SlopeSpec::make() const {
   return std::make_unique<Plane>(Plane::slope(angle_degrees, point, contact));
 }
 
-void SlopeSpec::write(Json& object) const {
-  object["angle_degrees"] = angle_degrees;
-  object["point"] = json_of(point);
-}
+void SlopeSpec::write(Json& object) const { write_fields(slope_fields(), *this, object); }
 
 std::unique_ptr<TerrainSpec> SlopeSpec::read(JsonFields& f) {
   auto spec = std::make_unique<SlopeSpec>();
-  spec->angle_degrees = f.number_or("angle_degrees", spec->angle_degrees);
-  spec->point = f.vec3_or("point", spec->point);
-  spec->validate(f.prefix());
+  read_fields(slope_fields(), f, *spec, f.prefix());
   return spec;
 }
 

@@ -14,8 +14,10 @@ from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module f
     DLPackExport, dlpack,
     Elevator, ElevatorSpec, ExternalForce, FitOptions, Force, FitResult, FittedParameter, H5Recorder,
     ImplicitEulerOptions, InputError, Integrator, IntegratorOptions, Model, Observer, Pins, Plane,
-    RecorderOptions, Recording, Rollout, RunReport, SimulatorOptions, SimulatorSnapshot, Simulator,
-    SpringCoefficients, Springs, SpringType, State, StepResult, Surface, Terrain, __version__,
+    ProjectiveDynamicsOptions, RecorderOptions, Recording, Rollout, RunReport, SimulatorOptions,
+    SimulatorSnapshot, Simulator,
+    SpringCoefficients, Springs, SpringType, State, StepResult, Surface, Terrain, VbdOptions,
+    XpbdOptions, __version__,
     angular_momentum, apply_override, body_kinds, build_cube, center_of_mass, check_same_scene,
     contact_models, cube_index, cube_particle_count, cube_spring_count, describe_recording,
     elastic_energy, gravitational_energy, integrator_infos, integrator_names, kinetic_energy,
@@ -88,8 +90,8 @@ Recording.scene = property(_recording_scene, doc=_recording_scene.__doc__)
 # its springs' coefficients). They pickle (Dask sends them, copy.deepcopy copies them) and print
 # as their fields.
 _OPTION_CLASSES = (ArkodeOptions, ContactParams, CubeSpec, DivergenceGuard, ElevatorSpec,
-                   FitOptions, ImplicitEulerOptions, IntegratorOptions, RecorderOptions,
-                   SimulatorOptions)
+                   FitOptions, ImplicitEulerOptions, IntegratorOptions, ProjectiveDynamicsOptions,
+                   RecorderOptions, SimulatorOptions, VbdOptions, XpbdOptions)
 
 
 def _option_fields(cls: type) -> list:

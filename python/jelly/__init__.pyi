@@ -300,9 +300,37 @@ class ArkodeOptions:
     max_steps: int
     def __init__(self) -> None: ...
 
+class ProjectiveDynamicsOptions:
+    iterations: int
+    tolerance: float
+    chebyshev: bool
+    chebyshev_rho: float
+    chebyshev_gamma: float
+    chebyshev_delay: int
+    contact: str
+    ordering: str
+    def __init__(self) -> None: ...
+
+class XpbdOptions:
+    substeps: int
+    iterations: int
+    sweep: str
+    contact: str
+    def __init__(self) -> None: ...
+
+class VbdOptions:
+    iterations: int
+    chebyshev_rho: float
+    damping: float
+    contact_hardness: float
+    def __init__(self) -> None: ...
+
 class IntegratorOptions:
     implicit: ImplicitEulerOptions
     arkode: ArkodeOptions
+    pd: ProjectiveDynamicsOptions
+    xpbd: XpbdOptions
+    vbd: VbdOptions
     def __init__(self) -> None: ...
     def validate(self) -> None: ...
 

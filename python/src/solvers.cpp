@@ -8,6 +8,8 @@
 #include <jelly/core/measures.hpp>
 #include <jelly/io/run_limits.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/detail/run_fields.hpp>
+#include <jelly/solvers/integrators/detail/option_fields.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/simulator.hpp>
@@ -15,24 +17,11 @@
 #include <jelly/terrain/plane.hpp>
 
 #include "common.hpp"
+#include "fields.hpp"
 
 namespace jelly::python {
 
 namespace {
-
-// A named choice of an options struct as a Python str, read and written through its name table;
-// a name outside the table raises jelly.InputError naming integrator.options.<field>.
-template <typename Options, typename E>
-auto choice_getter(E Options::*member, const std::vector<EnumName<E>>& (*table)()) {
-  return [member, table](const Options& o) { return std::string(name_of(table(), o.*member)); };
-}
-template <typename Options, typename E>
-auto choice_setter(E Options::*member, const std::vector<EnumName<E>>& (*table)(),
-                   const char* field) {
-  return [member, table, field](Options& o, const std::string& name) {
-    o.*member = value_of(table(), name, std::string("integrator.options.") + field);
-  };
-}
 
 // An Observer subclassed in Python (on_frame, optionally on_finish). Called with the GIL
 // released by run_until, so each call takes it back. The simulator is passed by pointer so that
@@ -259,63 +248,25 @@ void bind_solvers(py::module_& m) {
       },
       "Every registered integrator as {name: description}, sorted by name.");
 
-  py::class_<ImplicitEulerOptions>(m, "ImplicitEulerOptions",
-                                   "Options of implicit_euler (docs/implicit.md).")
-      .def(py::init<>(), "The defaults.")
-      .def_readwrite("newton_iterations", &ImplicitEulerOptions::newton_iterations,
-                     "1 = linearized backward Euler; > 1 = Newton, at most this many solves.")
-      .def_readwrite("newton_tolerance", &ImplicitEulerOptions::newton_tolerance,
-                     "Newton's relative tolerance.")
-      .def_property(
-          "definiteness", choice_getter(&ImplicitEulerOptions::definiteness, definiteness_fixes),
-          choice_setter(&ImplicitEulerOptions::definiteness, definiteness_fixes, "definiteness"),
-          "\"clamp\", \"project\" or \"none\".")
-      .def_property("linear_solver",
-                    choice_getter(&ImplicitEulerOptions::linear_solver, implicit_linear_solvers),
-                    choice_setter(&ImplicitEulerOptions::linear_solver, implicit_linear_solvers,
-                                  "linear_solver"),
-                    "\"auto\", \"cholmod\", \"ldlt\" or \"cg\".")
-      .def_property(
-          "cg_preconditioner",
-          choice_getter(&ImplicitEulerOptions::cg_preconditioner, cg_preconditioner_kinds),
-          choice_setter(&ImplicitEulerOptions::cg_preconditioner, cg_preconditioner_kinds,
-                        "cg_preconditioner"),
-          "\"jacobi\", \"cholmod\" or \"multigrid\" (lattice bodies; docs/implicit.md).")
-      .def_readwrite("cg_tolerance", &ImplicitEulerOptions::cg_tolerance,
-                     "Relative residual of CG.")
-      .def_readwrite("contact_screening_tolerance",
-                     &ImplicitEulerOptions::contact_screening_tolerance,
-                     "A looser CG residual at which each solve of a step with contacts first "
-                     "checks the contacts' set (default 1e-3; 0 = off; docs/implicit.md).")
-      .def_readwrite("cg_max_iterations", &ImplicitEulerOptions::cg_max_iterations,
-                     "CG iteration cap.")
-      .def_readwrite("refactor_iterations", &ImplicitEulerOptions::refactor_iterations,
-                     "CG iterations that trigger a new CHOLMOD preconditioner.")
-      .def_property("ordering", choice_getter(&ImplicitEulerOptions::ordering, cholmod_orderings),
-                    choice_setter(&ImplicitEulerOptions::ordering, cholmod_orderings, "ordering"),
-                    "\"metis\", \"amd\", \"nesdis\" or \"best\".")
-      .def_property(
-          "contact", choice_getter(&ImplicitEulerOptions::contact, implicit_contact_modes),
-          choice_setter(&ImplicitEulerOptions::contact, implicit_contact_modes, "contact"),
-          "\"implicit\" or \"after_step\".")
-      .def_readwrite("contact_iterations", &ImplicitEulerOptions::contact_iterations,
-                     "Solves per step while the contact set changes.");
-
-  py::class_<ArkodeOptions>(m, "ArkodeOptions",
-                            "Options of arkode_erk and arkode_dirk (docs/arkode.md).")
-      .def(py::init<>(), "The defaults.")
-      .def_readwrite("rtol", &ArkodeOptions::rtol, "Relative tolerance.")
-      .def_readwrite("atol", &ArkodeOptions::atol, "Absolute tolerance.")
-      .def_readwrite("method", &ArkodeOptions::method,
-                     "An ARKODE Butcher table name; empty = default.")
-      .def_readwrite("max_step", &ArkodeOptions::max_step, "Largest internal step (s); 0 = dt.")
-      .def_property(
-          "linear_solver", choice_getter(&ArkodeOptions::linear_solver, arkode_linear_solvers),
-          choice_setter(&ArkodeOptions::linear_solver, arkode_linear_solvers, "linear_solver"),
-          "arkode_dirk: \"auto\" (= \"cg\"), \"cg\", \"jacobi\", \"gmres\", "
-          "\"schur\" or \"klu\".")
-      .def_readwrite("max_steps", &ArkodeOptions::max_steps,
-                     "Internal steps per contact interval.");
+  // The options classes' properties come from their field tables (fields.hpp).
+  py::class_<ImplicitEulerOptions> implicit(m, "ImplicitEulerOptions",
+                                            "Options of implicit_euler (docs/implicit.md).");
+  implicit.def(py::init<>(), "The defaults.");
+  def_fields(implicit, implicit_euler_fields());
+  py::class_<ArkodeOptions> arkode(m, "ArkodeOptions",
+                                   "Options of arkode_erk and arkode_dirk (docs/arkode.md).");
+  arkode.def(py::init<>(), "The defaults.");
+  def_fields(arkode, arkode_fields());
+  py::class_<ProjectiveDynamicsOptions> pd(m, "ProjectiveDynamicsOptions",
+                                           "Options of projective_dynamics (docs/realtime.md).");
+  pd.def(py::init<>(), "The defaults.");
+  def_fields(pd, projective_dynamics_fields());
+  py::class_<XpbdOptions> xpbd(m, "XpbdOptions", "Options of xpbd (docs/realtime.md).");
+  xpbd.def(py::init<>(), "The defaults.");
+  def_fields(xpbd, xpbd_fields());
+  py::class_<VbdOptions> vbd(m, "VbdOptions", "Options of vbd (docs/realtime.md).");
+  vbd.def(py::init<>(), "The defaults.");
+  def_fields(vbd, vbd_fields());
 
   py::class_<IntegratorOptions>(
       m, "IntegratorOptions",
@@ -324,11 +275,17 @@ void bind_solvers(py::module_& m) {
       .def_readwrite("implicit", &IntegratorOptions::implicit, "implicit_euler's options.")
       .def_readwrite("arkode", &IntegratorOptions::arkode,
                      "arkode_erk's and arkode_dirk's options.")
+      .def_readwrite("pd", &IntegratorOptions::pd, "projective_dynamics' options.")
+      .def_readwrite("xpbd", &IntegratorOptions::xpbd, "xpbd's options.")
+      .def_readwrite("vbd", &IntegratorOptions::vbd, "vbd's options.")
       .def(
           "validate",
           [](const IntegratorOptions& o) {
             o.implicit.validate("integrator.options.");
             o.arkode.validate("integrator.options.");
+            o.pd.validate("integrator.options.");
+            o.xpbd.validate("integrator.options.");
+            o.vbd.validate("integrator.options.");
           },
           "Raises InputError naming the first invalid option.");
 
@@ -350,12 +307,12 @@ void bind_solvers(py::module_& m) {
                (i.is_adaptive() ? ", adaptive" : "") + ", " + std::to_string(i.steps()) + " steps>";
       });
 
-  py::class_<DivergenceGuard>(m, "DivergenceGuard",
-                              "What counts as diverged (scene key divergence).")
-      .def(py::init<>(), "The defaults: 500 m/s, 1e4 m, no energy cap.")
-      .def_readwrite("max_speed", &DivergenceGuard::max_speed, "m/s.")
-      .def_readwrite("max_distance", &DivergenceGuard::max_distance, "m from the origin.")
-      .def_readwrite("max_energy", &DivergenceGuard::max_energy, "J; inf = not checked.");
+  py::class_<DivergenceGuard> divergence(m, "DivergenceGuard",
+                                         "What counts as diverged (scene key divergence).");
+  divergence.def(py::init<>(), "The defaults: 500 m/s, 1e4 m, no energy cap.");
+  def_fields(divergence, divergence_fields());
+  divergence.def_readwrite("max_energy", &DivergenceGuard::max_energy,
+                           "J; inf = not checked (not a scene key).");
 
   py::class_<SimulatorOptions>(m, "SimulatorOptions",
                                "Time step, output interval and divergence limits.")

@@ -3,12 +3,14 @@
 // builds any kind from its spec (Simulator.add_terrain); scenes name terrains in their JSON.
 #include <jelly/core/json.hpp>
 #include <jelly/terrain/contact_params.hpp>
+#include <jelly/terrain/detail/contact_fields.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
 #include "common.hpp"
+#include "fields.hpp"
 
 namespace jelly::python {
 
@@ -57,25 +59,13 @@ void bind_terrain(py::module_& m) {
         return d;
       },
       "Every contact model a terrain's contact.model can name, as {name: description}.");
-  py::class_<ContactParams>(m, "ContactParams",
-                            "How a terrain answers a particle that touches it (docs/contact.md).")
-      .def(py::init<>(), "The defaults: coulomb, restitution 0.8, friction 0.5.")
-      .def_property(
-          "model", [](const ContactParams& c) { return std::string(contact_model_name(c.model)); },
-          [](ContactParams& c, const std::string& name) {
-            c.model = contact_model_from_name(name, "contact.model");
-          },
-          "\"coulomb\" or \"seed\".")
-      .def_readwrite("restitution", &ContactParams::restitution, "In [0, 1].")
-      .def_readwrite("friction", &ContactParams::friction,
-                     "Kinetic mu (coulomb), the report's friction (seed).")
-      .def_readwrite("static_friction", &ContactParams::static_friction, "Coulomb: >= friction.")
-      .def_readwrite("epsilon", &ContactParams::epsilon, "Seed: contact distance (m).")
-      .def_readwrite("resting_speed", &ContactParams::resting_speed,
-                     "Coulomb: slowest approach that bounces (m/s).")
-      .def(
-          "validate", [](const ContactParams& c) { c.validate("contact."); },
-          "Raises InputError naming the first invalid field.");
+  py::class_<ContactParams> contact(
+      m, "ContactParams", "How a terrain answers a particle that touches it (docs/contact.md).");
+  contact.def(py::init<>(), "The defaults: coulomb, restitution 0.8, friction 0.5.");
+  def_fields(contact, contact_params_fields(), "contact");
+  contact.def(
+      "validate", [](const ContactParams& c) { c.validate("contact."); },
+      "Raises InputError naming the first invalid field.");
 
   py::class_<Terrain>(m, "Terrain", "A rigid obstacle moving as a prescribed function of time.")
       .def_property_readonly(

@@ -7,6 +7,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/solvers/integrators/detail/option_fields.hpp>
 
 namespace jelly {
 
@@ -78,39 +79,46 @@ int arkode_method_id(const std::vector<EnumName<int>>& table, const std::string&
   return value_of(table, method.empty() ? default_method : method, "integrator.options.method");
 }
 
+const FieldTable<ArkodeOptions>& arkode_fields() {
+  using O = ArkodeOptions;
+  static const FieldTable<O> table{
+      "ArkodeOptions",
+      "integrator.options",
+      "Options of arkode_erk and arkode_dirk (docs/arkode.md)",
+      {
+          number_field<&O::rtol>("rtol", "", range_open(0, 1), "a relative tolerance in (0, 1)",
+                                 "Relative tolerance of the local error test"),
+          number_field<&O::atol>("atol", "m, m/s", range_above(0), "an absolute tolerance > 0",
+                                 "Absolute tolerance of the local error test"),
+          string_field<&O::method>(
+              "method", "an ARKODE Butcher table name of the integrator (jelly list)",
+              "An ARKODE Butcher table name; empty = the integrator's default"),
+          number_field<&O::max_step>("max_step", "s", range_at_least(0),
+                                     "a finite step >= 0 s (0 = the contact interval dt)",
+                                     "Largest internal step; 0 = the contact interval dt"),
+          choice_field<&O::linear_solver, &arkode_linear_solvers>(
+              "linear_solver", "How arkode_dirk solves its Newton systems (arkode_dirk only)"),
+          integer_field<&O::max_steps>("max_steps", "", range_above(0),
+                                       "a number of internal steps per contact interval > 0",
+                                       "Internal steps per contact interval at most"),
+      },
+  };
+  return table;
+}
+
 void ArkodeOptions::validate(const std::string& prefix) const {
-  require(std::isfinite(rtol) && rtol > 0 && rtol < 1, prefix + "rtol", rtol,
-          "a relative tolerance in (0, 1)");
-  require(std::isfinite(atol) && atol > 0, prefix + "atol", atol, "an absolute tolerance > 0");
-  require(std::isfinite(max_step) && max_step >= 0, prefix + "max_step", max_step,
-          "a finite step >= 0 s (0 = the contact interval dt)");
-  require(max_steps > 0, prefix + "max_steps", max_steps,
-          "a number of internal steps per contact interval > 0");
+  validate_fields(arkode_fields(), *this, prefix);
 }
 
 ArkodeOptions ArkodeOptions::read(JsonFields& f) {
   ArkodeOptions o;
-  o.rtol = f.number_or("rtol", o.rtol);
-  o.atol = f.number_or("atol", o.atol);
-  o.method = f.string_or("method", o.method);
-  o.max_step = f.number_or("max_step", o.max_step);
-  o.linear_solver = value_of(
-      arkode_linear_solvers(),
-      f.string_or("linear_solver", std::string(name_of(arkode_linear_solvers(), o.linear_solver))),
-      f.path("linear_solver"));
-  o.max_steps = f.long_or("max_steps", o.max_steps);
-  o.validate(f.prefix());
+  read_fields(arkode_fields(), f, o, f.prefix());
   return o;
 }
 
 Json ArkodeOptions::to_json() const {
   Json out = Json::object();
-  out["rtol"] = rtol;
-  out["atol"] = atol;
-  out["method"] = method;
-  out["max_step"] = max_step;
-  out["linear_solver"] = std::string(name_of(arkode_linear_solvers(), linear_solver));
-  out["max_steps"] = max_steps;
+  write_fields(arkode_fields(), *this, out);
   return out;
 }
 

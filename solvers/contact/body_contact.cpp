@@ -9,45 +9,69 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/solvers/contact/detail/body_contact_fields.hpp>
 
 namespace jelly {
 
+namespace {
+
+void check_body_friction(const BodyContactParams& p, const std::string& prefix) {
+  require(p.static_friction >= p.friction, prefix + "static_friction", p.static_friction,
+          "a finite number >= friction (" + to_text(p.friction) + ")");
+}
+
+// static_friction not given: at least friction.
+void body_static_friction_default(JsonFields& f, BodyContactParams& p) {
+  if (!json_field_has(f, "static_friction"))
+    p.static_friction = std::max(p.static_friction, p.friction);
+}
+
+}  // namespace
+
+const FieldTable<BodyContactParams>& body_contact_fields() {
+  using P = BodyContactParams;
+  static const FieldTable<P> table{
+      "BodyContactParams",
+      "body_contact",
+      "Contact between bodies (docs/contact.md); each body's particles are spheres of its "
+      "radius",
+      {
+          boolean_field<&P::enabled>("enabled", "Contact between different bodies"),
+          boolean_field<&P::self_contact>("self_contact",
+                                          "Contact between parts of one body that no spring joins"),
+          number_field<&P::restitution>("restitution", "", range_closed(0, 1), "a number in [0, 1]",
+                                        "Normal velocity kept, reversed, by a bounce"),
+          number_field<&P::friction>("friction", "", range_at_least(0), "a finite number >= 0",
+                                     "Kinetic friction coefficient"),
+          number_field<&P::static_friction>(
+              "static_friction", "", range_finite(), "a finite number >= friction",
+              "Static friction coefficient, >= friction (default: at least friction)"),
+          number_field<&P::resting_speed>("resting_speed", "m/s", range_at_least(0),
+                                          "a finite speed >= 0",
+                                          "A slower approach is absorbed, never reflected"),
+          integer_field<&P::iterations>("iterations", "", range_closed(1, 100),
+                                        "an integer in [1, 100]",
+                                        "Passes over the contact pairs per step"),
+      },
+      &check_body_friction,
+      &body_static_friction_default,
+  };
+  return table;
+}
+
 void BodyContactParams::validate(const std::string& prefix) const {
-  require(std::isfinite(restitution) && restitution >= 0 && restitution <= 1,
-          prefix + "restitution", restitution, "a number in [0, 1]");
-  require(std::isfinite(friction) && friction >= 0, prefix + "friction", friction,
-          "a finite number >= 0");
-  require(std::isfinite(static_friction) && static_friction >= friction, prefix + "static_friction",
-          static_friction, "a finite number >= friction (" + to_text(friction) + ")");
-  require(std::isfinite(resting_speed) && resting_speed >= 0, prefix + "resting_speed",
-          resting_speed, "a finite speed >= 0");
-  require(iterations >= 1 && iterations <= 100, prefix + "iterations", iterations,
-          "an integer in [1, 100]");
+  validate_fields(body_contact_fields(), *this, prefix);
 }
 
 BodyContactParams BodyContactParams::read(JsonFields& f) {
   BodyContactParams p;
-  p.enabled = f.boolean_or("enabled", p.enabled);
-  p.self_contact = f.boolean_or("self_contact", p.self_contact);
-  p.restitution = f.number_or("restitution", p.restitution);
-  p.friction = f.number_or("friction", p.friction);
-  p.static_friction = f.number_or("static_friction", std::max(p.static_friction, p.friction));
-  p.resting_speed = f.number_or("resting_speed", p.resting_speed);
-  p.iterations = f.integer_or("iterations", p.iterations);
-  f.reject_unknown();
-  p.validate(f.prefix());
+  read_fields(body_contact_fields(), f, p, f.prefix(), /*reject_unknown=*/true);
   return p;
 }
 
 Json BodyContactParams::to_json() const {
-  Json j;
-  j["enabled"] = enabled;
-  j["self_contact"] = self_contact;
-  j["restitution"] = restitution;
-  j["friction"] = friction;
-  j["static_friction"] = static_friction;
-  j["resting_speed"] = resting_speed;
-  j["iterations"] = iterations;
+  Json j = Json::object();
+  write_fields(body_contact_fields(), *this, j);
   return j;
 }
 

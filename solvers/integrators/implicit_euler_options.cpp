@@ -1,9 +1,8 @@
 #include <jelly/solvers/integrators/implicit_euler_options.hpp>
 
-#include <cmath>
-
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/solvers/integrators/detail/option_fields.hpp>
 
 namespace jelly {
 
@@ -37,63 +36,64 @@ const std::vector<EnumName<ImplicitContactMode>>& implicit_contact_modes() {
   return table;
 }
 
+const FieldTable<ImplicitEulerOptions>& implicit_euler_fields() {
+  using O = ImplicitEulerOptions;
+  static const FieldTable<O> table{
+      "ImplicitEulerOptions",
+      "integrator.options",
+      "Options of implicit_euler (docs/implicit.md)",
+      {
+          integer_field<&O::newton_iterations>(
+              "newton_iterations", "", range_closed(1, 100),
+              "an integer in [1, 100] (1 = linearized backward Euler)",
+              "1 = linearized backward Euler; > 1 = Newton, at most this many solves per step"),
+          number_field<&O::newton_tolerance>("newton_tolerance", "", range_open(0, 1),
+                                             "a relative tolerance in (0, 1)",
+                                             "Newton's relative tolerance on the residual"),
+          choice_field<&O::definiteness, &definiteness_fixes>(
+              "definiteness", "How compressed springs keep the matrix positive definite"),
+          choice_field<&O::linear_solver, &implicit_linear_solvers>(
+              "linear_solver", "The linear solver of each Newton step"),
+          choice_field<&O::cg_preconditioner, &cg_preconditioner_kinds>(
+              "cg_preconditioner", "CG's preconditioner (multigrid: lattice bodies)"),
+          number_field<&O::cg_tolerance>("cg_tolerance", "", range_open(0, 1),
+                                         "a relative residual in (0, 1)",
+                                         "CG's relative residual |b - A x| / |b|"),
+          integer_field<&O::cg_max_iterations>("cg_max_iterations", "", range_at_least(1),
+                                               "an integer >= 1", "CG iterations at most"),
+          integer_field<&O::refactor_iterations>(
+              "refactor_iterations", "", range_at_least(1), "an integer >= 1",
+              "CG iterations that trigger a new CHOLMOD preconditioner"),
+          choice_field<&O::ordering, &cholmod_orderings>("ordering",
+                                                         "CHOLMOD's fill-reducing ordering"),
+          choice_field<&O::contact, &implicit_contact_modes>("contact",
+                                                             "How coulomb terrains enter the step"),
+          integer_field<&O::contact_iterations>(
+              "contact_iterations", "", range_closed(1, 100), "an integer in [1, 100]",
+              "Linear solves per step at most while the set of contacts changes"),
+          number_field<&O::contact_screening_tolerance>(
+              "contact_screening_tolerance", "", range_or_zero(range_open(0, 1)),
+              "0 (off) or a relative residual in (0, 1)",
+              "A looser CG residual at which each solve of a step with contacts first checks "
+              "the contacts' set; 0 = off"),
+      },
+  };
+  return table;
+}
+
 void ImplicitEulerOptions::validate(const std::string& prefix) const {
-  require(newton_iterations >= 1 && newton_iterations <= 100, prefix + "newton_iterations",
-          newton_iterations, "an integer in [1, 100] (1 = linearized backward Euler)");
-  require(std::isfinite(newton_tolerance) && newton_tolerance > 0 && newton_tolerance < 1,
-          prefix + "newton_tolerance", newton_tolerance, "a relative tolerance in (0, 1)");
-  require(std::isfinite(cg_tolerance) && cg_tolerance > 0 && cg_tolerance < 1,
-          prefix + "cg_tolerance", cg_tolerance, "a relative residual in (0, 1)");
-  require(cg_max_iterations >= 1, prefix + "cg_max_iterations", cg_max_iterations,
-          "an integer >= 1");
-  require(refactor_iterations >= 1, prefix + "refactor_iterations", refactor_iterations,
-          "an integer >= 1");
-  require(contact_iterations >= 1 && contact_iterations <= 100, prefix + "contact_iterations",
-          contact_iterations, "an integer in [1, 100]");
-  require(std::isfinite(contact_screening_tolerance) &&
-              (contact_screening_tolerance == 0 ||
-               (contact_screening_tolerance > 0 && contact_screening_tolerance < 1)),
-          prefix + "contact_screening_tolerance", contact_screening_tolerance,
-          "0 (off) or a relative residual in (0, 1)");
+  validate_fields(implicit_euler_fields(), *this, prefix);
 }
 
 ImplicitEulerOptions ImplicitEulerOptions::read(JsonFields& f) {
   ImplicitEulerOptions o;
-  const auto choice = [&f](const auto& table, const char* key, auto value) {
-    const std::string name = f.string_or(key, std::string(name_of(table, value)));
-    return value_of(table, name, f.path(key));
-  };
-  o.newton_iterations = f.integer_or("newton_iterations", o.newton_iterations);
-  o.newton_tolerance = f.number_or("newton_tolerance", o.newton_tolerance);
-  o.definiteness = choice(definiteness_fixes(), "definiteness", o.definiteness);
-  o.linear_solver = choice(implicit_linear_solvers(), "linear_solver", o.linear_solver);
-  o.cg_preconditioner = choice(cg_preconditioner_kinds(), "cg_preconditioner", o.cg_preconditioner);
-  o.cg_tolerance = f.number_or("cg_tolerance", o.cg_tolerance);
-  o.cg_max_iterations = f.integer_or("cg_max_iterations", o.cg_max_iterations);
-  o.refactor_iterations = f.integer_or("refactor_iterations", o.refactor_iterations);
-  o.ordering = choice(cholmod_orderings(), "ordering", o.ordering);
-  o.contact = choice(implicit_contact_modes(), "contact", o.contact);
-  o.contact_iterations = f.integer_or("contact_iterations", o.contact_iterations);
-  o.contact_screening_tolerance =
-      f.number_or("contact_screening_tolerance", o.contact_screening_tolerance);
-  o.validate(f.prefix());
+  read_fields(implicit_euler_fields(), f, o, f.prefix());
   return o;
 }
 
 Json ImplicitEulerOptions::to_json() const {
   Json out = Json::object();
-  out["newton_iterations"] = newton_iterations;
-  out["newton_tolerance"] = newton_tolerance;
-  out["definiteness"] = std::string(name_of(definiteness_fixes(), definiteness));
-  out["linear_solver"] = std::string(name_of(implicit_linear_solvers(), linear_solver));
-  out["cg_preconditioner"] = std::string(name_of(cg_preconditioner_kinds(), cg_preconditioner));
-  out["cg_tolerance"] = cg_tolerance;
-  out["cg_max_iterations"] = cg_max_iterations;
-  out["refactor_iterations"] = refactor_iterations;
-  out["ordering"] = std::string(name_of(cholmod_orderings(), ordering));
-  out["contact"] = std::string(name_of(implicit_contact_modes(), contact));
-  out["contact_iterations"] = contact_iterations;
-  out["contact_screening_tolerance"] = contact_screening_tolerance;
+  write_fields(implicit_euler_fields(), *this, out);
   return out;
 }
 

@@ -1,9 +1,8 @@
 #include <jelly/solvers/integrators/projective_dynamics_options.hpp>
 
-#include <cmath>
-
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/solvers/integrators/detail/option_fields.hpp>
 
 namespace jelly {
 
@@ -17,54 +16,54 @@ const std::vector<EnumName<PositionContactMode>>& position_contact_modes() {
   return table;
 }
 
-void ProjectiveDynamicsOptions::validate(const std::string& prefix) const {
-  require(iterations >= 1 && iterations <= 10000, prefix + "iterations", iterations,
-          "an integer in [1, 10000]");
-  require(std::isfinite(tolerance) && tolerance >= 0 && tolerance < 1, prefix + "tolerance",
-          tolerance, "a relative residual in [0, 1) (0 = always run every iteration)");
-  require(std::isfinite(chebyshev_rho) && chebyshev_rho >= 0 && chebyshev_rho < 1,
-          prefix + "chebyshev_rho", chebyshev_rho, "a spectral radius in [0, 1) (0 = measured)");
-  require(std::isfinite(chebyshev_gamma) && chebyshev_gamma > 0 && chebyshev_gamma <= 1,
-          prefix + "chebyshev_gamma", chebyshev_gamma, "a relaxation in (0, 1]");
-  require(chebyshev_delay >= 1, prefix + "chebyshev_delay", chebyshev_delay, "an integer >= 1");
-  require(name_of(position_contact_modes(), contact) != "unknown", prefix + "contact",
-          static_cast<int>(contact), "one of " + quoted_names(position_contact_modes()));
-  require(name_of(cholmod_orderings(), ordering) != "unknown", prefix + "ordering",
-          static_cast<int>(ordering), "one of " + quoted_names(cholmod_orderings()));
+const FieldTable<ProjectiveDynamicsOptions>& projective_dynamics_fields() {
+  using O = ProjectiveDynamicsOptions;
+  static const FieldTable<O> table{
+      "ProjectiveDynamicsOptions",
+      "integrator.options",
+      "Options of projective_dynamics (docs/realtime.md)",
+      {
+          integer_field<&O::iterations>("iterations", "", range_closed(1, 10000),
+                                        "an integer in [1, 10000]",
+                                        "Local/global iterations per step"),
+          number_field<&O::tolerance>(
+              "tolerance", "", range_closed_open(0, 1),
+              "a relative residual in [0, 1) (0 = always run every iteration)",
+              "Relative residual that ends a step early; 0 = always run `iterations`"),
+          boolean_field<&O::chebyshev>("chebyshev",
+                                       "Chebyshev acceleration (Wang 2015) of the iterations"),
+          number_field<&O::chebyshev_rho>("chebyshev_rho", "", range_closed_open(0, 1),
+                                          "a spectral radius in [0, 1) (0 = measured)",
+                                          "Spectral radius of the plain iteration; 0 = measured "
+                                          "during the first step"),
+          number_field<&O::chebyshev_gamma>("chebyshev_gamma", "", range_open_closed(0, 1),
+                                            "a relaxation in (0, 1]",
+                                            "Under-relaxation of the accelerated update"),
+          integer_field<&O::chebyshev_delay>(
+              "chebyshev_delay", "", range_at_least(1), "an integer >= 1",
+              "Plain iterations of each step before the acceleration starts"),
+          choice_field<&O::contact, &position_contact_modes>("contact",
+                                                             "How coulomb terrains enter the step"),
+          choice_field<&O::ordering, &cholmod_orderings>(
+              "ordering", "Fill-reducing ordering of the CHOLMOD factor"),
+      },
+  };
+  return table;
 }
 
-}  // namespace jelly
-
-namespace jelly {
+void ProjectiveDynamicsOptions::validate(const std::string& prefix) const {
+  validate_fields(projective_dynamics_fields(), *this, prefix);
+}
 
 ProjectiveDynamicsOptions ProjectiveDynamicsOptions::read(JsonFields& f) {
   ProjectiveDynamicsOptions o;
-  const auto choice = [&f](const auto& table, const char* key, auto value) {
-    const std::string name = f.string_or(key, std::string(name_of(table, value)));
-    return value_of(table, name, f.path(key));
-  };
-  o.iterations = f.integer_or("iterations", o.iterations);
-  o.tolerance = f.number_or("tolerance", o.tolerance);
-  o.chebyshev = f.boolean_or("chebyshev", o.chebyshev);
-  o.chebyshev_rho = f.number_or("chebyshev_rho", o.chebyshev_rho);
-  o.chebyshev_gamma = f.number_or("chebyshev_gamma", o.chebyshev_gamma);
-  o.chebyshev_delay = f.integer_or("chebyshev_delay", o.chebyshev_delay);
-  o.contact = choice(position_contact_modes(), "contact", o.contact);
-  o.ordering = choice(cholmod_orderings(), "ordering", o.ordering);
-  o.validate(f.prefix());
+  read_fields(projective_dynamics_fields(), f, o, f.prefix());
   return o;
 }
 
 Json ProjectiveDynamicsOptions::to_json() const {
   Json out = Json::object();
-  out["iterations"] = iterations;
-  out["tolerance"] = tolerance;
-  out["chebyshev"] = chebyshev;
-  out["chebyshev_rho"] = chebyshev_rho;
-  out["chebyshev_gamma"] = chebyshev_gamma;
-  out["chebyshev_delay"] = chebyshev_delay;
-  out["contact"] = std::string(name_of(position_contact_modes(), contact));
-  out["ordering"] = std::string(name_of(cholmod_orderings(), ordering));
+  write_fields(projective_dynamics_fields(), *this, out);
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/solvers/integrators/detail/option_fields.hpp>
 
 namespace jelly {
 
@@ -15,42 +16,39 @@ const std::vector<EnumName<XpbdSweep>>& xpbd_sweeps() {
   return table;
 }
 
-void XpbdOptions::validate(const std::string& prefix) const {
-  require(substeps >= 1 && substeps <= 100000, prefix + "substeps", substeps,
-          "an integer in [1, 100000]");
-  require(iterations >= 1 && iterations <= 10000, prefix + "iterations", iterations,
-          "an integer in [1, 10000]");
-  require(name_of(xpbd_sweeps(), sweep) != "unknown", prefix + "sweep", static_cast<int>(sweep),
-          "one of " + quoted_names(xpbd_sweeps()));
-  require(name_of(position_contact_modes(), contact) != "unknown", prefix + "contact",
-          static_cast<int>(contact), "one of " + quoted_names(position_contact_modes()));
+const FieldTable<XpbdOptions>& xpbd_fields() {
+  using O = XpbdOptions;
+  static const FieldTable<O> table{
+      "XpbdOptions",
+      "integrator.options",
+      "Options of xpbd (docs/realtime.md)",
+      {
+          integer_field<&O::substeps>("substeps", "", range_closed(1, 100000),
+                                      "an integer in [1, 100000]", "Substeps per step"),
+          integer_field<&O::iterations>("iterations", "", range_closed(1, 10000),
+                                        "an integer in [1, 10000]",
+                                        "Sweeps over the springs and contacts per substep"),
+          choice_field<&O::sweep, &xpbd_sweeps>("sweep", "How a sweep visits the springs"),
+          choice_field<&O::contact, &position_contact_modes>("contact",
+                                                             "How coulomb terrains enter the step"),
+      },
+  };
+  return table;
 }
 
-}  // namespace jelly
-
-namespace jelly {
+void XpbdOptions::validate(const std::string& prefix) const {
+  validate_fields(xpbd_fields(), *this, prefix);
+}
 
 XpbdOptions XpbdOptions::read(JsonFields& f) {
   XpbdOptions o;
-  o.substeps = f.integer_or("substeps", o.substeps);
-  o.iterations = f.integer_or("iterations", o.iterations);
-  o.sweep =
-      value_of(xpbd_sweeps(), f.string_or("sweep", std::string(name_of(xpbd_sweeps(), o.sweep))),
-               f.path("sweep"));
-  o.contact =
-      value_of(position_contact_modes(),
-               f.string_or("contact", std::string(name_of(position_contact_modes(), o.contact))),
-               f.path("contact"));
-  o.validate(f.prefix());
+  read_fields(xpbd_fields(), f, o, f.prefix());
   return o;
 }
 
 Json XpbdOptions::to_json() const {
   Json out = Json::object();
-  out["substeps"] = substeps;
-  out["iterations"] = iterations;
-  out["sweep"] = std::string(name_of(xpbd_sweeps(), sweep));
-  out["contact"] = std::string(name_of(position_contact_modes(), contact));
+  write_fields(xpbd_fields(), *this, out);
   return out;
 }
 

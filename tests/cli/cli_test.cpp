@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/geometry/body_kinds.hpp>
+#include <jelly/io/detail/field_reference.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
@@ -26,6 +27,25 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
 using namespace cli_testing;
+
+TEST(Cli, FieldsPrintsEveryFieldTableAsMarkdownOrJson) {
+  const Result md = jelly("fields");
+  ASSERT_EQ(md.code, 0) << md.err;
+  EXPECT_EQ(md.err, "");
+  for (const FieldTableDoc& table : scene_field_tables()) {
+    EXPECT_THAT(md.out, HasSubstr("## `" + table.path + "`")) << table.name;
+    for (const FieldDoc& f : table.fields) {
+      EXPECT_THAT(md.out, HasSubstr("| `" + f.name + "` | " + f.type + " | `" + f.default_text))
+          << table.name << "." << f.name;
+    }
+  }
+  const Result json = jelly("fields --format json");
+  ASSERT_EQ(json.code, 0) << json.err;
+  EXPECT_EQ(json.out, field_tables_json(scene_field_tables()));
+  const Result bad = jelly("fields --format xml");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("--format"));
+}
 
 TEST(Cli, ListNamesEveryIntegratorTerrainKindAndContactModel) {
   const Result r = jelly("list");

@@ -60,6 +60,65 @@ def test_every_public_name_is_in_the_stub():
             assert extra == set(), f"{name}: members in __init__.pyi but not in the class"
 
 
+def stub_annotations():
+    """{class name: {attribute: annotation text}} of the stub's classes."""
+    tree = ast.parse(STUB.read_text())
+    out = {}
+    for node in tree.body:
+        if isinstance(node, ast.ClassDef):
+            out[node.name] = {item.target.id: ast.unparse(item.annotation) for item in node.body
+                              if isinstance(item, ast.AnnAssign)
+                              and isinstance(item.target, ast.Name)}
+    return out
+
+
+def test_option_classes_in_the_stub_are_their_field_tables():
+    # The option classes' properties come from the C++ field tables (python/src/fields.hpp), which
+    # list them as _fields: (name, Python type). The stub must annotate exactly those fields with
+    # those types, and a default instance must hold values of those types.
+    annotations = stub_annotations()
+    tables = {name: getattr(jelly, name)._fields for name in jelly.__all__
+              if inspect.isclass(getattr(jelly, name)) and hasattr(getattr(jelly, name), "_fields")}
+    assert {"ImplicitEulerOptions", "ArkodeOptions", "ProjectiveDynamicsOptions", "XpbdOptions",
+            "VbdOptions"} <= set(tables)
+    for name, fields in sorted(tables.items()):
+        stub = annotations[name]
+        assert {f: stub.get(f) for f, _ in fields} == dict(fields), (
+            f"{name}: __init__.pyi disagrees with its table")
+        # Members beyond the table's (not scene keys, e.g. DivergenceGuard.max_energy) are
+        # properties bound by hand: none of them may shadow a field.
+        extra = set(stub) - {f for f, _ in fields}
+        assert all(isinstance(getattr(getattr(jelly, name), e, None), property) for e in extra), (
+            f"{name}: {sorted(extra)}")
+        obj = getattr(jelly, name)()
+        for field, type_name in fields:
+            assert type(getattr(obj, field)).__name__ == type_name, f"{name}.{field}"
+
+
+def test_stub_attribute_types_match_the_module():
+    # Every class of the stub that takes no constructor arguments: each attribute the stub
+    # annotates as int, float, bool or str holds a value of that type in a default instance.
+    simple = {"int": int, "float": float, "bool": bool, "str": str}
+    checked = 0
+    for name, attributes in sorted(stub_annotations().items()):
+        cls = getattr(jelly, name, None)
+        if not inspect.isclass(cls) or issubclass(cls, BaseException):
+            continue
+        try:
+            obj = cls()
+        except TypeError:
+            continue
+        for attribute, annotation in attributes.items():
+            if annotation in simple and hasattr(obj, attribute):
+                value = getattr(obj, attribute)
+                assert type(value) is simple[annotation] or (
+                    annotation == "float" and type(value) is int), (
+                    f"{name}.{attribute}: the stub says {annotation}, the module gives "
+                    f"{type(value).__name__}")
+                checked += 1
+    assert checked >= 40
+
+
 def has_doc(obj):
     doc = inspect.getdoc(obj) or ""
     # pybind11 puts the signature(s) first: keep the text.
@@ -121,6 +180,8 @@ def instances(tmp_path):
         "H5Recorder": recorder, "ImplicitEulerOptions": jelly.ImplicitEulerOptions(),
         "Integrator": sim.integrator, "IntegratorOptions": jelly.IntegratorOptions(),
         "Model": model, "Observer": Watch(), "Pins": model.pins, "Plane": jelly.Plane.slope(20),
+        "ProjectiveDynamicsOptions": jelly.ProjectiveDynamicsOptions(),
+        "VbdOptions": jelly.VbdOptions(), "XpbdOptions": jelly.XpbdOptions(),
         "RecorderOptions": jelly.RecorderOptions(), "Recording": jelly.read_recording(path),
         "Rollout": jelly.rollout(scene, [{}], 0.01, every=0.005), "RunReport": report,
         "Scene": scene, "Simulator": sim, "SimulatorOptions": jelly.SimulatorOptions(),
