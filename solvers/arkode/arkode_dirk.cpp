@@ -88,20 +88,19 @@ class DirkDriver final : public arkode::Driver {
     // ARKODE refactors when gamma = h a_ii changed by more than dgmax (default 20%) since the
     // last setup. Between, the Newton corrections use the old gamma, and its convergence test
     // (del * rate < tolerance, with the rate of an earlier, exact-Jacobian iteration) accepts
-    // them after one iteration: on the damped oscillator the global error then stayed near
-    // 1e-5 for every rtol from 1e-4 to 1e-8 (docs/arkode.md). The Schur solver refines its
-    // solution to the current gamma instead; for KLU a 1% bound restores the accuracy.
+    // them after one iteration: on the damped oscillator the global error then stopped
+    // following rtol (docs/arkode.md). The Schur solver refines its solution to the current
+    // gamma instead; for KLU a tighter bound (kDeltaGammaMax) restores the accuracy.
     if (flag >= 0 && linear_solver_kind_ == ArkodeLinearSolver::kKlu)
       flag = ARKStepSetDeltaGammaMax(m, kDeltaGammaMax);
     // Newton starts from the interpolant of the last step (ARKODE's "maximum order" predictor)
-    // rather than from y_n: on a spinning cube of stiff springs the trivial predictor made 86%
-    // of the steps fail Newton's convergence test and took 9 times as many steps
-    // (docs/arkode.md). After a restart ARKODE falls back to y_n.
+    // rather than from y_n: on a spinning cube of stiff springs the trivial predictor made most
+    // steps fail Newton's convergence test and took many times as many steps (docs/arkode.md).
+    // After a restart ARKODE falls back to y_n.
     if (flag >= 0) flag = ARKStepSetPredictorMethod(m, kMaximumOrderPredictor);
     // ARKODE's default Hermite interpolant for this order-5 method has degree 5, which costs
-    // extra right-hand sides per step (8 of the 23 per step in free fall on the seed cube) and
-    // makes every prediction a long linear combination; degree 3 uses only the step's end
-    // values (docs/arkode.md).
+    // extra right-hand sides per step and makes every prediction a long linear combination;
+    // degree 3 uses only the step's end values (docs/arkode.md has the counts).
     if (flag >= 0) flag = ARKStepSetInterpolantDegree(m, kInterpolantDegree);
     return flag;
   }
