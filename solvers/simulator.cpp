@@ -513,6 +513,7 @@ RunReport Simulator::run_until(Real t_end) {
   if (body_contact_.active(model_)) {
     const BodyContact::Stats& b = body_contact_.stats();
     report.statistics["body_contact_pairs"] = static_cast<double>(b.pairs);
+    report.statistics["body_contact_energy_limited"] = static_cast<double>(b.limited);
     report.statistics["broad_phase_ms"] = 1e3 * b.broad_seconds;
     report.statistics["narrow_phase_ms"] = 1e3 * b.narrow_seconds;
   }
