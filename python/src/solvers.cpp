@@ -301,21 +301,23 @@ void bind_solvers(py::module_& m) {
       .def_readwrite("contact_iterations", &ImplicitEulerOptions::contact_iterations,
                      "Solves per step while the contact set changes.");
 
-  py::class_<ArkodeOptions>(m, "ArkodeOptions",
-                            "Options of arkode_erk and arkode_dirk (docs/arkode.md).")
-      .def(py::init<>(), "The defaults.")
+  py::class_<ArkodeOptions> arkode_options(
+      m, "ArkodeOptions", "Options of arkode_erk and arkode_dirk (docs/arkode.md).");
+  arkode_options.def(py::init<>(), "The defaults.")
       .def_readwrite("rtol", &ArkodeOptions::rtol, "Relative tolerance.")
       .def_readwrite("atol", &ArkodeOptions::atol, "Absolute tolerance.")
       .def_readwrite("method", &ArkodeOptions::method,
                      "An ARKODE Butcher table name; empty = default.")
       .def_readwrite("max_step", &ArkodeOptions::max_step, "Largest internal step (s); 0 = dt.")
-      .def_property(
-          "linear_solver", choice_getter(&ArkodeOptions::linear_solver, arkode_linear_solvers),
-          choice_setter(&ArkodeOptions::linear_solver, arkode_linear_solvers, "linear_solver"),
-          "arkode_dirk: \"auto\" (= \"cg\"), \"cg\", \"jacobi\", \"gmres\", "
-          "\"schur\" or \"klu\".")
       .def_readwrite("max_steps", &ArkodeOptions::max_steps,
                      "Internal steps per contact interval.");
+#ifdef JELLY_HAVE_ARKODE  // the names of the linear solvers are the component arkode's
+  arkode_options.def_property(
+      "linear_solver", choice_getter(&ArkodeOptions::linear_solver, arkode_linear_solvers),
+      choice_setter(&ArkodeOptions::linear_solver, arkode_linear_solvers, "linear_solver"),
+      "arkode_dirk: \"auto\" (= \"cg\"), \"cg\", \"jacobi\", \"gmres\", "
+      "\"schur\" or \"klu\".");
+#endif
 
   py::class_<IntegratorOptions>(
       m, "IntegratorOptions",
@@ -328,7 +330,9 @@ void bind_solvers(py::module_& m) {
           "validate",
           [](const IntegratorOptions& o) {
             o.implicit.validate("integrator.options.");
+#ifdef JELLY_HAVE_ARKODE
             o.arkode.validate("integrator.options.");
+#endif
           },
           "Raises InputError naming the first invalid option.");
 
