@@ -1,8 +1,9 @@
 """Builds the Python module jelly with CMake for `pip install .` and wheels (pyproject.toml).
 
 Only what the module needs is configured and built (no tests, benchmarks, viewer or jelly
-program). The extension jelly/_jelly*.so and the library it loads, libjelly.so.<major>, go
-into the package side by side; the extension finds the library through its RPATH, $ORIGIN.
+program). The extension jelly/_jelly*.so and the libraries it loads, jelly's components
+(libjelly.so.<major>, libjelly_io.so.<major>, ...), go into the package side by side; the
+extension finds them through its RPATH, $ORIGIN.
 The system libraries libjelly links (HDF5, CHOLMOD, Ceres, ...) are not in the wheel: the
 machine that installs it needs them (scripts/install-deps.sh), as for `cmake --install`.
 
@@ -65,9 +66,10 @@ class CMakeBuild(build_ext):
         target.mkdir(parents=True, exist_ok=True)
         extension = next((stage / "python" / "jelly").glob("_jelly*.so"))
         shutil.copy2(extension, self.get_ext_fullpath(ext.name))
-        for library in (stage / "lib").glob("libjelly.so.*"):
-            # The file the extension asks for (its SONAME, libjelly.so.<major>), as a file.
-            if re.fullmatch(r"libjelly\.so\.\d+", library.name):
+        for library in (stage / "lib").glob("libjelly*.so.*"):
+            # The files the extension asks for (their SONAMEs: libjelly.so.<major>, the other
+            # components' libjelly_<name>.so.<major>), as files.
+            if re.fullmatch(r"libjelly(_[a-z]+)?\.so\.\d+", library.name):
                 shutil.copy2(library.resolve(), target / library.name)
         # The Gmsh plugin, which libjelly loads from its own folder on first use.
         for plugin in (stage / "lib").glob("libjelly_gmsh.so"):
@@ -78,7 +80,7 @@ setup(
     version=version(),
     packages=["jelly"],
     package_dir={"jelly": "python/jelly"},
-    package_data={"jelly": ["__init__.pyi", "py.typed", "libjelly.so.*", "libjelly_gmsh.so"]},
+    package_data={"jelly": ["__init__.pyi", "py.typed", "libjelly*.so.*", "libjelly_gmsh.so"]},
     ext_modules=[CMakeExtension("jelly._jelly")],
     cmdclass={"build_ext": CMakeBuild},
     options={"build": {"build_base": "build-pip"}},  # not CMake's build/

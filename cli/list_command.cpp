@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <string>
 
+#include <jelly/core/components.hpp>
 #include <jelly/geometry/body_kinds.hpp>
 #include <jelly/geometry/tetrahedralize.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
@@ -22,8 +23,10 @@ void line(std::string_view kind, std::string_view name, std::string_view descrip
 
 }  // namespace
 
-// Every kind a scene can name, read from the registries.
+// The components this program has, then every kind a scene can name, read from the registries
+// (a component's kinds are there only when the component is).
 int list_command() {
+  for (const ComponentInfo& c : components()) line("component", c.name, c.description);
   for (const IntegratorInfo& info : integrator_infos())
     line("integrator", info.name, info.description);
   for (const BodyKindInfo& k : body_kinds()) line("body", k.name, k.description);

@@ -1,8 +1,11 @@
-# Installs the library, its public headers (cmake/public_headers.txt) under include/jelly/,
-# the jelly program (cli/CMakeLists.txt), the scenes under share/jelly/scenes, and the CMake
-# package files.
+# Installs the component libraries (jelly::core, jelly::io, ...) and jelly::jelly (all of them),
+# the public headers (cmake/public_headers.txt) under include/jelly/, the jelly program
+# (cli/CMakeLists.txt), the scenes under share/jelly/scenes, and the CMake package files.
 include(CMakePackageConfigHelpers)
 foreach(header IN LISTS JELLY_PUBLIC_HEADERS)
+  if(header MATCHES "^fit/" AND NOT TARGET jelly_fit)
+    continue()  # the component fit's headers (the umbrella includes them only with it)
+  endif()
   get_filename_component(folder ${header} DIRECTORY)
   install(FILES ${CMAKE_CURRENT_SOURCE_DIR}/${header}
           DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly/${folder})
@@ -11,7 +14,11 @@ install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/scenes/ DESTINATION ${CMAKE_INSTAL
         FILES_MATCHING PATTERN "*.json")
 install(FILES ${JELLY_BUILD_INCLUDE_DIR}/jelly/version.hpp ${JELLY_BUILD_INCLUDE_DIR}/jelly/jelly.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/jelly)
-install(TARGETS jelly EXPORT jellyTargets
+set(JELLY_COMPONENT_TARGETS)
+foreach(component IN LISTS JELLY_COMPONENTS)
+  list(APPEND JELLY_COMPONENT_TARGETS jelly_${component})
+endforeach()
+install(TARGETS jelly ${JELLY_COMPONENT_TARGETS} EXPORT jellyTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}

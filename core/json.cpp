@@ -229,4 +229,9 @@ std::string json_field_dump(const std::function<void(Json&)>& write, std::string
   return out[std::string(key)].dump();
 }
 
+std::vector<FieldTableDocument>& component_field_documents() {
+  static std::vector<FieldTableDocument> documents;
+  return documents;
+}
+
 }  // namespace jelly

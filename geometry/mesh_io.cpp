@@ -9,12 +9,9 @@
 #include <map>
 #include <unordered_map>
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-#include <assimp/Importer.hpp>
-
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/detail/mesh_file.hpp>
+#include <jelly/geometry/detail/mesh_file_reader.hpp>
 
 namespace jelly {
 
@@ -22,36 +19,6 @@ namespace {
 
 using detail::lower_extension;
 using detail::quoted;
-
-// Index of each distinct position, in order of first appearance; -0 and +0 are the same.
-class Welder {
- public:
-  int index(const Vec3& p, std::vector<Vec3>& vertices) {
-    const Key key{p.x() + 0.0, p.y() + 0.0, p.z() + 0.0};
-    const auto [it, inserted] = map_.try_emplace(key, static_cast<int>(vertices.size()));
-    if (inserted) vertices.push_back(p);
-    return it->second;
-  }
-
- private:
-  struct Key {
-    double x, y, z;
-    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-  };
-  struct Hash {
-    std::size_t operator()(const Key& k) const {
-      std::uint64_t h = 1469598103934665603ull;
-      for (double d : {k.x, k.y, k.z}) {
-        std::uint64_t bits;
-        std::memcpy(&bits, &d, sizeof bits);
-        h = (h ^ bits) * 1099511628211ull;
-        h ^= h >> 29;
-      }
-      return static_cast<std::size_t>(h);
-    }
-  };
-  std::unordered_map<Key, int, Hash> map_;
-};
 
 }  // namespace
 
@@ -133,56 +100,15 @@ MeshFile read_mesh(const std::string& path, const std::string& field) {
   if (ext == ".obj") detail::require_text_mesh(path, field, value, "OBJ");
   if (ext == ".stl") detail::require_text_mesh(path, field, value, "STL");
 
-  Assimp::Importer importer;
-  // ValidateDataStructure runs first and refuses a face naming a vertex the mesh does not have
-  // (before Triangulate reads the vertices of polygons).
-  const aiScene* scene =
-      importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate);
-  if (scene == nullptr) {
-    throw InputError(
-        field, value,
-        "a mesh file the reader (assimp) accepts: " + std::string(importer.GetErrorString()));
+  const detail::MeshFileReader reader = detail::mesh_file_reader();
+  if (reader == nullptr) {
+    throw InputError(field, value,
+                     "a mesh file, which this jelly cannot read: it was built without its meshes "
+                     "component (JELLY_WITH_MESHES=OFF; `jelly list` shows the components)");
   }
-
   MeshFile out;
-  Welder welder;
   std::map<std::string, std::vector<int>> groups;
-  int dropped = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* am = scene->mMeshes[m];
-    std::vector<int> index(am->mNumVertices);
-    for (unsigned v = 0; v < am->mNumVertices; ++v) {
-      const aiVector3D& p = am->mVertices[v];
-      const Vec3 q(p.x, p.y, p.z);
-      if (!q.allFinite()) {  // (the message is built only then: this loop is hot)
-        throw InputError(
-            field, value,
-            "a mesh with finite coordinates (a vertex is at (" + to_text(q.transpose()) + "))");
-      }
-      index[v] = welder.index(q, out.mesh.vertices);
-    }
-    const std::string name = am->mName.C_Str();
-    std::vector<int>* group = (name.empty() || name == "defaultobject") ? nullptr : &groups[name];
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines
-      for (int k = 0; k < 3; ++k) {
-        if (face.mIndices[k] >= am->mNumVertices) {
-          throw InputError(field, value,
-                           "a mesh whose faces name its vertices (a face names vertex " +
-                               std::to_string(static_cast<int>(face.mIndices[k])) + " of " +
-                               std::to_string(am->mNumVertices) + ")");
-        }
-      }
-      const Triangle t{index[face.mIndices[0]], index[face.mIndices[1]], index[face.mIndices[2]]};
-      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
-        ++dropped;
-        continue;
-      }
-      out.mesh.triangles.push_back(t);
-      if (group != nullptr) group->insert(group->end(), t.begin(), t.end());
-    }
-  }
+  const int dropped = reader(path, field, value, out.mesh, groups);
   require(out.mesh.num_triangles() > 0, field, value,
           "a mesh with at least one triangle (it has none" +
               std::string(dropped > 0 ? ", " + std::to_string(dropped) + " degenerate" : "") + ")");

@@ -11,9 +11,8 @@
 namespace jelly {
 
 std::vector<FieldTableDoc> scene_field_tables() {
-  return {
+  std::vector<FieldTableDoc> tables{
       document_fields(implicit_euler_fields(), {"implicit_euler"}),
-      document_fields(arkode_fields(), {"arkode_erk", "arkode_dirk"}),
       document_fields(projective_dynamics_fields(), {"projective_dynamics"}),
       document_fields(xpbd_fields(), {"xpbd"}),
       document_fields(vbd_fields(), {"vbd"}),
@@ -25,6 +24,9 @@ std::vector<FieldTableDoc> scene_field_tables() {
       document_fields(divergence_fields()),
       document_fields(crush_fields()),
   };
+  for (const FieldTableDocument document : component_field_documents())
+    tables.push_back(document());
+  return tables;
 }
 
 namespace {

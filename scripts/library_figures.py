@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """What linking and including jelly costs (docs/CONTRIBUTING.md, "The public API"), as a
 Markdown table: the installed headers, the umbrella header's preprocessed lines and compile CPU,
-the shared libraries libjelly loads, the start-up of `jelly run` (one step of the seed scene)
-and of `import jelly`.
+the shared libraries libjelly (the core) and a program of the core alone load, the start-up of
+`jelly run` (one step of the seed scene) and of `import jelly`.
 
     library_figures.py [--build DIR] [--source DIR] [--before-build DIR --before-source DIR]
                        [--repeat 5]
@@ -80,6 +80,22 @@ def linked_libraries(path):
     return sum(1 for line in out.splitlines() if line.strip())
 
 
+CORE_PROGRAM = ("#include <jelly/solvers/integrators/registry.hpp>\n"
+                "int main() { return jelly::integrator_names().empty(); }\n")
+
+
+def core_program_libraries(tree, work):
+    """Shared libraries (ldd lines) of a program that calls the core alone (an integrator name
+    list), linked against the tree's libjelly: since the components, the core library."""
+    source = os.path.join(work, "core_program.cpp")
+    program = os.path.join(work, "core_program")
+    with open(source, "w", encoding="utf-8") as f:
+        f.write(CORE_PROGRAM)
+    run(["g++", "-std=c++17", *tree.include_flags(), source, "-o", program, "-L", tree.build,
+         "-ljelly", "-Wl,-rpath," + tree.build])
+    return linked_libraries(program)
+
+
 def run_one_step(tree, work):
     scene = os.path.join(tree.source, "scenes", "seed_slope.json")
     # The tree's own libjelly, also for a program copied from another build tree.
@@ -136,6 +152,8 @@ def main():
             rows.append(("umbrella: nlohmann headers included", [str(k) for _, k in lines]))
             rows.append(("libjelly.so: shared libraries loaded (ldd)",
                          [str(linked_libraries(t.library())) for t in trees]))
+            rows.append(("a program of the core alone: shared libraries loaded (ldd)",
+                         [str(core_program_libraries(t, work)) for t in trees]))
             timings = [("umbrella: compile CPU (g++ -O2), s", umbrella_cpu),
                        ("jelly run, 1 step of the seed slope: wall, s", run_one_step)]
             if all(os.path.isdir(os.path.join(t.build, "python", "jelly")) for t in trees):

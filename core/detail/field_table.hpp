@@ -117,6 +117,12 @@ struct FieldTableDoc {
   std::vector<FieldDoc> fields;
 };
 
+// The documents of the field tables an optional component brings (arkode's options), added by
+// its register_<name>_component(); the reference lists them after the core's. Defined in
+// core/json.cpp.
+using FieldTableDocument = FieldTableDoc (*)();
+std::vector<FieldTableDocument>& component_field_documents();
+
 // The helpers the factories call (defined in core/json.cpp).
 int json_field_integer(JsonFields& f, std::string_view key, int fallback);
 long long json_field_long(JsonFields& f, std::string_view key, long long fallback);

@@ -12,7 +12,7 @@ from . import _jelly
 from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module folder)
     AnchorSpring, ArkodeOptions, Body, Checkpoint, ContactParams, CubeSpec, DivergenceGuard,
     DLPackExport, dlpack,
-    Elevator, ElevatorSpec, ExternalForce, FitOptions, Force, FitResult, FittedParameter, H5Recorder,
+    Elevator, ElevatorSpec, ExternalForce, Force, H5Recorder,
     ImplicitEulerOptions, InputError, Integrator, IntegratorOptions, Model, Observer, Pins, Plane,
     ProjectiveDynamicsOptions, RecorderOptions, Recording, Rollout, RunReport, SimulatorOptions,
     SimulatorSnapshot, Simulator,
@@ -21,9 +21,11 @@ from ._jelly import (  # noqa: F401  (the C++ API, one binding file per module f
     angular_momentum, apply_override, body_kinds, build_cube, center_of_mass, check_same_scene,
     contact_models, cube_index, cube_particle_count, cube_spring_count, describe_recording,
     elastic_energy, gravitational_energy, integrator_infos, integrator_names, kinetic_energy,
-    linear_momentum, make_model, make_terrain, parse_free_parameters, read_checkpoint, read_recording,
+    linear_momentum, make_model, make_terrain, read_checkpoint, read_recording,
     initial_state, rest_state, restore, scene_to_json, spring_type_names, terrain_kinds, total_energy,
     write_xdmf_for_recording)
+if hasattr(_jelly, "FitOptions"):  # the component fit (a jelly built with JELLY_WITH_FIT)
+    from ._jelly import FitOptions, FitResult, FittedParameter, parse_free_parameters  # noqa: F401
 from ._scene import Scene, load_scene
 from ._rollout import rollout
 from ._sweep import sweep, sweep_points
@@ -35,9 +37,9 @@ _FIT_KEYWORDS = ("free", "gradients", "window", "initial", "max_iterations", "fu
 
 
 def fit_recording(recording: _Union[Recording, str, _os.PathLike],
-                  options: _Optional[FitOptions] = None, *,
+                  options: _Optional["FitOptions"] = None, *,
                   write_scene: _Optional[_Union[str, _os.PathLike]] = None,
-                  **keywords: _Any) -> FitResult:
+                  **keywords: _Any) -> "FitResult":
     """Fits spring and damper coefficients to a recording (a Recording or the path of a file
     written by ``jelly run -o`` or H5Recorder with a scene), as ``jelly fit`` does: the terrains,
     integrator and dt come from the scene stored in it.
@@ -47,6 +49,9 @@ def fit_recording(recording: _Union[Recording, str, _os.PathLike],
     recording's scene with the fitted values (``jelly fit --write-scene``). Returns a FitResult
     (``print(result)`` prints jelly fit's report); the GIL is released while fitting.
     """
+    if not hasattr(_jelly, "FitOptions"):
+        raise InputError("fit_recording needs jelly's component fit: this jelly was built without "
+                         "it (JELLY_WITH_FIT=OFF)")
     if isinstance(recording, (str, _os.PathLike)):
         recording = read_recording(_os.fspath(recording))
     if write_scene is not None:
@@ -72,7 +77,7 @@ def fit_recording(recording: _Union[Recording, str, _os.PathLike],
     return result
 
 
-def fitted_scene(recording: Recording, result: FitResult) -> Scene:
+def fitted_scene(recording: Recording, result: "FitResult") -> Scene:
     """The recording's scene with the fitted coefficients written into its spring types."""
     return Scene(scene_to_json(_jelly._fitted_scene(recording, result)))
 
@@ -90,8 +95,10 @@ Recording.scene = property(_recording_scene, doc=_recording_scene.__doc__)
 # its springs' coefficients). They pickle (Dask sends them, copy.deepcopy copies them) and print
 # as their fields.
 _OPTION_CLASSES = (ArkodeOptions, ContactParams, CubeSpec, DivergenceGuard, ElevatorSpec,
-                   FitOptions, ImplicitEulerOptions, IntegratorOptions, ProjectiveDynamicsOptions,
+                   ImplicitEulerOptions, IntegratorOptions, ProjectiveDynamicsOptions,
                    RecorderOptions, SimulatorOptions, VbdOptions, XpbdOptions)
+if hasattr(_jelly, "FitOptions"):
+    _OPTION_CLASSES += (FitOptions,)
 
 
 def _option_fields(cls: type) -> list:

@@ -20,7 +20,9 @@ PYBIND11_MODULE(_jelly, m) {
   jelly::python::bind_terrain(m);
   jelly::python::bind_solvers(m);
   jelly::python::bind_io(m);
+#ifdef JELLY_HAVE_FIT
   jelly::python::bind_fit(m);
+#endif
   jelly::python::bind_adjoint(m);
   jelly::python::bind_dlpack(m);
   jelly::python::serialise_simulator(m);

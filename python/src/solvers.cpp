@@ -256,7 +256,9 @@ void bind_solvers(py::module_& m) {
   py::class_<ArkodeOptions> arkode(m, "ArkodeOptions",
                                    "Options of arkode_erk and arkode_dirk (docs/arkode.md).");
   arkode.def(py::init<>(), "The defaults.");
+#ifdef JELLY_HAVE_ARKODE  // the table (and its linear solvers' names) is the component arkode's
   def_fields(arkode, arkode_fields());
+#endif
   py::class_<ProjectiveDynamicsOptions> pd(m, "ProjectiveDynamicsOptions",
                                            "Options of projective_dynamics (docs/realtime.md).");
   pd.def(py::init<>(), "The defaults.");
@@ -282,7 +284,9 @@ void bind_solvers(py::module_& m) {
           "validate",
           [](const IntegratorOptions& o) {
             o.implicit.validate("integrator.options.");
+#ifdef JELLY_HAVE_ARKODE
             o.arkode.validate("integrator.options.");
+#endif
             o.pd.validate("integrator.options.");
             o.xpbd.validate("integrator.options.");
             o.vbd.validate("integrator.options.");

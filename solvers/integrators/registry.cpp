@@ -1,15 +1,12 @@
 #include <jelly/solvers/integrators/registry.hpp>
 
 #include <algorithm>
-#include <functional>
 #include <string>
-#include <type_traits>
 #include <utility>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
-#include <jelly/solvers/arkode/arkode_dirk.hpp>
-#include <jelly/solvers/arkode/arkode_erk.hpp>
+#include <jelly/solvers/integrators/detail/options_io.hpp>
 #include <jelly/solvers/integrators/explicit_euler.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/midpoint.hpp>
@@ -23,73 +20,45 @@ namespace jelly {
 
 namespace {
 
-using Factory = std::function<std::unique_ptr<Integrator>(const IntegratorOptions&)>;
-
-// The options member `Member` of IntegratorOptions, read, written and validated by its own type.
-template <auto Member>
-IntegratorOptionsIo options_io() {
-  using Options = std::remove_reference_t<decltype(std::declval<IntegratorOptions&>().*Member)>;
-  IntegratorOptionsIo io;
-  io.read = [](JsonFields& f, IntegratorOptions& o) { o.*Member = Options::read(f); };
-  io.write = [](const IntegratorOptions& o) { return (o.*Member).to_json(); };
-  io.validate = [](const IntegratorOptions& o, const std::string& prefix) {
-    (o.*Member).validate(prefix);
-  };
-  return io;
-}
+using detail::options_io;
 constexpr auto kImplicit = &IntegratorOptions::implicit;
-constexpr auto kArkode = &IntegratorOptions::arkode;
 constexpr auto kPd = &IntegratorOptions::pd;
 constexpr auto kXpbd = &IntegratorOptions::xpbd;
 constexpr auto kVbd = &IntegratorOptions::vbd;
 
-// arkode_erk's options: ArkodeOptions without arkode_dirk's linear solver.
-IntegratorOptionsIo arkode_erk_options() {
-  IntegratorOptionsIo io = options_io<kArkode>();
-  io.validate = [](const IntegratorOptions& o, const std::string& prefix) {
-    o.arkode.validate(prefix);
-    require(o.arkode.linear_solver == ArkodeLinearSolver::kAuto, prefix + "linear_solver",
-            "\"" + std::string(name_of(arkode_linear_solvers(), o.arkode.linear_solver)) + "\"",
-            "\"auto\" (arkode_erk solves no linear system: linear_solver is arkode_dirk's "
-            "option)");
-  };
-  return io;
-}
-
 struct Entry {
   IntegratorInfo info;
-  Factory make;
+  IntegratorFactory make;
 };
 
 const IntegratorOptionsIo kNoOptions{};
 
 template <typename T>
-Factory plain() {
-  return [](const IntegratorOptions&) { return std::make_unique<T>(); };
+IntegratorFactory plain() {
+  return
+      [](const IntegratorOptions&) -> std::unique_ptr<Integrator> { return std::make_unique<T>(); };
 }
 
-const std::vector<Entry>& table() {
-  static const std::vector<Entry> entries = [] {
+// The core's integrators; the components add theirs (register_integrator). Kept sorted by name.
+std::vector<Entry>& table() {
+  static std::vector<Entry> entries = [] {
     std::vector<Entry> e{
-        {{"arkode_dirk",
-          "SUNDIALS ARKODE adaptive implicit DIRK (Newton, Schur or KLU linear solves)",
-          options_io<kArkode>()},
-         [](const IntegratorOptions& o) { return std::make_unique<ArkodeDirk>(o.arkode); }},
-        {{"arkode_erk", "SUNDIALS ARKODE adaptive explicit Runge-Kutta (default 5(4) pair)",
-          arkode_erk_options()},
-         [](const IntegratorOptions& o) { return std::make_unique<ArkodeErk>(o.arkode); }},
         {{"explicit_euler", "forward Euler, order 1, explicit", kNoOptions, true},
          plain<ExplicitEuler>()},
         {{"implicit_euler",
           "backward Euler on a sparse Cholesky/CG solver, order 1, implicit (stable at any dt)",
           options_io<kImplicit>()},
-         [](const IntegratorOptions& o) { return std::make_unique<ImplicitEuler>(o.implicit); }},
+         [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+           return std::make_unique<ImplicitEuler>(o.implicit);
+         }},
         {{"midpoint", "explicit midpoint (the report's midpoint Euler), order 2", kNoOptions, true},
          plain<Midpoint>()},
         {{"projective_dynamics",
           "local/global backward Euler on one prefactored matrix (Liu 2013), order 1, implicit",
           options_io<kPd>()},
-         [](const IntegratorOptions& o) { return std::make_unique<ProjectiveDynamics>(o.pd); }},
+         [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+           return std::make_unique<ProjectiveDynamics>(o.pd);
+         }},
         {{"rk4", "classical Runge-Kutta, order 4, explicit", kNoOptions, true},
          plain<RungeKutta4>()},
         {{"symplectic_euler",
@@ -99,10 +68,14 @@ const std::vector<Entry>& table() {
           "vertex block descent: per-particle 3x3 Newton steps of backward Euler in a graph "
           "colouring (Chen 2024), order 1, implicit",
           options_io<kVbd>()},
-         [](const IntegratorOptions& o) { return std::make_unique<Vbd>(o.vbd); }},
+         [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+           return std::make_unique<Vbd>(o.vbd);
+         }},
         {{"xpbd", "extended position-based dynamics with substeps (Macklin 2016, 2019), order 1",
           options_io<kXpbd>()},
-         [](const IntegratorOptions& o) { return std::make_unique<Xpbd>(o.xpbd); }},
+         [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+           return std::make_unique<Xpbd>(o.xpbd);
+         }},
     };
     std::sort(e.begin(), e.end(),
               [](const Entry& a, const Entry& b) { return a.info.name < b.info.name; });
@@ -111,16 +84,31 @@ const std::vector<Entry>& table() {
   return entries;
 }
 
+// The infos of table(), in its order: rebuilt when an integrator is registered.
+std::vector<IntegratorInfo>& infos() {
+  static std::vector<IntegratorInfo> out = [] {
+    std::vector<IntegratorInfo> all;
+    for (const Entry& e : table()) all.push_back(e.info);
+    return all;
+  }();
+  return out;
+}
+
 }  // namespace
 
-const std::vector<IntegratorInfo>& integrator_infos() {
-  static const std::vector<IntegratorInfo> infos = [] {
-    std::vector<IntegratorInfo> out;
-    for (const Entry& e : table()) out.push_back(e.info);
-    return out;
-  }();
-  return infos;
+void register_integrator(const IntegratorInfo& info, IntegratorFactory make) {
+  std::vector<Entry>& entries = table();
+  const auto same = [&](const Entry& e) { return e.info.name == info.name; };
+  if (std::any_of(entries.begin(), entries.end(), same)) return;
+  entries.push_back({info, make});
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry& a, const Entry& b) { return a.info.name < b.info.name; });
+  std::vector<IntegratorInfo>& list = infos();
+  list.clear();
+  for (const Entry& e : entries) list.push_back(e.info);
 }
+
+const std::vector<IntegratorInfo>& integrator_infos() { return infos(); }
 
 std::vector<std::string> integrator_names() {
   std::vector<std::string> names;

@@ -1,6 +1,7 @@
 #pragma once
 // Integrators by name, from one sorted table: each entry says what the integrator is, how to
-// make it, and which options it takes in a scene (integrator.options).
+// make it, and which options it takes in a scene (integrator.options). The core's integrators
+// are in it from the start; a component's (arkode) only in a program that links the component.
 #include <memory>
 #include <string>
 #include <string_view>
@@ -33,11 +34,19 @@ struct IntegratorInfo {
   bool in_evaluation_contact = false;
 };
 
+// Makes an integrator from the options (validated before it is called).
+using IntegratorFactory = std::unique_ptr<Integrator> (*)(const IntegratorOptions& options);
+
+// Adds an integrator to the table (a name already there is left as it was): how a component
+// (arkode) registers its kinds (core/components.hpp). Before main or before any other thread
+// reads the table: the references integrator_infos() returned before are invalidated.
+void register_integrator(const IntegratorInfo& info, IntegratorFactory make);
+
 // Every registered integrator, sorted by name.
 const std::vector<IntegratorInfo>& integrator_infos();
 std::vector<std::string> integrator_names();
 // The registered integrator's IntegratorInfo::in_evaluation_contact; false for a name the
-// registry does not know (an integrator of the user's own).
+// registry does not know (an integrator of the user's own that was not registered).
 bool integrator_supports_in_evaluation_contact(std::string_view name);
 // Throws InputError "<field> = "rk5" is invalid: one of ..." for an unknown name.
 const IntegratorInfo& find_integrator(std::string_view name,

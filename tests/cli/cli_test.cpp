@@ -12,11 +12,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <jelly/core/components.hpp>
 #include <jelly/geometry/body_kinds.hpp>
 #include <jelly/io/detail/field_reference.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
+#include <jelly/version.hpp>
 
 #include "cli/cli_support.hpp"
 
@@ -63,6 +65,27 @@ TEST(Cli, ListNamesEveryIntegratorTerrainKindAndContactModel) {
   for (const EnumName<ContactModel>& model : contact_models()) {
     EXPECT_THAT(r.out, HasSubstr("\ncontact    " + std::string(model.name) + " "));
   }
+}
+
+// `jelly list` shows the components of this build first (the program and this test link the
+// same ones), and a component's integrators only when it is there.
+TEST(Cli, ListShowsTheComponentsOfThisBuild) {
+  const Result r = jelly("list");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, StartsWith("component  core "));
+  for (const char* name : {"io", "meshes", "arkode", "fit"}) {
+    const bool built = std::string(name) == "io" ||
+                       (std::string(name) == "meshes" && JELLY_WITH_MESHES) ||
+                       (std::string(name) == "arkode" && JELLY_WITH_ARKODE) ||
+                       (std::string(name) == "fit" && JELLY_WITH_FIT);
+    EXPECT_EQ(has_component(name), built) << name;
+    EXPECT_EQ(r.out.find("\ncomponent  " + std::string(name) + " ") != std::string::npos, built)
+        << name;
+  }
+  EXPECT_EQ(r.out.find("\nintegrator arkode_dirk ") != std::string::npos,
+            static_cast<bool>(JELLY_WITH_ARKODE));
+  EXPECT_EQ(r.out.find("\nintegrator arkode_erk ") != std::string::npos,
+            static_cast<bool>(JELLY_WITH_ARKODE));
 }
 
 TEST(Cli, AShortGoodRunExitsZeroWithASummary) {

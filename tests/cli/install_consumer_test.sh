@@ -56,4 +56,48 @@ out=$("$work/build/consumer" "$prefix/share/jelly/scenes/drop_coulomb.json" 2 --
 echo "$out"
 echo "$out" | grep -q '^completed at t = 2 s'
 echo "$out" | awk '/^centre of mass:/ { exit !($5 > 0.5) }'
+
+# The core alone (examples/consumer_core: find_package(jelly COMPONENTS core), jelly::core): it
+# builds, runs the seed cube on the slope, has no component's integrators, and loads none of
+# HDF5, SUNDIALS, Ceres or assimp; at most 25 shared libraries (docs/CONTRIBUTING.md,
+# "Components").
+"$cmake" -S "$source_dir/examples/consumer_core" -B "$work/build_core" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$prefix" >"$work/configure_core.log" ||
+  { cat "$work/configure_core.log"; exit 1; }
+"$cmake" --build "$work/build_core" >"$work/build_core.log" 2>&1 ||
+  { cat "$work/build_core.log"; exit 1; }
+out=$("$work/build_core/consumer_core" 0.5)
+echo "$out"
+echo "$out" | grep -q '^components: core$'
+echo "$out" | grep -q '^integrators: .*implicit_euler'
+if echo "$out" | grep -q arkode; then echo "the core alone names ARKODE's integrators"; exit 1; fi
+echo "$out" | grep -q '^completed at t = 0.5 s after 30 steps'
+libraries=$(ldd "$work/build_core/consumer_core")
+count=$(echo "$libraries" | wc -l)
+echo "consumer_core: $count shared libraries (ldd)"
+if echo "$libraries" | grep -E 'libhdf5|libsundials|libceres|libassimp|libjelly_'; then
+  echo "consumer_core loads a library of another component"; exit 1
+fi
+[ "$count" -le 25 ] || { echo "$libraries"; echo "consumer_core: more than 25 libraries"; exit 1; }
+
+# find_package's COMPONENTS: jelly_<component>_FOUND for each, a required unknown one fails with
+# a message naming it, an optional one does not.
+mkdir -p "$work/components"
+cat >"$work/components/CMakeLists.txt" <<'CMAKE'
+cmake_minimum_required(VERSION 3.20)
+project(jelly_components LANGUAGES CXX)
+find_package(jelly CONFIG REQUIRED COMPONENTS core io OPTIONAL_COMPONENTS arkode viewer)
+message(STATUS "found: core=${jelly_core_FOUND} io=${jelly_io_FOUND} viewer=${jelly_viewer_FOUND}")
+CMAKE
+"$cmake" -S "$work/components" -B "$work/components/build" -DCMAKE_PREFIX_PATH="$prefix" \
+  >"$work/components.log" 2>&1 || { cat "$work/components.log"; exit 1; }
+grep -q 'found: core=TRUE io=TRUE viewer=FALSE' "$work/components.log" ||
+  { cat "$work/components.log"; exit 1; }
+sed -i 's/OPTIONAL_COMPONENTS arkode viewer/viewer/' "$work/components/CMakeLists.txt"
+rm -rf "$work/components/build"
+if "$cmake" -S "$work/components" -B "$work/components/build" -DCMAKE_PREFIX_PATH="$prefix" \
+     >"$work/components.log" 2>&1; then
+  echo "find_package(jelly REQUIRED COMPONENTS viewer) succeeded"; exit 1
+fi
+grep -q 'no component "viewer"' "$work/components.log" || { cat "$work/components.log"; exit 1; }
 echo "install_consumer_test: ok"

@@ -27,7 +27,7 @@ wheel=$(ls "$work"/dist/jelly-*.whl)
 import sys, zipfile
 names = zipfile.ZipFile(sys.argv[1]).namelist()
 for expected in ("jelly/__init__.py", "jelly/__init__.pyi", "jelly/py.typed", "jelly/libjelly.so.0",
-                 "jelly/libjelly_gmsh.so"):
+                 "jelly/libjelly_io.so.0", "jelly/libjelly_gmsh.so"):
     assert expected in names, (expected, names)
 assert any(n.startswith("jelly/_jelly") and n.endswith(".so") for n in names), names
 PY
