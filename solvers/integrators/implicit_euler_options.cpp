@@ -23,6 +23,8 @@ const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds() {
       {CgPreconditionerKind::kCholmod, "cholmod", "a lagged CHOLMOD factor of an earlier matrix"},
       {CgPreconditionerKind::kMultigrid, "multigrid",
        "a geometric multigrid V-cycle on lattice bodies (block Jacobi on the others)"},
+      {CgPreconditionerKind::kAmg, "amg",
+       "a smoothed-aggregation algebraic multigrid V-cycle on any body (assembled matrix)"},
   };
   return table;
 }
