@@ -280,7 +280,8 @@ void bind_solvers(py::module_& m) {
           choice_getter(&ImplicitEulerOptions::cg_preconditioner, cg_preconditioner_kinds),
           choice_setter(&ImplicitEulerOptions::cg_preconditioner, cg_preconditioner_kinds,
                         "cg_preconditioner"),
-          "\"jacobi\", \"cholmod\" or \"multigrid\" (lattice bodies; docs/implicit.md).")
+          "\"jacobi\", \"cholmod\", \"multigrid\" (lattice bodies) or \"amg\" (any body; "
+          "docs/implicit.md).")
       .def_readwrite("cg_tolerance", &ImplicitEulerOptions::cg_tolerance,
                      "Relative residual of CG.")
       .def_readwrite("contact_screening_tolerance",

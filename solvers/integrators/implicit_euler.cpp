@@ -255,8 +255,8 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
   // Block-Jacobi CG needs only products with A: from the bands when the springs fill them.
   const bool matrix_free =
       kind == ImplicitLinearSolver::kCg &&
-      (automatic || (options_.cg_preconditioner != CgPreconditionerKind::kCholmod &&
-                     options_.cg_preconditioner != CgPreconditionerKind::kAmg)) &&
+      (automatic || options_.cg_preconditioner != CgPreconditionerKind::kCholmod) &&
+      options_.cg_preconditioner != CgPreconditionerKind::kAmg &&  // on the assembled matrix
       bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_ &&
       // Contact pairs between bodies and added forces' Jacobians add blocks off the springs'
       // bands: the assembled matrix.

@@ -12,8 +12,6 @@ namespace jelly {
 
 namespace {
 
-// The coarsest level is factorized densely at or below this many unknowns.
-constexpr int kAmgCoarsestUnknowns = 400;
 // Coarsening stops when a level would keep more than this fraction of its finer level's
 // unknowns, or after this many levels.
 constexpr double kAmgMinReduction = 0.8;
@@ -21,6 +19,12 @@ constexpr int kAmgMaxLevels = 12;
 // A mode of an aggregate is kept when its Gram eigenvalue exceeds this times the largest.
 constexpr Real kAmgModeTolerance = 1e-10;
 constexpr int kAmgPowerIterations = 12;
+// The smoother: a Chebyshev polynomial in D^-1 A of this degree on level 0 and on the coarse
+// levels (where an application costs little), on [upper / 10, upper].
+constexpr int kAmgFineDegree = 2;
+constexpr int kAmgCoarseDegree = 4;
+// The coarse levels are solved by W-cycles (two cycles per visit) below level 1.
+constexpr int kAmgCoarsestUnknowns = 400;
 // A diagonal block or coarsest operator that is only semi-definite gets this times its largest
 // diagonal entry added to its diagonal.
 constexpr Real kAmgShift = 1e-12;
@@ -65,17 +69,36 @@ void SmoothedAggregation::aggregate(int l) {
   std::vector<int> node_of(a.rows);
   for (int i = 0; i < nodes; ++i)
     for (int r = level.node_start[i]; r < level.node_start[i + 1]; ++r) node_of[r] = i;
-  // The node graph: neighbours of each node (pattern only), sorted.
-  std::vector<std::vector<int>> neighbours(nodes);
+  // The node graph: the neighbours of each node, sorted. Level 0: every coupling of the pattern
+  // but those of isolated nodes (no strength threshold: the mass often outweighs each spring's
+  // block at large steps, and thresholds measured no better); coarse levels: the nonzero
+  // blocks.
+  std::vector<Real> diagonal(nodes, 0.0);
+  std::vector<std::vector<std::pair<int, Real>>> blocks(nodes);
   for (int i = 0; i < nodes; ++i) {
-    std::vector<int>& n = neighbours[i];
+    std::vector<std::pair<int, Real>>& n = blocks[i];
     for (int r = level.node_start[i]; r < level.node_start[i + 1]; ++r)
       for (int q = a.ptr[r]; q < a.ptr[r + 1]; ++q) {
         const int j = node_of[a.col[q]];
-        if (j != i && (l > 0 || (!isolated_[i] && !isolated_[j]))) n.push_back(j);
+        if (j == i) {
+          diagonal[i] += a.val[q] * a.val[q];
+        } else if (l > 0 || (!isolated_[i] && !isolated_[j])) {
+          n.emplace_back(j, a.val[q] * a.val[q]);
+        }
       }
     std::sort(n.begin(), n.end());
-    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  std::vector<std::vector<int>> neighbours(nodes);
+  for (int i = 0; i < nodes; ++i) {
+    const std::vector<std::pair<int, Real>>& n = blocks[i];
+    for (size_t k = 0; k < n.size();) {
+      size_t e = k;
+      Real sum = 0;
+      while (e < n.size() && n[e].first == n[k].first) sum += n[e++].second;
+      const int j = n[k].first;
+      if (sum > 0 || l == 0) neighbours[i].push_back(j);
+      k = e;
+    }
   }
   std::vector<int>& agg = level.aggregate;
   agg.assign(nodes, -1);
@@ -131,10 +154,10 @@ void SmoothedAggregation::tentative(int l, const std::vector<Real>& modes, int m
     if (l == 0 && m == 6) {
       // Rotations about the aggregate's centre (the modes hold the coordinates there).
       Vec3 centre = Vec3::Zero();
-      for (int q = 0; q < nr; q += 3) centre += b.block<3, 1>(q, 3);
-      centre /= nr / 3;
+      for (int q = 0; q < nr; q += 3) centre += b.block<1, 3>(q, 3).transpose();
+      centre /= static_cast<Real>(nr / 3);
       for (int q = 0; q < nr; q += 3) {
-        const Vec3 p = b.block<3, 1>(q, 3) - centre;
+        const Vec3 p = b.block<1, 3>(q, 3).transpose() - centre;
         b.block<3, 3>(q, 3) << 0, p.z(), -p.y(), -p.z(), 0, p.x(), p.y(), -p.x(), 0;
       }
     }
@@ -224,11 +247,11 @@ void SmoothedAggregation::multiply(int l, const VecX& x, VecX& y, int threads) c
   });
 }
 
-void SmoothedAggregation::smooth(int l, const VecX& res, VecX& x, bool first, int threads) const {
+void SmoothedAggregation::scale_add(int l, const VecX& res, VecX& out, Real alpha, Real beta,
+                                    int threads) const {
   const Level& level = levels_[l];
   const Real* pr = res.data();
-  Real* px = x.data();
-  const Real omega = level.omega;
+  Real* po = out.data();
   for_rows(threads, level.nodes(), [&](long begin, long end) {
     for (long i = begin; i < end; ++i) {
       const int s = level.node_start[i], k = level.node_start[i + 1] - s;
@@ -236,10 +259,48 @@ void SmoothedAggregation::smooth(int l, const VecX& res, VecX& x, bool first, in
       for (int r = 0; r < k; ++r) {
         Real sum = 0;
         for (int c = 0; c < k; ++c) sum += inv[r * k + c] * pr[s + c];
-        px[s + r] = (first ? 0 : px[s + r]) + omega * sum;
+        po[s + r] = (alpha == 0 ? 0 : alpha * po[s + r]) + beta * sum;
       }
     }
   });
+}
+
+void SmoothedAggregation::residual(int l, const VecX& x, int threads) {
+  Level& level = levels_[l];
+  multiply(l, x, level.t, threads);
+  for_rows(threads, level.rows(), [&](long begin, long end) {
+    for (long i = begin; i < end; ++i) level.t[i] = level.b[i] - level.t[i];
+  });
+}
+
+void SmoothedAggregation::relax(int l, VecX& x, bool from_zero, int threads) {
+  Level& level = levels_[l];
+  const int degree = l == 0 ? kAmgFineDegree : kAmgCoarseDegree;
+  // Chebyshev polynomial in D^-1 A of degree `degree` on [upper / 10, upper].
+  const Real upper = level.upper, lower = 0.1 * upper;
+  const Real theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower);
+  const Real sigma = theta / delta;
+  Real rho = 1 / sigma;
+  if (from_zero) {
+    scale_add(l, level.b, level.d, 0, 1 / theta, threads);
+  } else {
+    residual(l, x, threads);
+    scale_add(l, level.t, level.d, 0, 1 / theta, threads);
+  }
+  for (int k = 1; k <= degree; ++k) {
+    if (k == 1 && from_zero) {
+      x = level.d;
+    } else {
+      for_rows(threads, level.rows(), [&](long begin, long end) {
+        for (long i = begin; i < end; ++i) x[i] += level.d[i];
+      });
+    }
+    if (k == degree) break;
+    residual(l, x, threads);
+    const Real rho_next = 1 / (2 * sigma - rho);
+    scale_add(l, level.t, level.d, rho_next * rho, 2 * rho_next / delta, threads);
+    rho = rho_next;
+  }
 }
 
 void SmoothedAggregation::transfer(const RowMatrix& m, const VecX& in, VecX& out, bool add,
@@ -268,10 +329,7 @@ Real SmoothedAggregation::estimate_lambda(int l, int threads) {
   for (int k = 0; k < kAmgPowerIterations; ++k) {
     x /= x.norm();
     multiply(l, x, y, threads);
-    const Real saved = level.omega;
-    level.omega = 1;
-    smooth(l, y, x, true, threads);  // x = D^-1 A x
-    level.omega = saved;
+    scale_add(l, y, x, 0, 1, threads);  // x = D^-1 A x
     lambda = x.norm();
   }
   return lambda;
@@ -310,6 +368,7 @@ LinearResult SmoothedAggregation::setup(const SparseMatrix& a, const VecX& coord
     level.x.setZero(level.rows());
     level.b.setZero(level.rows());
     level.t.setZero(level.rows());
+    level.d.setZero(level.rows());
     if (level.rows() <= kAmgCoarsestUnknowns || l + 1 >= kAmgMaxLevels) break;
     aggregate(l);
     std::vector<Real> coarse_modes;
@@ -338,7 +397,8 @@ LinearResult SmoothedAggregation::refresh(const SparseMatrix& a, int threads) {
     LinearResult r = invert_diagonal(l, threads);
     if (!r.ok()) return r;
     const Real lambda = estimate_lambda(l, threads);
-    level.omega = l == 0 ? 2.0 / 3 : 4.0 / (3.0 * 1.1 * lambda);
+    level.upper = 1.1 * lambda;
+    if (l == 0) level.upper = std::min(2.0, level.upper);
     if (l + 1 == levels) {
       coarsest_dense_ = level.rows() <= kAmgCoarsestUnknowns;
       if (coarsest_dense_) {
@@ -374,7 +434,9 @@ LinearResult SmoothedAggregation::refresh(const SparseMatrix& a, int threads) {
     const View v = view(l);
     const Eigen::Map<const RowMatrix> al(v.rows, v.rows, v.ptr[v.rows], v.ptr, v.col, v.val);
     const RowMatrix at = al * level.tentative;
-    level.p = level.tentative - (4.0 / (3.0 * lambda)) * (dinv * at);
+    RowMatrix smoothing = dinv * at;
+    smoothing *= 4.0 / (3.0 * lambda);
+    level.p = level.tentative - smoothing;
     level.p.makeCompressed();
     level.r = level.p.transpose();
     level.r.makeCompressed();
@@ -388,6 +450,7 @@ LinearResult SmoothedAggregation::refresh(const SparseMatrix& a, int threads) {
       next.x.setZero(next.rows());
       next.b.setZero(next.rows());
       next.t.setZero(next.rows());
+      next.d.setZero(next.rows());
     }
   }
   return {};
@@ -404,29 +467,29 @@ void SmoothedAggregation::cycle(int l, int threads) {
   if (l + 1 == levels) {
     if (coarsest_dense_) {
       level.x = coarsest_.solve(level.b);
-      return;
+    } else {
+      relax(l, level.x, true, threads);
     }
-    // Two sweeps of the smoother from zero (a symmetric operator).
-    smooth(l, level.b, level.x, true, threads);
-    multiply(l, level.x, level.t, threads);
-    level.t = level.b - level.t;
-    smooth(l, level.t, level.x, false, threads);
     return;
   }
   Level& next = levels_[l + 1];
-  smooth(l, level.b, level.x, true, threads);
-  multiply(l, level.x, level.t, threads);
-  for_rows(threads, level.rows(), [&](long begin, long end) {
-    for (long i = begin; i < end; ++i) level.t[i] = level.b[i] - level.t[i];
-  });
+  relax(l, level.x, true, threads);
+  residual(l, level.x, threads);
   transfer(level.r, level.t, next.b, false, threads);
   cycle(l + 1, threads);
+  if (l + 2 < levels) {
+    // W-cycle below level 1: a second cycle on the coarse residual (the same symmetric
+    // operator again: the product stays symmetric positive definite).
+    next.w = next.x;
+    next.s = next.b;
+    residual(l + 1, next.x, threads);
+    next.b = next.t;
+    cycle(l + 1, threads);
+    next.x += next.w;
+    next.b = next.s;
+  }
   transfer(level.p, next.x, level.x, true, threads);
-  multiply(l, level.x, level.t, threads);
-  for_rows(threads, level.rows(), [&](long begin, long end) {
-    for (long i = begin; i < end; ++i) level.t[i] = level.b[i] - level.t[i];
-  });
-  smooth(l, level.t, level.x, false, threads);
+  relax(l, level.x, false, threads);
 }
 
 void SmoothedAggregation::apply(const VecX& r, VecX& z, int threads) {

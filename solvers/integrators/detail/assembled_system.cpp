@@ -40,11 +40,11 @@ std::unique_ptr<LinearSolver> make_linear_solver(ImplicitLinearSolver kind, bool
   cholmod.ordering = options.ordering;
   if (kind == ImplicitLinearSolver::kCholmod) return std::make_unique<CholmodSolver>(cholmod);
   if (kind == ImplicitLinearSolver::kLdlt) return std::make_unique<LdltSolver>();
-  CgOptions cg;  // auto's CG is block Jacobi, the fastest measured above its threshold
+  CgOptions cg;  // auto's CG is block Jacobi (the fastest measured above its threshold) or amg
   cg.preconditioner = CgPreconditioner::kJacobi;
   if (!automatic && options.cg_preconditioner == CgPreconditionerKind::kCholmod)
     cg.preconditioner = CgPreconditioner::kLaggedCholesky;
-  if (!automatic && options.cg_preconditioner == CgPreconditionerKind::kAmg)
+  if (options.cg_preconditioner == CgPreconditionerKind::kAmg)
     cg.preconditioner = CgPreconditioner::kAmg;
   cg.tolerance = options.cg_tolerance;
   cg.max_iterations = options.cg_max_iterations;

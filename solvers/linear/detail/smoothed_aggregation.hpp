@@ -18,11 +18,13 @@
 // Cholesky factor. refresh() recomputes them from the current values; between refreshes the
 // coarse levels lag while level 0's smoother and residuals use the current matrix.
 //
-// Smoother: block Jacobi damped by 2/3 on level 0 (lambda_max(D^-1 A) <= 2 for a mass plus
-// positive semi-definite spring blocks) and 4 / (3 lambda) on coarse levels (lambda times 1.1),
-// the same number of sweeps before and after the coarse correction: the V-cycle is symmetric
-// positive definite whatever coarse operators it holds. Every loop of the V-cycle is a gather
-// over rows on a static split and the setup is serial: the same bits for any thread count.
+// Smoother: a Chebyshev polynomial in D^-1 A (D the diagonal blocks), of degree 2 on level 0
+// and 4 on the coarse levels, on [upper / 10, upper], upper = 1.1 times the power estimate (at
+// most 2 on level 0, where lambda_max(D^-1 A) <= 2 for a mass plus positive semi-definite
+// spring blocks); the same polynomial before and after the coarse correction, and levels below
+// 1 visited twice (a W-cycle): the cycle is symmetric positive definite whatever coarse
+// operators it holds. Every loop of the cycle is a gather over rows on a static split and the
+// setup is serial: the same bits for any thread count.
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -69,13 +71,13 @@ class SmoothedAggregation {
     std::vector<int> node_start;  // [nodes + 1]: first unknown of each node
     std::vector<Real> inverse;    // the inverses of the diagonal blocks, row-major, packed
     std::vector<int> inverse_start;
-    Real omega = 2.0 / 3;
+    Real upper = 2;  // the smoother's bound on the eigenvalues of D^-1 A
     // Transfers to the next coarser level (absent on the coarsest).
     RowMatrix tentative, p, r;
     std::vector<int> aggregate;  // [nodes]: aggregate of each node (-1: none)
     int aggregates = 0;
     std::vector<int> coarse_start;  // [aggregates + 1]: first coarse unknown of each aggregate
-    VecX x, b, t;
+    VecX x, b, t, d, w, s;  // the cycle's vectors
     int rows() const { return node_start.empty() ? 0 : node_start.back(); }
     int nodes() const { return static_cast<int>(node_start.size()) - 1; }
   };
@@ -91,7 +93,12 @@ class SmoothedAggregation {
   // The largest eigenvalue of D^-1 A on level l, by power iteration from a fixed vector.
   Real estimate_lambda(int l, int threads);
   void multiply(int l, const VecX& x, VecX& y, int threads) const;
-  void smooth(int l, const VecX& res, VecX& x, bool first, int threads) const;
+  // out = alpha out + beta D^-1 res (alpha 0: out is not read).
+  void scale_add(int l, const VecX& res, VecX& out, Real alpha, Real beta, int threads) const;
+  // t = b - A x on level l.
+  void residual(int l, const VecX& x, int threads);
+  // The smoother on level l's b, from x (or from zero).
+  void relax(int l, VecX& x, bool from_zero, int threads);
   void transfer(const RowMatrix& m, const VecX& in, VecX& out, bool add, int threads) const;
   void cycle(int l, int threads);
 
