@@ -68,6 +68,7 @@ struct SpeedRun {
       parts.model = make_model(*scene);
       parts.state = initial_state(parts.model);
       for (const auto& terrain : scene->terrains) parts.terrains.push_back(make_terrain(*terrain));
+      if (!parts.terrains.empty()) lower_onto(*parts.terrains.front());
       method = make_integrator(integrator, options);
       bands = std::make_unique<const SpringBands>(parts.model);
       f.resize(parts.model.num_dofs());
@@ -78,17 +79,21 @@ struct SpeedRun {
     spec.n = n;
     spec.ks = ks;
     parts = build_scene(spec);
-    // Lower the cube onto the slope: the deepest particle 1 mm below the surface.
-    Real lowest = INFINITY;
-    for (int i = 0; i < parts.model.num_particles(); ++i)
-      lowest =
-          std::min(lowest, parts.terrains.front()->signed_distance(particle(parts.state.x, i), 0));
-    const Vec3 normal = parts.terrains.front()->normal(Vec3::Zero(), 0);
-    for (int i = 0; i < parts.model.num_particles(); ++i)
-      particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
+    lower_onto(*parts.terrains.front());
     method = make_integrator(integrator, options);
     bands = std::make_unique<const SpringBands>(parts.model);
     f.resize(parts.model.num_dofs());
+  }
+
+  // Lowers the bodies onto `terrain` (a plane): the deepest particle 1 mm below its surface, so
+  // that contacts are active from the first step.
+  void lower_onto(const Terrain& terrain) {
+    Real lowest = INFINITY;
+    for (int i = 0; i < parts.model.num_particles(); ++i)
+      lowest = std::min(lowest, terrain.signed_distance(particle(parts.state.x, i), 0));
+    const Vec3 normal = terrain.normal(Vec3::Zero(), 0);
+    for (int i = 0; i < parts.model.num_particles(); ++i)
+      particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
   }
 
   bool finished(const SpeedOptions& o) const {

@@ -18,9 +18,10 @@ inline constexpr const char* kDirectCholmod = "direct";
 struct SpeedOptions {
   std::vector<std::string> integrators;  // empty: every registered integrator
   std::vector<int> sizes{5, 10, 20, 30};
-  // Scene files measured instead of the slope's cubes (sizes then unused): their bodies,
-  // terrains and integrator options (cg_preconditioner replaced by each of `preconditioners`),
-  // stepped at dt; rows labelled "integrator[preconditioner]@file stem", n = the scene's index.
+  // Scene files measured instead of the slope's cubes (sizes then unused): their bodies
+  // (lowered onto the first terrain, as the cubes are, when there is one), terrains and
+  // integrator options (cg_preconditioner replaced by each of `preconditioners`), stepped at
+  // dt; rows labelled "integrator[preconditioner]@file stem", n = the scene's index.
   std::vector<std::string> scenes;
   // implicit_euler's cg_preconditioner values, a row each (labelled "implicit_euler[name]"),
   // and kDirectCholmod for its linear_solver "cholmod" (a factorization every step); empty: its

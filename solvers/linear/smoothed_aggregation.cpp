@@ -14,16 +14,11 @@ namespace {
 
 // Coarsening stops when a level would keep more than this fraction of its finer level's
 // unknowns, or after this many levels.
-constexpr double kAmgMinReduction = 0.8;
+constexpr double kAmgMinReduction = 0.5;
 constexpr int kAmgMaxLevels = 12;
 // A mode of an aggregate is kept when its Gram eigenvalue exceeds this times the largest.
 constexpr Real kAmgModeTolerance = 1e-10;
 constexpr int kAmgPowerIterations = 12;
-// The smoother: a Chebyshev polynomial in D^-1 A of this degree on level 0 and on the coarse
-// levels (where an application costs little), on [upper / 10, upper].
-constexpr int kAmgFineDegree = 2;
-constexpr int kAmgCoarseDegree = 4;
-// The coarse levels are solved by W-cycles (two cycles per visit) below level 1.
 constexpr int kAmgCoarsestUnknowns = 400;
 // A diagonal block or coarsest operator that is only semi-definite gets this times its largest
 // diagonal entry added to its diagonal.
@@ -44,6 +39,10 @@ void for_rows(int threads, long n, Body&& body) {
 }
 
 }  // namespace
+
+long SmoothedAggregation::non_zeros(int l) const {
+  return l == 0 ? static_cast<long>(fine_->nonZeros()) : static_cast<long>(levels_[l].a.nonZeros());
+}
 
 SmoothedAggregation::View SmoothedAggregation::view(int l) const {
   View v;
@@ -275,7 +274,7 @@ void SmoothedAggregation::residual(int l, const VecX& x, int threads) {
 
 void SmoothedAggregation::relax(int l, VecX& x, bool from_zero, int threads) {
   Level& level = levels_[l];
-  const int degree = l == 0 ? kAmgFineDegree : kAmgCoarseDegree;
+  const int degree = l == 0 ? options_.fine_degree : options_.coarse_degree;
   // Chebyshev polynomial in D^-1 A of degree `degree` on [upper / 10, upper].
   const Real upper = level.upper, lower = 0.1 * upper;
   const Real theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower);
@@ -477,9 +476,10 @@ void SmoothedAggregation::cycle(int l, int threads) {
   residual(l, level.x, threads);
   transfer(level.r, level.t, next.b, false, threads);
   cycle(l + 1, threads);
-  if (l + 2 < levels) {
+  if (options_.w_cycle && l + 2 < levels && 4 * next.rows() <= level.rows()) {
     // W-cycle below level 1: a second cycle on the coarse residual (the same symmetric
-    // operator again: the product stays symmetric positive definite).
+    // operator again: the product stays symmetric positive definite). Only below a level at
+    // most a quarter of this one: 2^k visits of level k cost at most (2/4)^k of level 0's.
     next.w = next.x;
     next.s = next.b;
     residual(l + 1, next.x, threads);

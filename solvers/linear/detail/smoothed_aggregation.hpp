@@ -38,6 +38,15 @@ namespace jelly {
 
 class SmoothedAggregation {
  public:
+  // The cycle: Chebyshev degrees and whether levels below 1 are visited twice (W-cycle).
+  struct Options {
+    int fine_degree = 2;
+    int coarse_degree = 4;
+    bool w_cycle = true;
+  };
+  SmoothedAggregation() = default;
+  explicit SmoothedAggregation(Options options) : options_(options) {}
+
   // Aggregates and tentative prolongators for the pattern of `a` (full storage, symmetric, 3x3
   // blocks of particles, compressed) and the values of refresh(a). `coordinates` (3 per
   // particle, or empty) give the rotations of the near-null space. Allocates: once per pattern.
@@ -53,8 +62,9 @@ class SmoothedAggregation {
   bool ready() const { return !levels_.empty(); }
   void clear() { levels_.clear(); }
   int levels() const { return static_cast<int>(levels_.size()); }
-  // Unknowns of level l.
+  // Unknowns and stored entries of level l.
   int unknowns(int l) const { return levels_[l].rows(); }
+  long non_zeros(int l) const;
 
  private:
   using RowMatrix = Eigen::SparseMatrix<Real, Eigen::RowMajor, int>;
@@ -102,6 +112,7 @@ class SmoothedAggregation {
   void transfer(const RowMatrix& m, const VecX& in, VecX& out, bool add, int threads) const;
   void cycle(int l, int threads);
 
+  Options options_;
   const SparseMatrix* fine_ = nullptr;
   std::vector<Level> levels_;
   Eigen::LLT<Eigen::MatrixXd> coarsest_;
