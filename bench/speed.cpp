@@ -254,8 +254,8 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
                                  static_cast<double>(threads)};
           if (is_adaptive_integrator(integrator)) {
             std::vector<Cell> row = head;
-            row.insert(row.end(), {NAN, NAN, o.dt, 0.0, std::string("skipped_adaptive"), NAN,
-                                   NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN});
+            row.insert(row.end(), {NAN, NAN, o.dt, 0.0, std::string("skipped_adaptive"), NAN, NAN,
+                                   NAN, NAN, NAN, NAN, NAN, NAN, NAN});
             speed.add_row(row);
             continue;
           }

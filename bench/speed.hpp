@@ -1,8 +1,8 @@
 #pragma once
 // Cost per step against the cube size for each integrator, on the seed slope with every contact
-// active (or on scene files): the step split into the integrator (of which force evaluations) and contact, the
-// integrator's own statistics (assembly, factorisation, solve when it reports them), springs per
-// second and the peak resident memory of each configuration (memory.hpp).
+// active (or on scene files): the step split into the integrator (of which force evaluations) and
+// contact, the integrator's own statistics (assembly, factorisation, solve when it reports them),
+// springs per second and the peak resident memory of each configuration (memory.hpp).
 #include <string>
 #include <vector>
 

@@ -353,8 +353,8 @@ struct CgSolver::Impl {
   std::unique_ptr<CholmodSolver> factor_;
   std::unique_ptr<SmoothedAggregation> amg_;  // kAmg
   VecX coordinates_;                          // kAmg: the near-null space's positions
-  bool stale_ = true;   // the next factorize must refactor
-  bool fresh_ = false;  // the factor is of the current matrix
+  bool stale_ = true;                         // the next factorize must refactor
+  bool fresh_ = false;                        // the factor is of the current matrix
   long preconditioner_factorizations_ = 0;
 };
 

@@ -2,7 +2,8 @@
 // Preconditioned conjugate gradients behind the LinearSolver interface, preconditioned by the
 // inverse diagonal (Jacobi), by a CHOLMOD factor of an earlier matrix ("lagged"), which is
 // refreshed only when CG needs more than a few iterations with it or after invalidate(), or by
-// a smoothed-aggregation algebraic multigrid V-cycle (solvers/linear/detail/smoothed_aggregation.hpp).
+// a smoothed-aggregation algebraic multigrid cycle
+// (solvers/linear/detail/smoothed_aggregation.hpp).
 #include <functional>
 #include <memory>
 #include <vector>

@@ -350,7 +350,8 @@ LinearResult SmoothedAggregation::setup(const SparseMatrix& a, const VecX& coord
   for (int r = 0; r < n; ++r) {
     modes[static_cast<size_t>(r) * m + r % 3] = 1;
     if (rotations)
-      for (int d = 0; d < 3; ++d) modes[static_cast<size_t>(r) * m + 3 + d] = coordinates[r - r % 3 + d];
+      for (int d = 0; d < 3; ++d)
+        modes[static_cast<size_t>(r) * m + 3 + d] = coordinates[r - r % 3 + d];
   }
   // Nodes without couplings now (pins, sticking contacts) stay out of the coarse space: the
   // smoother solves their rows exactly.

@@ -87,7 +87,7 @@ class SmoothedAggregation {
     std::vector<int> aggregate;  // [nodes]: aggregate of each node (-1: none)
     int aggregates = 0;
     std::vector<int> coarse_start;  // [aggregates + 1]: first coarse unknown of each aggregate
-    VecX x, b, t, d, w, s;  // the cycle's vectors
+    VecX x, b, t, d, w, s;          // the cycle's vectors
     int rows() const { return node_start.empty() ? 0 : node_start.back(); }
     int nodes() const { return static_cast<int>(node_start.size()) - 1; }
   };
