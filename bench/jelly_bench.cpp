@@ -122,9 +122,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   speed_cmd->add_option("--dt", speed.dt, "time step (s)")->capture_default_str();
   speed_cmd
-      ->add_option("--preconditioners", speed.preconditioners,
-                   "implicit_euler's cg_preconditioner values (jacobi, cholmod, multigrid), a row "
-                   "each, labelled implicit_euler[name] (default: its default only)")
+      ->add_option(
+          "--preconditioners", speed.preconditioners,
+          "implicit_euler's cg_preconditioner values (jacobi, cholmod, multigrid, amg; direct: "
+          "its CHOLMOD solver instead of CG), a row "
+          "each, labelled implicit_euler[name] (default: its default only)")
+      ->delimiter(',');
+  speed_cmd
+      ->add_option("--scenes", speed.scenes,
+                   "scene files measured instead of the slope's cubes (their bodies, terrains and "
+                   "integrator options; --sizes and --ks unused), rows labelled @file")
       ->delimiter(',');
   speed_cmd->add_option("--ks", speed.ks, "spring stiffness of every type (N/m)")
       ->capture_default_str();

@@ -12,6 +12,7 @@
 #include <jelly/core/detail/team_chooser.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/io/scene.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly::bench {
@@ -27,7 +28,7 @@ void SpeedOptions::validate() const {
   require(interleave_block >= 1, "--interleave-block", interleave_block, "an integer >= 1");
   require(std::isfinite(ks) && ks > 0, "--ks", ks, "a stiffness > 0 N/m");
   for (const std::string& p : preconditioners)
-    value_of(cg_preconditioner_kinds(), p, "--preconditioners");
+    if (p != kDirectCholmod) value_of(cg_preconditioner_kinds(), p, "--preconditioners");
 }
 
 namespace {
@@ -59,26 +60,40 @@ struct SpeedRun {
   Statistics before_timing;
 
   SpeedRun(std::vector<Cell> row_head, const std::string& integrator, int n, int thread_count,
-           Real ks, const IntegratorOptions& options)
+           Real ks, const IntegratorOptions& options, const Scene* scene = nullptr)
       : head(std::move(row_head)), threads(thread_count) {
     if (threads == 0)
       chooser = std::make_unique<parallel::TeamChooser>(parallel::available_cores());
+    if (scene != nullptr) {  // a scene file's bodies and terrains as they are
+      parts.model = make_model(*scene);
+      parts.state = initial_state(parts.model);
+      for (const auto& terrain : scene->terrains) parts.terrains.push_back(make_terrain(*terrain));
+      if (!parts.terrains.empty()) lower_onto(*parts.terrains.front());
+      method = make_integrator(integrator, options);
+      bands = std::make_unique<const SpringBands>(parts.model);
+      f.resize(parts.model.num_dofs());
+      return;
+    }
     SceneSpec spec;
     spec.name = "slope";
     spec.n = n;
     spec.ks = ks;
     parts = build_scene(spec);
-    // Lower the cube onto the slope: the deepest particle 1 mm below the surface.
-    Real lowest = INFINITY;
-    for (int i = 0; i < parts.model.num_particles(); ++i)
-      lowest =
-          std::min(lowest, parts.terrains.front()->signed_distance(particle(parts.state.x, i), 0));
-    const Vec3 normal = parts.terrains.front()->normal(Vec3::Zero(), 0);
-    for (int i = 0; i < parts.model.num_particles(); ++i)
-      particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
+    lower_onto(*parts.terrains.front());
     method = make_integrator(integrator, options);
     bands = std::make_unique<const SpringBands>(parts.model);
     f.resize(parts.model.num_dofs());
+  }
+
+  // Lowers the bodies onto `terrain` (a plane): the deepest particle 1 mm below its surface, so
+  // that contacts are active from the first step.
+  void lower_onto(const Terrain& terrain) {
+    Real lowest = INFINITY;
+    for (int i = 0; i < parts.model.num_particles(); ++i)
+      lowest = std::min(lowest, terrain.signed_distance(particle(parts.state.x, i), 0));
+    const Vec3 normal = terrain.normal(Vec3::Zero(), 0);
+    for (int i = 0; i < parts.model.num_particles(); ++i)
+      particle(parts.state.x, i) -= (lowest + 1e-3) * normal;
   }
 
   bool finished(const SpeedOptions& o) const {
@@ -182,50 +197,82 @@ std::vector<Table> run_speed(const SpeedOptions& o) {
       variants.emplace_back(integrator, "");
     }
   }
-  for (const auto& [integrator, preconditioner] : variants) {
-    IntegratorOptions options;
-    if (!preconditioner.empty())
-      options.implicit.cg_preconditioner =
-          value_of(cg_preconditioner_kinds(), preconditioner, "--preconditioners");
-    const std::string label =
-        preconditioner.empty() ? integrator : integrator + "[" + preconditioner + "]";
-    for (int n : o.sizes) {
-      // The rows of this integrator and size that this shard owns.
-      std::vector<std::unique_ptr<SpeedRun>> runs;
-      for (int requested_threads : o.threads) {
-        const long this_item = item++;
-        if (!o.shard.owns(this_item)) continue;
-        // 0: the default, each step's team size chosen as the Simulator chooses it.
-        const int threads = requested_threads;
-        std::vector<Cell> head{static_cast<double>(this_item), label, static_cast<double>(n),
-                               static_cast<double>(threads)};
-        if (is_adaptive_integrator(integrator)) {
-          std::vector<Cell> row = head;
-          row.insert(row.end(), {NAN, NAN, o.dt, 0.0, std::string("skipped_adaptive"), NAN, NAN,
-                                 NAN, NAN, NAN, NAN, NAN, NAN, NAN});
-          speed.add_row(row);
-          continue;
-        }
-        if (o.interleave) {
-          runs.push_back(std::make_unique<SpeedRun>(head, integrator, n, threads, o.ks, options));
-          continue;
-        }
-        const bool reset = reset_peak_memory();
-        SpeedRun run(head, integrator, n, threads, o.ks, options);
-        run.memory_reset = reset;
-        run.advance(o, o.warmup_steps + o.steps);
-        run.add_rows(o.dt, speed, stats);
+  std::vector<Scene> scenes;
+  for (const std::string& file : o.scenes) scenes.push_back(load_scene(file));
+  // Each scene's rows one after the other (all variants of one scene in a row), else each
+  // variant's sizes.
+  const std::vector<int> scene_items = scenes.empty() ? std::vector<int>{-1} : [&] {
+    std::vector<int> all;
+    for (int k = 0; k < static_cast<int>(scenes.size()); ++k) all.push_back(k);
+    return all;
+  }();
+  // With --interleave: a scene's rows of every variant run in alternation (the slope's rows of
+  // one variant and size).
+  std::vector<std::unique_ptr<SpeedRun>> runs;
+  const auto run_interleaved = [&] {
+    for (bool more = !runs.empty(); more;) {
+      more = false;
+      for (auto& run : runs) {
+        run->advance(o, o.interleave_block);
+        more = more || !run->finished(o);
       }
-      // Interleaved: blocks of steps of each row in turn, until all are done.
-      for (bool more = !runs.empty(); more;) {
-        more = false;
-        for (auto& run : runs) {
-          run->advance(o, o.interleave_block);
-          more = more || !run->finished(o);
-        }
-      }
-      for (const auto& run : runs) run->add_rows(o.dt, speed, stats);
     }
+    for (const auto& run : runs) run->add_rows(o.dt, speed, stats);
+    runs.clear();
+  };
+  for (const int scene_index : scene_items) {
+    const Scene* scene = scene_index >= 0 ? &scenes[scene_index] : nullptr;
+    for (const auto& [integrator, preconditioner] : variants) {
+      IntegratorOptions options =
+          scene != nullptr ? scene->integrator.options : IntegratorOptions{};
+      if (preconditioner == kDirectCholmod) {
+        options.implicit.linear_solver = ImplicitLinearSolver::kCholmod;
+      } else if (!preconditioner.empty()) {
+        options.implicit.cg_preconditioner =
+            value_of(cg_preconditioner_kinds(), preconditioner, "--preconditioners");
+      }
+      std::string label =
+          preconditioner.empty() ? integrator : integrator + "[" + preconditioner + "]";
+      if (scene != nullptr) {
+        const std::string& file = o.scenes[scene_index];
+        const size_t slash = file.find_last_of('/');
+        std::string stem = file.substr(slash == std::string::npos ? 0 : slash + 1);
+        if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0)
+          stem.resize(stem.size() - 5);
+        label += "@" + stem;
+      }
+      const std::vector<int> sizes = scene != nullptr ? std::vector<int>{scene_index} : o.sizes;
+      for (int n : sizes) {
+        // The rows of this integrator and size that this shard owns.
+        for (int requested_threads : o.threads) {
+          const long this_item = item++;
+          if (!o.shard.owns(this_item)) continue;
+          // 0: the default, each step's team size chosen as the Simulator chooses it.
+          const int threads = requested_threads;
+          std::vector<Cell> head{static_cast<double>(this_item), label, static_cast<double>(n),
+                                 static_cast<double>(threads)};
+          if (is_adaptive_integrator(integrator)) {
+            std::vector<Cell> row = head;
+            row.insert(row.end(), {NAN, NAN, o.dt, 0.0, std::string("skipped_adaptive"), NAN, NAN,
+                                   NAN, NAN, NAN, NAN, NAN, NAN, NAN});
+            speed.add_row(row);
+            continue;
+          }
+          if (o.interleave) {
+            runs.push_back(
+                std::make_unique<SpeedRun>(head, integrator, n, threads, o.ks, options, scene));
+            continue;
+          }
+          const bool reset = reset_peak_memory();
+          SpeedRun run(head, integrator, n, threads, o.ks, options, scene);
+          run.memory_reset = reset;
+          run.advance(o, o.warmup_steps + o.steps);
+          run.add_rows(o.dt, speed, stats);
+        }
+        if (scene == nullptr) run_interleaved();
+      }
+    }
+    run_interleaved();
   }
   return {speed, stats};
 }

@@ -1,8 +1,8 @@
 #pragma once
 // Cost per step against the cube size for each integrator, on the seed slope with every contact
-// active: the step split into the integrator (of which force evaluations) and contact, the
-// integrator's own statistics (assembly, factorisation, solve when it reports them), springs per
-// second and the peak resident memory of each configuration (memory.hpp).
+// active (or on scene files): the step split into the integrator (of which force evaluations) and
+// contact, the integrator's own statistics (assembly, factorisation, solve when it reports them),
+// springs per second and the peak resident memory of each configuration (memory.hpp).
 #include <string>
 #include <vector>
 
@@ -12,11 +12,20 @@
 
 namespace jelly::bench {
 
+// The --preconditioners value that runs implicit_euler with CHOLMOD instead of CG.
+inline constexpr const char* kDirectCholmod = "direct";
+
 struct SpeedOptions {
   std::vector<std::string> integrators;  // empty: every registered integrator
   std::vector<int> sizes{5, 10, 20, 30};
-  // implicit_euler's cg_preconditioner values, a row each (labelled "implicit_euler[name]");
-  // empty: its default only.
+  // Scene files measured instead of the slope's cubes (sizes then unused): their bodies
+  // (lowered onto the first terrain, as the cubes are, when there is one), terrains and
+  // integrator options (cg_preconditioner replaced by each of `preconditioners`), stepped at
+  // dt; rows labelled "integrator[preconditioner]@file stem", n = the scene's index.
+  std::vector<std::string> scenes;
+  // implicit_euler's cg_preconditioner values, a row each (labelled "implicit_euler[name]"),
+  // and kDirectCholmod for its linear_solver "cholmod" (a factorization every step); empty: its
+  // default only.
   std::vector<std::string> preconditioners;
   Real ks = 1400;  // N/m, every spring type (kd stays the seed's 50)
   // Thread counts, each a row (the scaling table); 0 = all cores.

@@ -281,7 +281,7 @@ class ImplicitEulerOptions:
     newton_tolerance: float
     definiteness: str
     linear_solver: str
-    cg_preconditioner: str  # "jacobi", "cholmod" or "multigrid" (lattice bodies)
+    cg_preconditioner: str  # "jacobi", "cholmod", "multigrid" (lattice bodies) or "amg" (any body)
     cg_tolerance: float
     contact_screening_tolerance: float
     cg_max_iterations: int

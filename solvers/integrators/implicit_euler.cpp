@@ -198,6 +198,10 @@ void ImplicitEuler::Impl::add_statistics(Statistics& s) const {
   s["solve_seconds"] = times_.solve;
   if (matrix_free_.uses_multigrid())
     s["multigrid_levels"] = static_cast<double>(matrix_free_.multigrid_levels());
+  if (assembled_ && assembled_->multigrid_levels() > 0) {  // cg_preconditioner = amg
+    s["multigrid_levels"] = static_cast<double>(assembled_->multigrid_levels());
+    s["amg_refreshes"] = static_cast<double>(assembled_->preconditioner_refreshes());
+  }
   if (resolves_contact()) {
     const ImplicitContact::Counters& cc = contact_.counters();
     s["contact_extra_solves"] = static_cast<double>(cc.extra_solves);
@@ -245,6 +249,7 @@ StepResult ImplicitEuler::Impl::prepare(const Dynamics& dynamics, Real h) {
   const bool matrix_free =
       kind == ImplicitLinearSolver::kCg &&
       (automatic || options_.cg_preconditioner != CgPreconditionerKind::kCholmod) &&
+      options_.cg_preconditioner != CgPreconditionerKind::kAmg &&  // on the assembled matrix
       bands != nullptr && bands->dense() && bands->fits(model) && !matrix_free_failed_ &&
       // Contact pairs between bodies add blocks off the springs' bands: the assembled matrix.
       !(options_.contact == ImplicitContactMode::kImplicit && dynamics.body_contact() != nullptr);

@@ -22,6 +22,8 @@ const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds() {
       {CgPreconditionerKind::kCholmod, "cholmod", "a lagged CHOLMOD factor of an earlier matrix"},
       {CgPreconditionerKind::kMultigrid, "multigrid",
        "a geometric multigrid V-cycle on lattice bodies (block Jacobi on the others)"},
+      {CgPreconditionerKind::kAmg, "amg",
+       "a smoothed-aggregation algebraic multigrid cycle on any body (assembled matrix)"},
   };
   return table;
 }
@@ -55,7 +57,9 @@ const FieldTable<ImplicitEulerOptions>& implicit_euler_fields() {
           choice_field<&O::linear_solver, &implicit_linear_solvers>(
               "linear_solver", "The linear solver of each Newton step"),
           choice_field<&O::cg_preconditioner, &cg_preconditioner_kinds>(
-              "cg_preconditioner", "CG's preconditioner (multigrid: lattice bodies)"),
+              "cg_preconditioner",
+              "CG's preconditioner (multigrid: lattice bodies; amg: any body, where CG solves: "
+              "linear_solver cg, or auto above 1000 unknowns)"),
           number_field<&O::cg_tolerance>("cg_tolerance", "", range_open(0, 1),
                                          "a relative residual in (0, 1)",
                                          "CG's relative residual |b - A x| / |b|"),
@@ -63,7 +67,8 @@ const FieldTable<ImplicitEulerOptions>& implicit_euler_fields() {
                                                "an integer >= 1", "CG iterations at most"),
           integer_field<&O::refactor_iterations>(
               "refactor_iterations", "", range_at_least(1), "an integer >= 1",
-              "CG iterations that trigger a new CHOLMOD preconditioner"),
+              "CG iterations that trigger a new CHOLMOD preconditioner (amg: a refresh of its "
+              "coarse levels; 1 = every step)"),
           choice_field<&O::ordering, &cholmod_orderings>("ordering",
                                                          "CHOLMOD's fill-reducing ordering"),
           choice_field<&O::contact, &implicit_contact_modes>("contact",

@@ -26,6 +26,8 @@ enum class CgPreconditionerKind {
   kCholmod,  // a CHOLMOD factor of an earlier matrix, refreshed when it stops paying
   // A geometric multigrid V-cycle on lattice bodies (matrix-free CG; block Jacobi elsewhere)
   kMultigrid,
+  // Smoothed-aggregation algebraic multigrid on any body (the assembled matrix's CG)
+  kAmg,
 };
 const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds();
 

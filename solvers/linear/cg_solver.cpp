@@ -10,6 +10,7 @@
 #include <Eigen/LU>
 
 #include <jelly/core/detail/parallel.hpp>
+#include <jelly/solvers/linear/detail/smoothed_aggregation.hpp>
 
 namespace jelly {
 
@@ -350,22 +351,39 @@ struct CgSolver::Impl {
   VecX inverse_diagonal_;
   CgWork work_;
   std::unique_ptr<CholmodSolver> factor_;
-  bool stale_ = true;   // the next factorize must refactor
-  bool fresh_ = false;  // the factor is of the current matrix
+  std::unique_ptr<SmoothedAggregation> amg_;  // kAmg
+  VecX coordinates_;                          // kAmg: the near-null space's positions
+  bool stale_ = true;                         // the next factorize must refactor
+  bool fresh_ = false;                        // the factor is of the current matrix
   long preconditioner_factorizations_ = 0;
 };
 
 CgSolver::CgSolver(CgOptions options) : impl_(std::make_unique<Impl>(options)) {
   if (options.preconditioner == CgPreconditioner::kLaggedCholesky)
     impl_->factor_ = std::make_unique<CholmodSolver>(options.cholmod);
+  if (options.preconditioner == CgPreconditioner::kAmg)
+    impl_->amg_ = std::make_unique<SmoothedAggregation>();
 }
 
 CgSolver::~CgSolver() = default;
 
 std::string_view CgSolver::name() const {
-  return impl_->options_.preconditioner == CgPreconditioner::kJacobi ? "cg_jacobi"
-                                                                     : "cg_lagged_cholmod";
+  switch (impl_->options_.preconditioner) {
+    case CgPreconditioner::kJacobi:
+      return "cg_jacobi";
+    case CgPreconditioner::kLaggedCholesky:
+      return "cg_lagged_cholmod";
+    case CgPreconditioner::kAmg:
+      return "cg_amg";
+  }
+  return "cg";
 }
+
+void CgSolver::set_coordinates(const VecX& x) { impl_->coordinates_ = x; }
+
+bool CgSolver::needs_coordinates() const { return impl_->amg_ && !impl_->amg_->ready(); }
+
+int CgSolver::multigrid_levels() const { return impl_->amg_ ? impl_->amg_->levels() : 0; }
 
 LinearResult CgSolver::analyze(const SparseMatrix& a) { return impl_->analyze(a, counters_); }
 
@@ -408,6 +426,7 @@ LinearResult CgSolver::Impl::analyze(const SparseMatrix& a, LinearSolverCounters
     }
   }
   ++counters.analyses;
+  if (amg_) amg_->clear();  // a new pattern: new aggregates
   if (factor_) {
     LinearResult r = factor_->analyze(a);
     if (!r.ok()) return r;
@@ -420,6 +439,29 @@ LinearResult CgSolver::Impl::factorize(const SparseMatrix& a, LinearSolverCounte
     return LinearResult::failure(LinearStatus::kInvalidInput,
                                  "CG: factorize: the matrix does not have the analysed size");
   a_ = &a;
+  if (amg_) {
+    if (!block3_) {
+      a_ = nullptr;
+      return LinearResult::failure(LinearStatus::kInvalidInput,
+                                   "CG: the amg preconditioner needs a matrix of 3x3 blocks");
+    }
+    LinearResult r;
+    if (!amg_->ready()) {
+      r = amg_->setup(a, coordinates_, threads_);
+    } else if (stale_) {
+      r = amg_->refresh(a, threads_);
+    } else {
+      r = amg_->update_fine(a, threads_);
+    }
+    if (!r.ok()) {
+      amg_->clear();
+      a_ = nullptr;
+      return r;
+    }
+    if (stale_) ++preconditioner_factorizations_;  // built or refreshed
+    stale_ = false;
+    return {};
+  }
   if (!factor_) {
     if (block3_) {
       const int* outer = a.outerIndexPtr();
@@ -504,7 +546,9 @@ void CgSolver::Impl::multiply(const VecX& x, VecX& y) {
 }
 
 void CgSolver::Impl::precondition(const VecX& r, VecX& z) {
-  if (factor_) {
+  if (amg_) {
+    amg_->apply(r, z, threads_);
+  } else if (factor_) {
     factor_->solve(r, z);
   } else if (block3_) {
     work_.threads = threads_;
@@ -520,7 +564,7 @@ LinearResult CgSolver::Impl::run(const VecX& b, VecX& x, int max_iterations,
   return cg_run(
       work_, options_.tolerance, [this](const VecX& in, VecX& out) { multiply(in, out); },
       [this](const VecX& in, VecX& out) { precondition(in, out); }, b, x, max_iterations, counters,
-      !factor_ && block3_ ? &blocks_ : nullptr);
+      !factor_ && !amg_ && block3_ ? &blocks_ : nullptr);
 }
 
 LinearResult CgSolver::Impl::solve(const VecX& b, VecX& x, LinearSolverCounters& counters) {
@@ -536,6 +580,9 @@ LinearResult CgSolver::Impl::solve(const VecX& b, VecX& x, LinearSolverCounters&
                               ? std::min(options_.max_iterations, options_.lagged_iteration_limit)
                               : options_.max_iterations;
   LinearResult result = run(b, x, first_limit, counters);
+  // Amg: refresh the coarse levels when they no longer pay (an iteration count: the same
+  // decisions on any machine and thread count).
+  if (amg_ && result.iterations > options_.refactor_iterations) stale_ = true;
   if (factor_ && !fresh_ && result.status == LinearStatus::kNotConverged) {
     // The lagged factor is too far from A: refactor now and solve again.
     stale_ = true;

@@ -1,7 +1,9 @@
 #pragma once
-// Preconditioned conjugate gradients behind the LinearSolver interface, preconditioned either by
-// the inverse diagonal (Jacobi) or by a CHOLMOD factor of an earlier matrix ("lagged"), which is
-// refreshed only when CG needs more than a few iterations with it or after invalidate().
+// Preconditioned conjugate gradients behind the LinearSolver interface, preconditioned by the
+// inverse diagonal (Jacobi), by a CHOLMOD factor of an earlier matrix ("lagged"), which is
+// refreshed only when CG needs more than a few iterations with it or after invalidate(), or by
+// a smoothed-aggregation algebraic multigrid cycle
+// (solvers/linear/detail/smoothed_aggregation.hpp).
 #include <functional>
 #include <memory>
 #include <vector>
@@ -13,12 +15,16 @@ namespace jelly {
 
 // kJacobi inverts the 3x3 diagonal blocks (block Jacobi) when the matrix has the 3x3-block
 // pattern of a SpringJacobian, and the scalar diagonal otherwise.
-enum class CgPreconditioner { kJacobi, kLaggedCholesky };
+// kAmg: one V-cycle of smoothed aggregation per iteration; needs the 3x3-block pattern.
+enum class CgPreconditioner { kJacobi, kLaggedCholesky, kAmg };
 
 struct CgOptions {
   CgPreconditioner preconditioner = CgPreconditioner::kJacobi;
   Real tolerance = 1e-8;  // stop when |b - A x| <= tolerance |b|
   int max_iterations = 1000;
+  // Amg: the coarse levels' values are refreshed at the next factorize when a solve took more
+  // than refactor_iterations iterations (1: every factorize) or after invalidate(); the
+  // aggregates are built once per pattern.
   // Lagged Cholesky: the factor is refreshed at the next factorize when the CPU time of the last
   // solve exceeded the average cost per solve (factorization included) since the last refresh,
   // which minimises the average cost, or when a solve took more than this many iterations.
@@ -34,7 +40,7 @@ class CgSolver final : public LinearSolver {
   explicit CgSolver(CgOptions options = {});
   ~CgSolver() override;
 
-  // "cg_jacobi" or "cg_lagged_cholmod".
+  // "cg_jacobi", "cg_lagged_cholmod" or "cg_amg".
   std::string_view name() const override;
   LinearResult analyze(const SparseMatrix& a) override;
   LinearResult factorize(const SparseMatrix& a) override;
@@ -43,8 +49,16 @@ class CgSolver final : public LinearSolver {
   // Threads of the mat-vec, the preconditioner and the vector operations (results do not
   // depend on it: fixed partitions and sums in fixed chunks, docs/threads.md).
   void set_threads(int threads) override;
-  // The CHOLMOD factorizations done for the lagged preconditioner (counted in counters() too).
+  // The CHOLMOD factorizations done for the lagged preconditioner (counted in counters() too),
+  // or the multigrid hierarchies built or refreshed.
   long preconditioner_factorizations() const;
+  // Amg: the positions of the particles (3 per particle) whose rigid-body modes are the near-null
+  // space of the next hierarchy built (without them: the translations only).
+  void set_coordinates(const VecX& x);
+  // Amg: whether the next factorize builds a hierarchy (and so reads the coordinates).
+  bool needs_coordinates() const;
+  // Amg: the levels of the hierarchy (0 before the first factorize).
+  int multigrid_levels() const;
 
  private:
   struct Impl;  // the preconditioner, the upper block triangle of A, the CG vectors

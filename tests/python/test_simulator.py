@@ -292,14 +292,15 @@ def test_arkode_linear_solver_is_one_of_its_table():
 
 
 def test_multigrid_preconditioner_is_an_option_and_follows_block_jacobi():
-    # cg_preconditioner = "multigrid" on the matrix-free path (an 8^3 cube, stretched, falling freely):
-    # the same motion as block Jacobi to a tight CG tolerance, in fewer CG iterations.
+    # cg_preconditioner = "multigrid" on the matrix-free path (an 8^3 cube, stretched, falling freely),
+    # and "amg" on the assembled one: the same motion as block Jacobi to a tight CG tolerance, in
+    # fewer CG iterations.
     options = jelly.IntegratorOptions()
     assert options.implicit.cg_preconditioner == "jacobi"
     with pytest.raises(ValueError, match="cg_preconditioner"):
-        options.implicit.cg_preconditioner = "amg"
+        options.implicit.cg_preconditioner = "ilu"
     runs = {}
-    for name in ["jacobi", "multigrid"]:
+    for name in ["jacobi", "multigrid", "amg"]:
         options = jelly.IntegratorOptions()
         options.implicit.cg_preconditioner = name
         options.implicit.cg_tolerance = 1e-10
@@ -319,6 +320,9 @@ def test_multigrid_preconditioner_is_an_option_and_follows_block_jacobi():
         runs[name] = (np.array(sim.state.x), report.statistics["cg_iterations"])
     assert np.abs(runs["multigrid"][0] - runs["jacobi"][0]).max() < 1e-7
     assert runs["multigrid"][1] < runs["jacobi"][1]
+    # "amg" (smoothed aggregation on the assembled matrix) follows them as well.
+    assert np.abs(runs["amg"][0] - runs["jacobi"][0]).max() < 1e-7
+    assert runs["amg"][1] < runs["jacobi"][1]
 
 
 def test_contact_screening_equals_jelly_run_and_is_validated(scenes, run_cli, tmp_path):

@@ -40,10 +40,12 @@ std::unique_ptr<LinearSolver> make_linear_solver(ImplicitLinearSolver kind, bool
   cholmod.ordering = options.ordering;
   if (kind == ImplicitLinearSolver::kCholmod) return std::make_unique<CholmodSolver>(cholmod);
   if (kind == ImplicitLinearSolver::kLdlt) return std::make_unique<LdltSolver>();
-  CgOptions cg;  // auto's CG is block Jacobi, the fastest measured above its threshold
-  cg.preconditioner = !automatic && options.cg_preconditioner == CgPreconditionerKind::kCholmod
-                          ? CgPreconditioner::kLaggedCholesky
-                          : CgPreconditioner::kJacobi;
+  CgOptions cg;  // auto's CG is block Jacobi (the fastest measured above its threshold) or amg
+  cg.preconditioner = CgPreconditioner::kJacobi;
+  if (!automatic && options.cg_preconditioner == CgPreconditionerKind::kCholmod)
+    cg.preconditioner = CgPreconditioner::kLaggedCholesky;
+  if (options.cg_preconditioner == CgPreconditionerKind::kAmg)
+    cg.preconditioner = CgPreconditioner::kAmg;
   cg.tolerance = options.cg_tolerance;
   cg.max_iterations = options.cg_max_iterations;
   cg.refactor_iterations = options.refactor_iterations;
@@ -56,6 +58,7 @@ std::unique_ptr<LinearSolver> make_linear_solver(ImplicitLinearSolver kind, bool
 AssembledSystem::AssembledSystem(const Model& model, ImplicitLinearSolver solver, bool automatic,
                                  const ImplicitEulerOptions& options, SystemTimes& times)
     : solver_(make_linear_solver(solver, automatic, options)), times_(times) {
+  cg_ = dynamic_cast<CgSolver*>(solver_.get());
   jacobian_options_.definiteness = options.definiteness;
   jacobian_.emplace(model);
   a_ = jacobian_->make_matrix();
@@ -79,6 +82,8 @@ void AssembledSystem::set_threads(int threads) {
 bool AssembledSystem::assemble(const Dynamics& dynamics, const VecX& x, const VecX& v, Real h,
                                VecX& kw) {
   const Model& model = dynamics.model();
+  // Amg: the rigid-body modes of its near-null space at the positions of this step.
+  if (cg_ != nullptr && cg_->needs_coordinates()) cg_->set_coordinates(x);
   jacobian_->assemble_system(model, x, v, jacobian_options_, h, h * h, a_, v, kw, threads_);
   if (dynamics.anchors() != nullptr)
     add_anchor_system(*dynamics.anchors(), *jacobian_, h, h * h, a_, v, kw);

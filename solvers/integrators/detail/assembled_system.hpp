@@ -12,6 +12,7 @@
 #include <jelly/solvers/contact/detail/implicit_body_contact.hpp>
 #include <jelly/solvers/integrators/detail/backward_euler_system.hpp>
 #include <jelly/solvers/integrators/implicit_euler_options.hpp>
+#include <jelly/solvers/linear/cg_solver.hpp>
 
 namespace jelly {
 
@@ -60,6 +61,11 @@ class AssembledSystem final : public BackwardEulerSystem {
   void unconstrain(const ImplicitContact& contacts);
 
   const LinearSolverCounters& counters() const { return solver_->counters(); }
+  // The amg preconditioner's levels (0: another solver) and hierarchies built or refreshed.
+  int multigrid_levels() const { return cg_ != nullptr ? cg_->multigrid_levels() : 0; }
+  long preconditioner_refreshes() const {
+    return cg_ != nullptr ? cg_->preconditioner_factorizations() : 0;
+  }
 
  private:
   // The pattern of a_: the springs' blocks, the pairs' and the forces'; analysed again.
@@ -68,6 +74,7 @@ class AssembledSystem final : public BackwardEulerSystem {
   JacobianOptions jacobian_options_;
   std::optional<SpringJacobian> jacobian_;
   std::unique_ptr<LinearSolver> solver_;
+  CgSolver* cg_ = nullptr;  // solver_ when it is CG (amg reads the positions)
   SparseMatrix a_;
   SystemTimes& times_;
   int threads_ = 1;

@@ -307,7 +307,7 @@ TEST(ImplicitEuler, InvalidOptionsNameTheField) {
           {R"({"ordering": "colamd"})",
            R"(integrator.options.ordering = "colamd" is invalid: one of "amd", "metis", "nesdis", "best")"},
           {R"({"cg_preconditioner": "ilu"})",
-           R"(integrator.options.cg_preconditioner = "ilu" is invalid: one of "jacobi", "cholmod", "multigrid")"},
+           R"(integrator.options.cg_preconditioner = "ilu" is invalid: one of "jacobi", "cholmod", "multigrid", "amg")"},
           {R"({"definiteness": "psd"})",
            R"(integrator.options.definiteness = "psd" is invalid: one of "clamp", "project", "none")"},
           {R"({"cg_tolerance": 0})",
