@@ -10,7 +10,6 @@ of a 1/60 s frame against its error, and the stiffest stable ks, per setup and s
 whichever of the tables stability.csv, accuracy.csv, speed.csv and budget.csv exist.
 """
 import argparse
-import csv
 import math
 import os
 import sys
@@ -20,32 +19,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from bench_page import read_table  # noqa: E402  (the one reader of jelly-bench's CSV files)
+
 # A run that completed, also when its solver missed its own tolerance on some steps.
 COMPLETED = ("completed", "completed_with_warnings")
-
-
-def read_table(path):
-    """Rows of a jelly-bench CSV as dicts (numbers converted), and its metadata."""
-    meta, types, rows, header = {}, None, [], None
-    with open(path, newline="") as f:
-        lines = []
-        for line in f:
-            if line.startswith("# "):
-                key, _, value = line[2:].rstrip("\n").partition(": ")
-                if key == "types":
-                    types = value.split(",")
-                else:
-                    meta[key] = value
-            else:
-                lines.append(line)
-    reader = csv.reader(lines)
-    header = next(reader)
-    for cells in reader:
-        row = {}
-        for name, kind, cell in zip(header, types, cells):
-            row[name] = cell if kind == "s" else float(cell)
-        rows.append(row)
-    return rows, meta
 
 
 def finite(x):
