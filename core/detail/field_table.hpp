@@ -247,7 +247,8 @@ Field<field_detail::StructOf<M>> vec3_field(std::string_view name, std::string_v
   f.read = [](JsonFields& j, S& s, std::string_view key) { s.*M = json_field_vec3(j, key, s.*M); };
   f.write = [](const S& s, Json& out, std::string_view key) { json_field_put(out, key, s.*M); };
   f.valid = [](const S& s, const FieldRange& r) {
-    return (s.*M).allFinite() && r.contains((s.*M).norm());
+    // stableNorm: the length of [1e308, 0, 0] is finite (norm() would overflow).
+    return (s.*M).allFinite() && r.contains((s.*M).stableNorm());
   };
   f.text = [](const S& s) { return json_field_text(s.*M); };
   return f;
