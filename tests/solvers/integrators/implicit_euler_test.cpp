@@ -155,8 +155,7 @@ TEST(ImplicitEuler, MatrixFreeSolveAgreesWithCholmod) {
     sim.add_terrain(std::make_unique<Plane>(Plane::slope(20)));
     const RunReport report = sim.run_until(0.5);
     EXPECT_TRUE(report.ok()) << report.reason;
-    EXPECT_GT(report.statistics.at("contact_extra_solves") + sim.contacts().contact_count(),
-              0);
+    EXPECT_GT(report.statistics.at("contact_extra_solves") + sim.contacts().contact_count(), 0);
     *solver = std::string(static_cast<const ImplicitEuler&>(sim.integrator()).linear_solver_name());
     return sim.state();
   };
@@ -187,8 +186,7 @@ TEST(ImplicitEuler, MultigridAgreesWithBlockJacobiOnAnyThreadCount) {
     sim.add_terrain(std::make_unique<Plane>(Plane::slope(20)));
     const RunReport report = sim.run_until(0.5);
     EXPECT_TRUE(report.ok()) << report.reason;
-    EXPECT_GT(report.statistics.at("contact_extra_solves") + sim.contacts().contact_count(),
-              0);
+    EXPECT_GT(report.statistics.at("contact_extra_solves") + sim.contacts().contact_count(), 0);
     *solver = std::string(static_cast<const ImplicitEuler&>(sim.integrator()).linear_solver_name());
     *iterations = report.statistics.at("cg_iterations");
     return sim.state();
