@@ -242,7 +242,7 @@ std::vector<std::string> after_step_integrators() {
 
 // The after-step response never adds energy to a frictionless, inelastic collision at a game's
 // steps: the total energy never rises above its start (the pairs taken one after another with
-// the particles' projection reached 1.16-1.19 E0 at 1/60 s: docs/contact.md).
+// the particles' projection gained energy: docs/contact.md has the figures).
 TEST(BodyContact, AfterStepHeadOnCollisionNeverGainsEnergy) {
   for (const std::string& integrator : after_step_integrators())
     for (const Real dt : {1.0 / 60, 1.0 / 30}) {
