@@ -1,29 +1,16 @@
 #include <jelly/bench/peer_budget.hpp>
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
 
 namespace jelly::bench {
 
 namespace {
-
-// The signed volume of the lattice cell whose corners are v (corner c at offset
-// (c >> 2 & 1, c >> 1 & 1, c & 1)), as 6 tetrahedra about its diagonal v0 - v7.
-Real cell_volume(const VecX& x, const std::array<int, 8>& v) {
-  static constexpr int kTets[6][2] = {{1, 3}, {3, 2}, {2, 6}, {6, 4}, {4, 5}, {5, 1}};
-  const Vec3 p0(particle(x, v[0])), p7(particle(x, v[7]));
-  Real volume = 0;
-  for (const auto& t : kTets) {
-    const Vec3 a = Vec3(particle(x, v[t[0]])) - p0, b = Vec3(particle(x, v[t[1]])) - p0;
-    volume += a.cross(b).dot(p7 - p0) / 6;
-  }
-  return volume;
-}
 
 Real median_of(std::vector<Real> v) {
   if (v.empty()) return NAN;
@@ -69,20 +56,9 @@ FrameMeasures measure_frame(const Model& model, const Terrains& terrains, const 
     m.stretch = std::max(m.stretch, (length - s.rest_length[k]) / s.rest_length[k]);
   }
   if (lattice_n > 1) {
-    const int n = lattice_n;
-    Real deformed = 0, rest = 0;
-    for (int i = 0; i + 1 < n; ++i)
-      for (int j = 0; j + 1 < n; ++j)
-        for (int k = 0; k + 1 < n; ++k) {
-          std::array<int, 8> v;
-          for (int c = 0; c < 8; ++c)
-            v[c] = cube_index(n, i + (c >> 2 & 1), j + (c >> 1 & 1), k + (c & 1));
-          const Real r = cell_volume(model.rest_position, v), d = cell_volume(x, v);
-          rest += r;
-          deformed += d;
-          if (d * r <= 0) ++m.inverted_cells;
-        }
-    m.volume_ratio = deformed / rest;
+    const BodyVolume v = body_volume(model, model.bodies[0], x);
+    m.volume_ratio = v.ratio();
+    m.inverted_cells = static_cast<int>(v.inverted);
   }
   return m;
 }

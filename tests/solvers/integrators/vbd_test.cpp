@@ -3,7 +3,6 @@
 // and its independence of the thread count (docs/realtime.md).
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -30,40 +29,6 @@ Simulator vbd_sim(const Model& model, const State& s, Real dt, const VbdOptions&
   so.dt = dt;
   so.threads = threads;
   return Simulator(model, s, make_integrator("vbd", o), so);
-}
-
-// The signed volume of an n^3 lattice's cells (each split into 6 tetrahedra about its main
-// diagonal) divided by their rest volume, and how many cells have a negative volume.
-struct LatticeVolume {
-  Real ratio = 0;
-  int inverted = 0;
-};
-Real hexahedron_volume(const VecX& x, const std::array<int, 8>& v) {
-  static constexpr int kTets[6][2] = {{1, 3}, {3, 2}, {2, 6}, {6, 4}, {4, 5}, {5, 1}};
-  const Vec3 p0(particle(x, v[0])), p7(particle(x, v[7]));
-  Real volume = 0;
-  for (const auto& t : kTets) {
-    const Vec3 a = Vec3(particle(x, v[t[0]])) - p0, b = Vec3(particle(x, v[t[1]])) - p0;
-    volume += a.cross(b).dot(p7 - p0) / 6;
-  }
-  return volume;
-}
-LatticeVolume lattice_volume(int n, const VecX& rest, const VecX& x) {
-  LatticeVolume out;
-  Real deformed = 0, undeformed = 0;
-  for (int i = 0; i + 1 < n; ++i)
-    for (int j = 0; j + 1 < n; ++j)
-      for (int k = 0; k + 1 < n; ++k) {
-        std::array<int, 8> v;
-        for (int c = 0; c < 8; ++c)
-          v[c] = cube_index(n, i + (c >> 2 & 1), j + (c >> 1 & 1), k + (c & 1));
-        const Real r = hexahedron_volume(rest, v), d = hexahedron_volume(x, v);
-        undeformed += r;
-        deformed += d;
-        if (d * r <= 0) ++out.inverted;
-      }
-  out.ratio = deformed / undeformed;
-  return out;
 }
 
 // No two particles of one colour share a spring, and every particle has one colour.
@@ -198,9 +163,9 @@ ImpactOutcome seed_cube_n20_impact(Real duration, Real contact_hardness) {
   const Terrain& slope = *sim.terrains()[0];
   ImpactOutcome out;
   testing::Probe probe([&](const Simulator& s) {
-    const LatticeVolume v = lattice_volume(20, model.rest_position, s.state().x);
-    out.lowest_ratio = std::min(out.lowest_ratio, v.ratio);
-    out.most_inverted = std::max(out.most_inverted, v.inverted);
+    const BodyVolume v = body_volume(s.model(), s.model().bodies[0], s.state().x);
+    out.lowest_ratio = std::min(out.lowest_ratio, v.ratio());
+    out.most_inverted = std::max(out.most_inverted, static_cast<int>(v.inverted));
     for (int i = 0; i < model.num_particles(); ++i)
       out.deepest = std::min(out.deepest, slope.signed_distance(particle(s.state().x, i), 0));
   });

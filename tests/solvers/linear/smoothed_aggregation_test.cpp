@@ -211,8 +211,9 @@ TEST(SmoothedAggregation, ImplicitEulerAgreesWithBlockJacobiOnAnyThreadCount) {
       *solver =
           std::string(static_cast<const ImplicitEuler&>(sim.integrator()).linear_solver_name());
       *iterations = report.statistics.at("cg_iterations");
-      if (preconditioner == CgPreconditionerKind::kAmg)
+      if (preconditioner == CgPreconditionerKind::kAmg) {
         EXPECT_GE(report.statistics.at("multigrid_levels"), 2);
+      }
       return sim.state();
     };
     std::string jacobi_name, amg_name, other_name;
