@@ -1,7 +1,7 @@
 // Broad and narrow phase of body-body contact (docs/contact.md, "What contact costs"): two n^3
 // cubes side by side, their facing layers overlapping by 1 % of the contact distance (n^2
 // contact pairs), one BodyContact::resolve per iteration on a fresh copy of the state (the copy
-// is not timed). Counters: particles, pairs, ns per particle, and the broad phase alone.
+// is not timed), alone or after the collision phase (BodyContact::collide). Counters: particles, pairs, ns per particle, and the broad phase alone.
 // Run on one core: taskset -c 0 build/bench/jelly_contact_benchmark (the manual times and the
 // *_ms counters are wall clock; on a shared machine read the CPU column).
 #include <chrono>
@@ -33,7 +33,10 @@ Model two_cubes(int n) {
   return model;
 }
 
-void BM_BodyContactResolve(benchmark::State& bench) {
+// One step's body contact; `collide`: with the collision phase before the step
+// (BodyContact::collide, as the Simulator runs it; resolve() then takes its pairs from that set)
+// rather than resolve()'s own search.
+void body_contact_step(benchmark::State& bench, bool collide) {
   const Model model = two_cubes(static_cast<int>(bench.range(0)));
   const State start = rest_state(model);
   BodyContact contact;
@@ -43,6 +46,7 @@ void BM_BodyContactResolve(benchmark::State& bench) {
     s.x = start.x;
     s.v = start.v;
     const auto t0 = std::chrono::steady_clock::now();
+    if (collide) contact.collide(model, start, 1e-3);
     contact.resolve(model, start, s, 1e-3);
     const auto t1 = std::chrono::steady_clock::now();
     pairs = contact.pairs().size();
@@ -57,11 +61,19 @@ void BM_BodyContactResolve(benchmark::State& bench) {
       1e9 * (contact.stats().broad_seconds + contact.stats().narrow_seconds) / steps /
       model.num_particles();
 }
+void BM_BodyContactResolve(benchmark::State& bench) { body_contact_step(bench, false); }
+void BM_BodyContactCollideAndResolve(benchmark::State& bench) { body_contact_step(bench, true); }
 BENCHMARK(BM_BodyContactResolve)
     ->Arg(10)
     ->Arg(20)
     ->Arg(30)
     ->Arg(32)
+    ->Arg(40)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BodyContactCollideAndResolve)
+    ->Arg(10)
+    ->Arg(20)
     ->Arg(40)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);

@@ -63,7 +63,8 @@ void Simulator::add_terrain(std::unique_ptr<Terrain> terrain) {
 void Simulator::remove_terrain(int index) {
   check_terrain_index(index);
   terrains_.erase(terrains_.begin() + index);
-  // Seed contacts name no terrain; the implicit solve's active set is rebuilt each step.
+  // Seed contacts name no terrain; implicit_euler's carried contacts follow their terrain to
+  // its new index (ImplicitContact::renumber_terrains).
 }
 
 void Simulator::replace_terrain(int index, std::unique_ptr<Terrain> terrain) {
@@ -416,6 +417,9 @@ StepResult Simulator::step() {
   parallel::copy(threads, state_.x, before_.x);
   parallel::copy(threads, state_.v, before_.v);
   before_.t = state_.t;
+  // Collision detection apart from integration: the pairs that may touch in this step, which
+  // the integrator's solve or finish_step()'s resolve takes.
+  if (bodies) body_contact_.collide(model_, state_, options_.dt);
   StepResult result;
   try {
     result = integrator_->step(dynamics, state_, options_.dt);
@@ -451,10 +455,7 @@ void Simulator::note_forces(RunReport& report) {
     if (integrator_->uses_force_jacobians()) {
       if (force->has_jacobian()) continue;
       note = "force '" + force->name() +
-             "' gives no Jacobian: " + std::string(integrator_->name()) +
-             (integrator_->is_adaptive()
-                  ? "'s Newton matrix leaves it out (more Newton iterations or smaller steps)"
-                  : " treats it explicitly within each step");
+             "' gives no Jacobian: " + integrator_->without_force_jacobian();
     } else if (integrator_->is_implicit() && integrator_->is_adaptive()) {
       // ARKODE's DIRK: the force is in every implicit stage's residual, not in its matrix.
       note = "force '" + force->name() + "': " + std::string(integrator_->name()) +
@@ -514,6 +515,8 @@ RunReport Simulator::run_until(Real t_end) {
     const BodyContact::Stats& b = body_contact_.stats();
     report.statistics["body_contact_pairs"] = static_cast<double>(b.pairs);
     report.statistics["body_contact_energy_limited"] = static_cast<double>(b.limited);
+    report.statistics["body_contact_collided_steps"] = static_cast<double>(b.collided);
+    report.statistics["body_contact_searched_steps"] = static_cast<double>(b.searched);
     report.statistics["broad_phase_ms"] = 1e3 * b.broad_seconds;
     report.statistics["narrow_phase_ms"] = 1e3 * b.narrow_seconds;
   }

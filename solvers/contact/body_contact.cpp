@@ -15,6 +15,12 @@ namespace jelly {
 
 namespace {
 
+// collide()'s reach beyond the velocity's travel, as a share of the radius (at least the
+// margin implicit_euler's candidates take, kCandidateMargin, so that they fit within it).
+constexpr Real kCollideShare = 0.3;
+// The share of its reach a particle may travel for resolve() to keep collide()'s set.
+constexpr Real kCollideTravel = 0.99;
+
 void check_body_friction(const BodyContactParams& p, const std::string& prefix) {
   require(p.static_friction >= p.friction, prefix + "static_friction", p.static_friction,
           "a finite number >= friction (" + to_text(p.friction) + ")");
@@ -145,6 +151,9 @@ void BodyContact::filter(const Model& /*model*/) {
     if (inverse_mass_[p.first] + inverse_mass_[p.second] <= 0) continue;  // two pins
     contacts_.push_back(p);
   }
+  // In one order whichever search found them (the broad phase's order depends on its grid):
+  // the response sums over pairs, so collide()'s set and a search give the same bits.
+  std::sort(contacts_.begin(), contacts_.end());
 }
 
 void BodyContact::check_no_overlap(const Model& model, const VecX& x, Real tolerance) {
@@ -172,6 +181,53 @@ void BodyContact::check_no_overlap(const Model& model, const VecX& x, Real toler
   }
 }
 
+void BodyContact::collide(const Model& model, const State& state, Real h) {
+  collisions_fresh_ = false;
+  collisions_.clear();
+  if (!active(model)) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  prepare(model);
+  const int n = model.num_particles();
+  const Real fall = 2 * h * h * model.gravity.norm();
+  reach_.resize(n);
+  padded_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    reach_[i] = radius_[i] > 0 ? kCollideShare * radius_[i] + 2 * h * particle(state.v, i).norm() + fall
+                               : 0;
+    padded_[i] = radius_[i] + reach_[i];
+  }
+  if (padded_.allFinite()) {
+    broad_.find_pairs(state.x, padded_, candidates_);
+    filter(model);
+    collisions_.swap(contacts_);
+    contacts_.clear();
+    collided_x_ = state.x;
+    collisions_fresh_ = true;
+  }
+  stats_.broad_seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+bool BodyContact::take_collisions(const VecX& x) {
+  const bool fresh = collisions_fresh_ && collided_x_.size() == x.size() &&
+                     std::equal(x.data(), x.data() + x.size(), collided_x_.data());
+  collisions_fresh_ = false;
+  return fresh;
+}
+
+void BodyContact::select_collisions(const VecX& x, const VecX* pad) {
+  contacts_.clear();
+  for (const BroadPhase::Pair& p : collisions_) {
+    const int i = p.first, j = p.second;
+    if (inverse_mass_[i] + inverse_mass_[j] <= 0) continue;  // two pins
+    const Real ri = pad != nullptr ? (*pad)[i] : radius_[i];
+    const Real rj = pad != nullptr ? (*pad)[j] : radius_[j];
+    const Real reach = ri + rj;
+    const Vec3 d(x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]);
+    if (d.squaredNorm() < reach * reach) contacts_.push_back(p);
+  }
+}
+
 const std::vector<BroadPhase::Pair>& BodyContact::find_candidates(const Model& model, const VecX& x,
                                                                   const VecX& pad, Real margin) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -180,8 +236,19 @@ const std::vector<BroadPhase::Pair>& BodyContact::find_candidates(const Model& m
   for (int i = 0; i < padded_.size(); ++i) {
     if (!(radius_[i] > 0)) padded_[i] = 0;
   }
-  broad_.find_pairs(x, padded_, candidates_);
-  filter(model);
+  // collide()'s set holds every pair these spheres make when none is larger than its sphere
+  // there.
+  bool covered = take_collisions(x);
+  for (int i = 0; covered && i < padded_.size(); ++i)
+    covered = padded_[i] <= radius_[i] + reach_[i];
+  if (covered) {
+    select_collisions(x, &padded_);
+    ++stats_.collided;
+  } else {
+    broad_.find_pairs(x, padded_, candidates_);
+    filter(model);
+    ++stats_.searched;
+  }
   stats_.broad_seconds +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return contacts_;
@@ -435,9 +502,23 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   prepare(model);
-  broad_.find_pairs(state.x, radius_, candidates_);
+  // collide()'s set holds every pair in contact at the end when no particle travelled beyond
+  // its reach (with a share of it for round-off): the distance of two spheres shrank by at
+  // most the sum of their travels.
+  bool covered = take_collisions(before.x);
+  for (int i = 0; covered && i < model.num_particles(); ++i) {
+    covered = radius_[i] <= 0 ||
+              (particle(state.x, i) - particle(before.x, i)).norm() <= kCollideTravel * reach_[i];
+  }
+  if (covered) {
+    select_collisions(state.x, nullptr);
+    ++stats_.collided;
+  } else {
+    broad_.find_pairs(state.x, radius_, candidates_);
+    ++stats_.searched;
+  }
   const auto t1 = Clock::now();
-  filter(model);
+  if (!covered) filter(model);
   if (!contacts_.empty()) {
     // Velocities first (the positions stay, but for friction's take-back), then the projection
     // from the positions they leave.

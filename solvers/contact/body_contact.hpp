@@ -54,6 +54,8 @@ class BodyContact {
   struct Stats {
     long pairs = 0;    // contact pairs resolved, summed over the steps
     long limited = 0;  // steps whose projection was limited to keep the energy (translations)
+    long collided = 0;  // steps whose pairs came from collide()'s set
+    long searched = 0;  // steps that searched again (no collide(), or a particle beyond its reach)
     double broad_seconds = 0;   // time in the broad phase
     double narrow_seconds = 0;  // time filtering and resolving the pairs
     long steps = 0;
@@ -65,9 +67,20 @@ class BodyContact {
   const BodyContactParams& params() const { return params_; }
   // Whether resolve() can do anything for this model: two bodies, or a body with self-contact.
   bool active(const Model& model) const;
+  // The collision phase of a step, before the integrator moves anything (as Warp's collide()
+  // before simulate()): the pairs that may touch during a step of size h from `state`, each
+  // particle's sphere grown by its reach (a share of its radius, and the distance its velocity
+  // and gravity carry it in the step). The step's consumer takes its pairs from this set:
+  // resolve() when every particle ended within its reach, find_candidates() when its pads fit
+  // within the reaches; otherwise it searches again. Both give the same pairs in the same
+  // (sorted) order, so results never depend on the reach, only the cost does; the set serves
+  // one step (the state it was found for) once.
+  void collide(const Model& model, const State& state, Real h);
+  // The pairs of the last collide() (filtered as resolve() filters, i < j).
+  const std::vector<BroadPhase::Pair>& collisions() const { return collisions_; }
   // Resolves the contacts of `state` after a step of size h from `before`.
   void resolve(const Model& model, const State& before, State& state, Real h);
-  // The pairs of the last resolve() (global particle indices, i < j).
+  // The pairs of the last resolve() (global particle indices, i < j, sorted).
   const std::vector<BroadPhase::Pair>& pairs() const { return contacts_; }
   const Stats& stats() const { return stats_; }
 
@@ -96,6 +109,11 @@ class BodyContact {
   void prepare(const Model& model);
   // Keeps the broad phase's pairs that may touch: other bodies, or (self-contact) no spring.
   void filter(const Model& model);
+  // Whether collide()'s set was found at exactly `x` and not used yet; marks it used.
+  bool take_collisions(const VecX& x);
+  // contacts_ = the pairs of collide()'s set whose spheres, of radius radius_[i] + pad[i]
+  // (pad may be null), overlap at `x`.
+  void select_collisions(const VecX& x, const VecX* pad);
   bool joined(int i, int j) const;
   // resolve()'s passes: the velocity passes (returns whether a pair approached), and the
   // projection of the overlaps at state.x into particle moves (moved_) and into body
@@ -114,6 +132,10 @@ class BodyContact {
   std::vector<int> body_;
   std::vector<int> neighbour_start_, neighbours_;  // CSR, sorted
   std::vector<BroadPhase::Pair> candidates_, contacts_;
+  // collide()'s set: its pairs, the position it was found at, each particle's reach.
+  std::vector<BroadPhase::Pair> collisions_;
+  VecX collided_x_, reach_;
+  bool collisions_fresh_ = false;
   Stats stats_;
   // resolve()'s work arrays (sized once per model).
   std::vector<int> share_;               // [N] pairs of a particle in this pass

@@ -164,6 +164,24 @@ void ImplicitContact::find_penetrating(const Terrains& terrains, Position&& posi
       parallel::kMinParticlesPerThread);
 }
 
+void ImplicitContact::renumber_terrains(const Terrains& terrains) {
+  const auto seen = [&](const Terrain* t) {
+    return std::find(last_terrains_.begin(), last_terrains_.end(), t) != last_terrains_.end();
+  };
+  terrain_index_.assign(last_terrains_.size(), -1);
+  for (size_t k = 0; k < last_terrains_.size(); ++k) {
+    const auto at = std::find_if(terrains.begin(), terrains.end(),
+                                 [&](const auto& t) { return t.get() == last_terrains_[k]; });
+    if (at != terrains.end()) {
+      terrain_index_[k] = static_cast<int>(at - terrains.begin());
+    } else if (k < terrains.size() && !seen(terrains[k].get())) {
+      terrain_index_[k] = static_cast<int>(k);  // replaced in place
+    }
+  }
+  last_terrains_.clear();
+  for (const auto& t : terrains) last_terrains_.push_back(t.get());
+}
+
 bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, const State& s0,
                                  const VecX& f, Real h, int threads) {
   threads_ = threads;
@@ -186,11 +204,16 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
   // The explicit prediction x0 + h v1, v1 = v0 + h f / m: last step's contacts (unless let go)
   // that it keeps on their surface, and the particles it carries into a terrain.
   std::fill(slot_.begin(), slot_.end(), -1);
+  renumber_terrains(terrains);
   for (int ci = 0; ci < static_cast<int>(contacts_.size()); ++ci) {
-    const Contact& old = contacts_[ci];
-    if (old.pinned || old.release || old.particle >= np ||
-        old.terrain >= static_cast<int>(terrains.size()))
-      continue;
+    Contact& old = contacts_[ci];
+    if (old.pinned || old.release || old.particle >= np) continue;
+    if (!terrain_index_.empty()) {
+      old.terrain = old.terrain < static_cast<int>(terrain_index_.size())
+                        ? terrain_index_[old.terrain]
+                        : -1;
+    }
+    if (old.terrain < 0 || old.terrain >= static_cast<int>(terrains.size())) continue;
     slot_[old.particle] = ci;
   }
   next_.clear();
@@ -378,6 +401,7 @@ void ImplicitContact::restore(const Real* data, size_t size) {
   require(size % kSavedPerContact == 0, "integrator state (contacts)", size,
           "5 numbers per contact");
   contacts_.clear();
+  last_terrains_.clear();  // the saved indices are the current terrains'
   for (size_t i = 0; i < size; i += kSavedPerContact) {
     Contact c;
     constexpr Real kMaxIndex = std::numeric_limits<int>::max();

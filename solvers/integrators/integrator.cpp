@@ -39,6 +39,12 @@ void Integrator::restore_internal_state(const std::vector<Real>& /*data*/) {}
 
 Statistics Integrator::statistics() const { return {{"steps", static_cast<double>(steps_)}}; }
 
+std::string Integrator::without_force_jacobian() const {
+  return std::string(name()) +
+         (is_adaptive() ? "'s Newton matrix leaves it out (more Newton iterations or smaller steps)"
+                        : " treats it explicitly within each step");
+}
+
 void finish_step(const StepResult& result, ContactSolver& contacts, BodyContact* bodies,
                  const Model& model, const Terrains& terrains, const State& before, State& state,
                  Real h, int threads) {

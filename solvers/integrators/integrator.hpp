@@ -63,6 +63,9 @@ class Integrator {
   // True when the method takes the Jacobians of added forces (Force::add_jacobian) into its
   // solve; an implicit method without them treats added forces explicitly within its step.
   virtual bool uses_force_jacobians() const { return false; }
+  // For a method that uses them: what it does with an added force that gives none (the run
+  // report's note "force 'name' gives no Jacobian: <this>").
+  virtual std::string without_force_jacobian() const;
   // True when the method chooses its own internal steps within each step(h) (error control):
   // the h-convergence of fixed-step methods does not apply to it.
   virtual bool is_adaptive() const { return false; }

@@ -169,13 +169,26 @@ void ProjectiveDynamics::set_pins(const Pins& pins) {
   for (int i : pinned_list_) pinned_[i] = 1;
 }
 
-void ProjectiveDynamics::set_anchor_weights(const AnchorSprings* anchors, Real h) {
+void ProjectiveDynamics::set_anchor_weights(const Dynamics& dynamics, const State& s, Real h) {
   for (int i : anchored_) anchor_weight_[i] = 0;
   anchored_.clear();
-  if (anchors == nullptr) return;
-  for (const AnchorSpring& a : *anchors) {
-    if (anchor_weight_[a.particle] == 0) anchored_.push_back(a.particle);
-    anchor_weight_[a.particle] += a.stiffness + a.damping / h;
+  const auto add = [&](int i, Real w) {
+    if (!(w > 0)) return;
+    if (anchor_weight_[i] == 0) anchored_.push_back(i);
+    anchor_weight_[i] += w;
+  };
+  if (const AnchorSprings* anchors = dynamics.anchors(); anchors != nullptr) {
+    for (const AnchorSpring& a : *anchors) add(a.particle, a.stiffness + a.damping / h);
+  }
+  dynamics.added_force_jacobians(s.t, s.x, s.v, jacobian_);
+  for (const ForceJacobian::Block& b : jacobian_.blocks()) {
+    if (b.i != b.j) continue;
+    const Mat3 stiffness = -(b.dfdx + b.dfdv / h);
+    const Real largest =
+        Eigen::SelfAdjointEigenSolver<Mat3>(0.5 * (stiffness + stiffness.transpose()),
+                                            Eigen::EigenvaluesOnly)
+            .eigenvalues()[2];
+    if (largest > 0) add(b.i, std::exp2(std::ceil(std::log2(largest))));
   }
 }
 
@@ -294,7 +307,7 @@ StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real 
   if (contact_active_) contact_->project(x_);
   place_pins(model, s.t + h);
   set_pins(model.pins);
-  set_anchor_weights(dynamics.anchors(), h);
+  set_anchor_weights(dynamics, s, h);
   if (StepResult r = sync_penalties(); !r.ok) return r;
 
   const bool measure_rho = options_.chebyshev && rho_ == 0;

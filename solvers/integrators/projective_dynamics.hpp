@@ -13,6 +13,7 @@
 #include <memory>
 #include <vector>
 
+#include <jelly/core/force.hpp>
 #include <jelly/core/sparse_matrix.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/integrators/projective_dynamics_options.hpp>
@@ -32,6 +33,13 @@ class ProjectiveDynamics final : public Integrator {
   std::string_view name() const override { return "projective_dynamics"; }
   int order() const override { return 1; }
   bool is_implicit() const override { return true; }
+  // Every force, added ones included, is evaluated at each iterate (the fixed point is the
+  // implicit step); an added force's Jacobian goes into the factor as the anchors' does.
+  bool uses_force_jacobians() const override { return true; }
+  std::string without_force_jacobian() const override {
+    return "projective_dynamics evaluates it at every iterate, but its factor leaves it out "
+           "(a stiff force can keep the iterations from converging)";
+  }
   // steps, symbolic_analyses, factorizations (once per model and dt), iterations (global
   // solves), not_converged (steps that ended above the tolerance), chebyshev_rho,
   // factorization_seconds, solve_seconds, contact_restitution_limited.
@@ -72,8 +80,13 @@ class ProjectiveDynamics final : public Integrator {
   // pinned_ from the model's pins (each is held in the factor like a sticking contact, and its
   // residual is the pin's).
   void set_pins(const Pins& pins);
-  // anchor_weight_ = k + c / h of the anchor springs, per particle.
-  void set_anchor_weights(const AnchorSprings* anchors, Real h);
+  // anchor_weight_ = k + c / h of the anchor springs, per particle, plus the stiffness of the
+  // added forces' Jacobians at the step's start: each diagonal block's largest eigenvalue of
+  // -(df/dx + df/dv / h), rounded up to a power of two (so that slowly changing Jacobians
+  // seldom update the factor). The factor's diagonal then bounds the force's stiffness from
+  // above (for forces between pairs of particles within a factor of two), which keeps the
+  // iterations converging where a stiff force would make them diverge.
+  void set_anchor_weights(const Dynamics& dynamics, const State& s, Real h);
   // Brings the diagonal additions in the factor in line with the anchors and the contacts'
   // modes (rank updates of the factor, no factorization).
   StepResult sync_penalties();
@@ -93,6 +106,7 @@ class ProjectiveDynamics final : public Integrator {
   std::vector<Real> penalty_;        // [N]: what the factor holds beyond A (anchors, contacts)
   std::vector<Real> anchor_weight_;  // [N]: k + c / h of the anchor springs
   std::vector<int> anchored_;
+  ForceJacobian jacobian_;  // the added forces' blocks at the step's start
   std::vector<char> pinned_;  // [N]
   std::vector<int> pinned_list_;
   std::vector<int> penalized_list_, rows_;

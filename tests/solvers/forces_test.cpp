@@ -252,6 +252,40 @@ TEST(AddedForces, ArkodeDirkTakesAForcesJacobianIntoItsNewtonSolves) {
   EXPECT_LT((with.x - without.x).cwiseAbs().maxCoeff(), 1e-3);
 }
 
+// projective_dynamics evaluates every force at each iterate and puts an added force's Jacobian
+// into its factor (as it does the anchor springs'): a stiff force stays stable and loses its
+// energy with it; without it the iterations diverge at the first step, and the run says why.
+TEST(AddedForces, ProjectiveDynamicsTakesAForcesJacobianIntoItsFactor) {
+  const auto run = [](bool jacobian, RunReport* report) {
+    IntegratorOptions o;
+    o.pd.tolerance = 1e-6;
+    o.pd.iterations = 200;
+    Simulator sim = deformed_cube(3, make_integrator("projective_dynamics", o), 1.0 / 30);
+    sim.set_gravity(Vec3::Zero());
+    const auto force =
+        std::make_shared<SpringsToAnchors>(sim.model(), Vec3(0.05, 0, 0), 1e5, 0, jacobian);
+    sim.add_force(force);
+    const Real e0 = kinetic_energy(sim.model(), sim.state()) +
+                    elastic_energy(sim.model(), sim.state()) + force->energy(sim.state().x);
+    *report = sim.run_until(0.5);
+    const Real e = kinetic_energy(sim.model(), sim.state()) +
+                   elastic_energy(sim.model(), sim.state()) + force->energy(sim.state().x);
+    return e / e0;
+  };
+  RunReport with, without;
+  const Real kept = run(true, &with);
+  run(false, &without);
+  EXPECT_TRUE(with.ok()) << with.brief();
+  EXPECT_TRUE(with.notes.empty());
+  EXPECT_LT(kept, 1e-3);  // backward Euler damps the stiff oscillation out
+  ASSERT_GE(without.notes.size(), 1u);
+  EXPECT_EQ(without.notes[0],
+            "force 'springs_to_anchors' gives no Jacobian: projective_dynamics evaluates it at "
+            "every iterate, but its factor leaves it out (a stiff force can keep the iterations "
+            "from converging)");
+  EXPECT_TRUE(!without.ok() || without.statistics.at("not_converged") > 0) << without.brief();
+}
+
 TEST(AddedForces, WithoutItsJacobianTheForceIsSaidToBeExplicitOnce) {
   Simulator sim = deformed_cube(3, implicit(ImplicitLinearSolver::kCholmod), 1.0 / 30);
   sim.add_force(std::make_shared<SpringsToAnchors>(sim.model(), Vec3::Zero(), 10, 0, false));
@@ -351,6 +385,35 @@ TEST(LiveModel, AMovedTerrainMidRunEqualsAFreshRunWithItThere) {
     unmoved.run_until(0.5);
     EXPECT_NE(edited.state().x, unmoved.state().x) << name;
   }
+}
+
+// A terrain removed mid-run shifts the indices of those after it: implicit_euler's contacts
+// carried from the last step (stick or slide, friction viscosity) follow their terrain, so the
+// run equals, bit for bit, one that never had the removed terrain (untouched by the cube).
+TEST(LiveModel, ARemovedTerrainMidRunEqualsARunThatNeverHadIt) {
+  const Real a = 0.6;  // a slope steeper than the friction holds: the cube slides
+  ContactParams contact;
+  contact.restitution = 0;
+  const auto slope = [&] {
+    return std::make_unique<Plane>(Vec3(0, 1.6, 0), Vec3(std::sin(a), std::cos(a), 0), contact);
+  };
+  Simulator edited = deformed_cube(3, make_integrator("implicit_euler"), 1.0 / 120);
+  edited.add_terrain(std::make_unique<Plane>(Vec3(-5, 0, 0), Vec3(1, 0, 0)));
+  edited.add_terrain(slope());
+  Simulator never = deformed_cube(3, make_integrator("implicit_euler"), 1.0 / 120);
+  never.add_terrain(slope());
+  edited.run_until(0.6);
+  never.run_until(0.6);
+  ASSERT_EQ(edited.state().x, never.state().x);
+  Real lowest = 1;  // the cube rests on the slope at the removal
+  for (int i = 0; i < never.model().num_particles(); ++i)
+    lowest = std::min(lowest, never.terrains()[0]->signed_distance(particle(never.state().x, i), 0.6));
+  ASSERT_LT(lowest, 1e-6);
+  edited.remove_terrain(0);
+  edited.run_until(0.9);
+  never.run_until(0.9);
+  EXPECT_EQ(edited.state().x, never.state().x);
+  EXPECT_EQ(edited.state().v, never.state().v);
 }
 
 TEST(LiveModel, InvalidEditsThrowNamingTheFieldAndChangeNothing) {

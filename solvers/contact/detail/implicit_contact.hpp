@@ -161,6 +161,10 @@ class ImplicitContact {
   // The coulomb terrain whose surface, offset by `gap` (the particle's thickness), position p (at
   // time t1) penetrates deepest by more than `tolerance`, or -1.
   int penetrated_terrain(const Terrains& terrains, const Vec3& p, Real gap, Real tolerance) const;
+  // terrain_index_[k]: where last step's terrain k is now (-1: removed). Terrains removed
+  // between steps shift the indices after them; one put in place of another
+  // (Simulator::replace_terrain, a terrain not seen last step) keeps its index.
+  void renumber_terrains(const Terrains& terrains);
   // penetrating_[i] = penetrated_terrain(terrains, position(i), tolerance) for the particles
   // without a contact (slot_[i] < 0; -1 for the others), on threads_.
   template <class Position>
@@ -179,6 +183,10 @@ class ImplicitContact {
   std::vector<Real> saved_;        // original values of the constrained columns
   std::vector<int> saved_at_;      // [contacts]: offset into saved_
   std::vector<int> penetrating_;   // [N]: find_penetrating's terrains
+  // The terrains of the last begin_step() (empty after restore(): its indices hold) and
+  // renumber_terrains()'s result.
+  std::vector<const Terrain*> last_terrains_;
+  std::vector<int> terrain_index_;
   int threads_ = 1;
   int projected_ = 0;
   int pinned_ = 0;  // the first pinned_ entries of contacts_ are pins

@@ -141,6 +141,61 @@ TEST(BodyContact, ResponseConservesMomentum) {
   }
 }
 
+// Collision detection apart from integration: collide() before the step finds a set from which
+// resolve() (after the step) and find_candidates() (the implicit solve's) take exactly the pairs
+// a search of their own would find; a particle that travels beyond its reach makes them search.
+TEST(BodyContact, CollideFindsThePairsEveryConsumerWouldFind) {
+  const Model model = two_cubes(0.02);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  State before = rest_state(model);
+  for (int i = 0; i < model.num_particles(); ++i) {
+    particle(before.v, i) =
+        Vec3(u(rng), u(rng), u(rng)) + (i < 64 ? Vec3(3, 0, 0) : Vec3(-3, 0, 0));
+  }
+  const Real h = 1.0 / 60;
+  State after = before;
+  after.x += h * before.v;  // a step's drift: the cubes overlap at its end
+  BodyContactParams params;
+  params.iterations = 10;
+  BodyContact searched(params), collided(params);
+  State by_search = after, by_collide = after;
+  searched.resolve(model, before, by_search, h);
+  collided.collide(model, before, h);
+  ASSERT_GT(collided.collisions().size(), searched.pairs().size());
+  collided.resolve(model, before, by_collide, h);
+  ASSERT_GT(searched.pairs().size(), 10u);
+  EXPECT_EQ(collided.pairs(), searched.pairs());
+  EXPECT_EQ(collided.stats().collided, 1);
+  EXPECT_EQ(collided.stats().searched, 0);
+  EXPECT_EQ(searched.stats().searched, 1);
+  // The same pairs in the same order: the same bits.
+  EXPECT_EQ(by_collide.x, by_search.x);
+  EXPECT_EQ(by_collide.v, by_search.v);
+
+  // The implicit solve's candidates: its pads (the step's travel and a quarter radius) fit
+  // within the reaches.
+  const VecX pad = h * before.v.reshaped(3, model.num_particles()).colwise().norm().transpose();
+  collided.collide(model, before, h);
+  const Pairs from_set = collided.find_candidates(model, before.x, pad, 0.25);
+  EXPECT_EQ(from_set, searched.find_candidates(model, before.x, pad, 0.25));
+  EXPECT_EQ(collided.stats().collided, 2);
+
+  // One particle thrown 1 m in the step: beyond its reach, so resolve() searches again.
+  collided.collide(model, before, h);
+  State far = after;
+  particle(far.x, 0) += Vec3(1, 0, 0);
+  collided.resolve(model, before, far, h);
+  EXPECT_EQ(collided.stats().searched, 1);
+  // A set serves once, and only the state it was found for.
+  collided.collide(model, before, h);
+  State moved = before;
+  particle(moved.x, 3) += Vec3(1e-9, 0, 0);
+  collided.find_candidates(model, moved.x, pad, 0.25);
+  collided.find_candidates(model, before.x, pad, 0.25);
+  EXPECT_EQ(collided.stats().searched, 3);
+}
+
 // Two free cubes thrown at each other off-centre without gravity: they collide and separate;
 // linear momentum is conserved by every integrator (to 1e-9 relative) and, frictionless,
 // angular momentum by symplectic Euler, which conserves it exactly between contacts.
@@ -264,6 +319,23 @@ TEST(BodyContact, AfterStepHeadOnCollisionNeverGainsEnergy) {
 // With restitution 1 and no dampers, at 1 ms: the integrators that keep energy (rk4, ARKODE's
 // explicit and implicit Runge-Kutta) keep the collision's energy to 1 %; the others lose what
 // their own damping takes, and none ever gains more than round-off.
+// In a run, every step's contact takes its pairs from the collision phase: after the step
+// (after_step) and inside implicit_euler's solve.
+TEST(BodyContact, RunsTakeTheirPairsFromTheCollisionPhase) {
+  for (const bool inside : {false, true}) {
+    Simulator sim = head_on("implicit_euler", 1.0 / 60, 0);
+    if (inside) sim.set_integrator(make_integrator("implicit_euler"));
+    const RunReport report = sim.run_until(0.3);
+    // (During the impact the springs accelerate particles beyond the reach their velocity at
+    // the step's start gave: those steps search again.)
+    const Real collided = report.statistics.at("body_contact_collided_steps");
+    EXPECT_GE(collided, 0.6 * report.steps) << inside;
+    EXPECT_EQ(collided + report.statistics.at("body_contact_searched_steps"), report.steps)
+        << inside;
+    EXPECT_GT(report.statistics.at("body_contact_pairs"), 0) << inside;
+  }
+}
+
 TEST(BodyContact, AfterStepElasticCollisionKeepsItsEnergy) {
   for (const std::string& integrator : {"arkode_dirk", "arkode_erk", "implicit_euler",
                                         "projective_dynamics", "rk4", "vbd", "xpbd"}) {
