@@ -606,6 +606,41 @@ TEST(BodyColor, ReadWrittenAndRecorded) {
   EXPECT_EQ(r.model.bodies[1].color, scene.bodies[1].color);
 }
 
+// A body's thickness is written to its recording's body group and read back with the body
+// (issue 40: it was only in the scene JSON): a cloth's default (its contact radius), a set one,
+// a volume's 0.
+TEST(BodyThickness, RecordedAndReadBack) {
+  const std::string json = R"({
+    "bodies": [
+      {"kind": "cube", "name": "cube", "n": 3, "edge_length": 1, "origin": [-2, 0.5, 0]},
+      {"kind": "cloth", "name": "sheet", "nu": 4, "nv": 4, "size_u": 1, "size_v": 1,
+       "position": [2, 1, 0]},
+      {"kind": "cloth", "name": "thick", "nu": 4, "nv": 4, "size_u": 1, "size_v": 1,
+       "position": [4, 1, 0], "thickness": 0.125}
+    ],
+    "terrains": [], "integrator": {"name": "rk4", "dt": 0.001}, "duration": 0.01
+  })";
+  const Scene scene = parse_scene(json);
+  testing::TempDir dir;
+  const std::string path = dir.file("thickness.h5");
+  Simulator sim = make_simulator(scene);
+  ASSERT_EQ(sim.model().bodies.size(), 3u);
+  ASSERT_GT(sim.model().bodies[1].thickness, 0);
+  {
+    RecorderOptions options;
+    options.scene_json = scene_to_json(scene);
+    H5Recorder recorder(path, sim, options);
+    sim.add_observer(recorder);
+    ASSERT_TRUE(sim.run_until(0.01).ok());
+  }
+  const Recording r = read_recording(path);
+  ASSERT_EQ(r.model.bodies.size(), 3u);
+  EXPECT_EQ(r.model.bodies[0].thickness, 0);
+  EXPECT_EQ(r.model.bodies[1].thickness, sim.model().bodies[1].thickness);
+  EXPECT_EQ(r.model.bodies[1].thickness, sim.model().bodies[1].radius);
+  EXPECT_EQ(r.model.bodies[2].thickness, 0.125);
+}
+
 TEST(BodyColor, BadColorsNameTheField) {
   for (const std::string color : {"[0.1, 1.5, 0.2]", "[-0.1, 0, 0]", "[0, 0]", "\"green\""}) {
     SCOPED_TRACE(color);
