@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -604,6 +606,27 @@ TEST(BodyColor, ReadWrittenAndRecorded) {
   ASSERT_EQ(r.model.bodies.size(), 2u);
   EXPECT_FALSE(r.model.bodies[0].color);
   EXPECT_EQ(r.model.bodies[1].color, scene.bodies[1].color);
+
+  // ParaView: the coloured body's blocks (its springs and its surface) carry the colour as a
+  // field of every frame; the other body's none.
+  std::string xdmf;
+  {
+    std::ifstream in(dir.file("colors.xdmf"));
+    xdmf.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string field = "<Attribute Name=\"color\"";
+  const std::string values = ">0.10000000000000001 0.80000000000000004 0.20000000000000001<";
+  const size_t red = xdmf.find("<Grid Name=\"red\""), green = xdmf.find("<Grid Name=\"green\"");
+  ASSERT_NE(red, std::string::npos);
+  ASSERT_NE(green, std::string::npos);
+  int fields = 0;
+  for (size_t at = xdmf.find(field); at != std::string::npos; at = xdmf.find(field, at + 1)) {
+    ++fields;
+    EXPECT_NE(xdmf.find(values, at), std::string::npos);
+    EXPECT_FALSE(at > red && (green < red || at < green)) << "a colour in the red body's block";
+  }
+  EXPECT_EQ(fields % 2, 0);
+  EXPECT_GE(fields, 2 * static_cast<int>(r.time.size()));
 }
 
 // A body's thickness is written to its recording's body group and read back with the body
