@@ -442,6 +442,35 @@ TEST(RenderCli, TheSphereDoesNotShowThroughTheCloth) {
   EXPECT_GT(through[1], 500) << "the measure does not see the sphere through a thin cloth";
 }
 
+// `--fxaa` renders (single-sampled, smoothed afterwards); with `--samples` above 1 it is refused
+// naming the option, since FXAA replaces multisampling.
+TEST(RenderCli, FxaaRendersAndRefusesMultisampling) {
+  TempDir dir;
+  const std::string jelly = std::string("'") + JELLY_CLI + "' ";
+  testing::Result r = testing::run(
+      jelly + "run '" JELLY_SCENES_DIR "/seed_slope.json' --duration 0.05 --quiet -o '" +
+          dir.file("r.h5") + "'",
+      dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = testing::run(jelly + "render '" + dir.file("r.h5") + "' -o '" + dir.file("f%03d.png") +
+                       "' --width 320 --height 240 --end 0 --fxaa",
+                   dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  if (r.err.find("no offscreen") != std::string::npos) GTEST_SKIP() << r.err;
+  const viewer::Image image = viewer::read_png(dir.file("f000.png"));
+  EXPECT_EQ(image.width, 320);
+  long red = 0;
+  for (size_t i = 0; i + 2 < image.rgb.size(); i += 3) red += testing::is_jelly(&image.rgb[i]);
+  EXPECT_GT(red, 200);
+  for (const std::string command :
+       {"render '" + dir.file("r.h5") + "' -o '" + dir.file("g%03d.png") + "' --fxaa --samples 4",
+        "view '" + dir.file("r.h5") + "' --fxaa --samples 2"}) {
+    r = testing::run(jelly + command, dir);
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_NE(r.err.find("--samples"), std::string::npos) << r.err;
+  }
+}
+
 // A recording keeps its bodies' colours: `jelly render` draws the green body green.
 TEST(RenderCli, KeepsTheBodiesColours) {
   TempDir dir;
