@@ -190,8 +190,12 @@ int run_jelly(int argc, char** argv) {
   view->add_option("--speed", view_args.speed,
                    "Live: simulated seconds per wall second (0: as fast as possible)")
       ->capture_default_str();
-  view->add_option("--samples", view_args.samples, "Multisampling (1 = none)")
-      ->capture_default_str();
+  CLI::Option* view_samples =
+      view->add_option("--samples", view_args.samples, "Multisampling (1 = none)")
+          ->capture_default_str();
+  view->add_flag("--fxaa", view_args.fxaa,
+                 "Smooth edges by FXAA after drawing single-sampled, in place of multisampling "
+                 "(cheaper on a software renderer)");
   view->add_flag("--paused", view_args.paused, "Start paused");
   view->add_flag("--hide-panel", view_args.hide_panel, "No panel (H toggles it)");
   view->add_flag("--particles", view_args.particles, "Show the particles");
@@ -227,8 +231,12 @@ int run_jelly(int argc, char** argv) {
   render->add_option("--camera", render_args.camera,
                      "Camera: yaw,pitch,distance[,tx,ty,tz] (degrees, m); default: as `jelly "
                      "view` frames the recording");
-  render->add_option("--samples", render_args.samples, "Multisampling (1 = none)")
-      ->capture_default_str();
+  CLI::Option* render_samples =
+      render->add_option("--samples", render_args.samples, "Multisampling (1 = none)")
+          ->capture_default_str();
+  render->add_flag("--fxaa", render_args.fxaa,
+                   "Smooth edges by FXAA after drawing single-sampled, in place of "
+                   "multisampling (cheaper on a software renderer)");
   render->add_option("--crf", render_args.crf, "H.264 quality, lower is better")
       ->capture_default_str();
   render->add_flag("--particles", render_args.particles, "Show the particles");
@@ -306,6 +314,8 @@ int run_jelly(int argc, char** argv) {
     if (fit->parsed()) return fit_command(fit_args);
     if (list->parsed()) return list_command();
     if (fields->parsed()) return fields_command(fields_format);
+    view_args.samples_given = view_samples->count() > 0;
+    render_args.samples_given = render_samples->count() > 0;
     if (view->parsed()) return view_command(view_args);
     if (render->parsed()) return render_command(render_args);
     if (export_cmd->parsed()) return export_command(export_args);

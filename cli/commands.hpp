@@ -71,6 +71,8 @@ struct ViewArgs {
   bool overwrite = false;  // replace an existing --screenshot file
   double speed = 1;
   int samples = 4;
+  bool samples_given = false;  // --samples on the command line
+  bool fxaa = false;
   bool record = false;           // live: record from the first frame (F9 / the Record button)
   std::string record_dir = ".";  // where recordings and F12 screenshots are written
 };
@@ -85,6 +87,8 @@ struct RenderArgs {
   double start = -1, end = -1;
   std::string camera;
   int samples = 4;
+  bool samples_given = false;  // --samples on the command line
+  bool fxaa = false;
   int crf = 18;
   bool particles = false, springs = false, no_shadows = false;
   bool overwrite = false;  // replace an existing output (for PNG frames: frame 0)

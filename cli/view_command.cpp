@@ -65,6 +65,8 @@ int view_command(const ViewArgs& args) {
   require(args.frames >= -1, "--frames", args.frames, ">= 0 frames (-1: until closed)");
   require(args.speed >= 0, "--speed", args.speed, ">= 0 (0: as fast as possible)");
   require(args.samples >= 1 && args.samples <= 16, "--samples", args.samples, "1 to 16");
+  require(!args.fxaa || !args.samples_given || args.samples == 1, "--samples", args.samples,
+          "1 with --fxaa (FXAA replaces multisampling)");
   if (!args.screenshot.empty() && args.frames < 0)
     throw InputError("--screenshot", args.screenshot, "used with --frames N (the frame to save)");
   if (!args.screenshot.empty())
@@ -83,7 +85,8 @@ int view_command(const ViewArgs& args) {
   options.springs = args.springs;
   options.stats = args.stats;
   options.speed = args.speed;
-  options.samples = args.samples;
+  options.samples = args.fxaa ? 1 : args.samples;
+  options.fxaa = args.fxaa;
   options.record = args.record;
   options.record_dir = args.record_dir;
   {
@@ -129,13 +132,16 @@ int render_command(const RenderArgs& args) {
   options.start = args.start;
   options.end = args.end;
   options.camera = args.camera;
-  options.samples = args.samples;
+  options.samples = args.fxaa ? 1 : args.samples;
+  options.fxaa = args.fxaa;
   options.crf = args.crf;
   options.particles = args.particles;
   options.springs = args.springs;
   options.shadows = !args.no_shadows;
   require(args.fps >= 0, "--fps", args.fps, "> 0 frames per second (0: the recording's rate)");
   require(args.crf >= 0 && args.crf <= 51, "--crf", args.crf, "0 to 51");
+  require(!args.fxaa || !args.samples_given || args.samples == 1, "--samples", args.samples,
+          "1 with --fxaa (FXAA replaces multisampling)");
   if (viewer::video_format(args.output, "-o") == viewer::VideoFormat::kPngSequence) {
     std::vector<char> first(args.output.size() + 32);
     std::snprintf(first.data(), first.size(), args.output.c_str(), 0);

@@ -18,6 +18,12 @@ set(JELLY_COMPONENT_TARGETS)
 foreach(component IN LISTS JELLY_COMPONENTS)
   list(APPEND JELLY_COMPONENT_TARGETS jelly_${component})
 endforeach()
+# The component viewer (viewer/CMakeLists.txt) is not in jelly::jelly: asked for by name.
+set(JELLY_INSTALLED_COMPONENTS ${JELLY_COMPONENTS})
+if(TARGET jelly_viewer)
+  list(APPEND JELLY_COMPONENT_TARGETS jelly_viewer)
+  list(APPEND JELLY_INSTALLED_COMPONENTS viewer)
+endif()
 install(TARGETS jelly ${JELLY_COMPONENT_TARGETS} EXPORT jellyTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -9,7 +9,7 @@
 namespace jelly {
 
 struct ComponentInfo {
-  std::string_view name;         // "core", "io", "meshes", "arkode", "fit"
+  std::string_view name;         // "core", "io", "meshes", "arkode", "fit", "viewer"
   std::string_view description;  // what it brings, one line
 };
 
@@ -30,5 +30,6 @@ void register_io_component();
 void register_meshes_component();
 void register_arkode_component();
 void register_fit_component();
+void register_viewer_component();  // the viewer layer's (viewer/), when the program links it
 
 }  // namespace jelly

@@ -341,6 +341,7 @@ void H5Recorder::Impl::write_static(const Simulator& sim) {
       h5::write_attribute(g.get(), "num_springs", static_cast<long>(b.num_springs));
       h5::write_attribute(g.get(), "radius", b.radius);
       h5::write_attribute(g.get(), "spacing", b.spacing);
+      h5::write_attribute(g.get(), "thickness", b.thickness);
       if (b.color)
         h5::write_attribute(g.get(), "color",
                             std::vector<double>{b.color->x(), b.color->y(), b.color->z()});

@@ -155,6 +155,12 @@ Recording read(hid_t file) {
         body.radius = h5::read_double_attribute(g.get(), "radius");
       if (h5::has_attribute(g.get(), "spacing"))
         body.spacing = h5::read_double_attribute(g.get(), "spacing");
+      if (h5::has_attribute(g.get(), "thickness")) {
+        body.thickness = h5::read_double_attribute(g.get(), "thickness");
+        expect(std::isfinite(body.thickness) && body.thickness >= 0,
+               groups[bi].group() + " attribute thickness",
+               std::to_string(body.thickness) + " is not a distance >= 0 (m)");
+      }
       if (h5::has_attribute(g.get(), "color")) {
         // sRGB [r, g, b] in [0, 1], written as space-separated text by the attribute reader.
         std::istringstream text(attributes_of(g.get())["color"]);

@@ -221,6 +221,8 @@ struct RecordedBody {
   hsize_t surface_vertices = 0;
   std::vector<int> offsets, particles;
   std::vector<double> weights;
+  // Its colour (the group's attribute color: sRGB r g b in [0, 1]), when the scene gave one.
+  std::vector<double> color;
   std::string group() const { return "/particles/" + name; }
 };
 
@@ -335,6 +337,13 @@ RecordingLayout inspect(hid_t file, const std::string& h5_path) {
               ? static_cast<hsize_t>(h5::read_long_attribute(group.get(), "first_particle"))
               : next;
       next = body.first + body.count;
+      for (const auto& [key, text] : h5::read_attributes_as_text(group.get())) {
+        if (key != "color") continue;
+        std::istringstream in(text);
+        double c = 0;
+        while (in >> c) body.color.push_back(c);
+        if (body.color.size() != 3) body.color.clear();  // not an [r, g, b]: left out
+      }
       read_surface(file, h5_path, body);
       r.bodies.push_back(std::move(body));
     }
@@ -913,6 +922,7 @@ void body_grids(Writer& w, hid_t file, const RecordingLayout& r, const RecordedB
     if (observables) {
       for (const Observable& o : r.observables) w.field(o.name, &o.values[f * o.width], o.width);
     }
+    if (!body.color.empty()) w.field("color", body.color.data(), 3);
     out << "      </Grid>\n";
   }
   out << "    </Grid>\n";
@@ -938,6 +948,7 @@ void surface_grids(Writer& w, hid_t file, const RecordingLayout& r, const Record
     w.data_item(frame_item(xyz, own + "/frame/position", f), 10);
     out << "        </Geometry>\n";
     w.attribute("speed", "Scalar", "Node", frame_item(speed, own + "/frame/speed", f));
+    if (!body.color.empty()) w.field("color", body.color.data(), 3);
     out << "      </Grid>\n";
   }
   out << "    </Grid>\n";

@@ -51,7 +51,7 @@ RenderVideoReport render_video(const std::string& recording_path, const std::str
   RenderOptions render_options;
   render_options.shadows = options.shadows;
   Renderer renderer(render_options);
-  RenderTarget target(options.width, options.height, options.samples);
+  RenderTarget target(options.width, options.height, options.samples, options.fxaa);
   RenderScene scene = view.make_scene(frames.front());
   scene.show_particles = scene.show_particles || options.particles;
   scene.show_springs = options.springs;
@@ -62,6 +62,7 @@ RenderVideoReport render_video(const std::string& recording_path, const std::str
     if (options.camera.empty()) camera = follow.at(k);
     target.bind();
     renderer.draw(scene, camera, options.width, options.height);
+    target.set_fxaa_rect(renderer.edge_rect());
     target.resolve();
     target.read_rgb(pixels);
     report.render_seconds += seconds_since(t);

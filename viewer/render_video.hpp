@@ -11,6 +11,7 @@ struct RenderVideoOptions {
   double start = -1, end = -1;  // simulated time range; < 0 = the recording's
   std::string camera;           // "yaw,pitch,distance[,tx,ty,tz]"; empty = framed like `jelly view`
   int samples = 4;
+  bool fxaa = false;  // FXAA after single-sampled drawing, in place of multisampling
   bool particles = false, springs = false, shadows = true;
   int crf = 18;  // H.264 quality (lower is better)
 };

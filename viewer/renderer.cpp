@@ -622,24 +622,49 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
   // the ground is drawn unshadowed, then again with shadows inside it only.
   std::array<int, 4> shadow_rect{0, 0, width, height};
   const bool shadows = options_.shadows && scene.show_surfaces && !scene.bodies.empty();
+  // The bodies and the finite obstacles (at their poses): what casts shadows, and what has
+  // silhouettes to smooth.
+  Vec3f lo, hi;
+  scene.particle_bounds(lo, hi);
+  if (!(lo.x() <= hi.x())) lo = hi = Vec3f::Zero();
+  for (size_t t = 0; t < g.terrains.size(); ++t) {
+    const Eigen::AlignedBox3f& box = g.terrain_bounds[t];
+    if (!scene.terrains[t].casts_shadow || box.isEmpty()) continue;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3f local((corner & 1) ? box.max().x() : box.min().x(),
+                        (corner & 2) ? box.max().y() : box.min().y(),
+                        (corner & 4) ? box.max().z() : box.min().z());
+      const Vec3f p = (scene.terrains[t].pose * local.homogeneous()).head<3>();
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  {
+    // Their rectangle in the picture, a few pixels wider; the whole picture when a corner is
+    // behind the camera.
+    edge_rect_ = {0, 0, width, height};
+    float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+    bool behind = false;
+    for (int corner = 0; corner < 8 && !behind; ++corner) {
+      const Vec3f p((corner & 1) ? hi.x() : lo.x(), (corner & 2) ? hi.y() : lo.y(),
+                    (corner & 4) ? hi.z() : lo.z());
+      const Eigen::Vector4f c = view_proj * Eigen::Vector4f(p.x(), p.y(), p.z(), 1);
+      behind = c.w() <= 1e-6f;
+      const float x = (0.5f * c.x() / c.w() + 0.5f) * static_cast<float>(width);
+      const float y = (0.5f * c.y() / c.w() + 0.5f) * static_cast<float>(height);
+      x0 = std::min(x0, x);
+      x1 = std::max(x1, x);
+      y0 = std::min(y0, y);
+      y1 = std::max(y1, y);
+    }
+    if (!behind)
+      edge_rect_ = {std::clamp(static_cast<int>(x0) - 4, 0, width),
+                    std::clamp(static_cast<int>(y0) - 4, 0, height),
+                    std::clamp(static_cast<int>(x1) + 5, 0, width),
+                    std::clamp(static_cast<int>(y1) + 5, 0, height)};
+  }
   if (shadows) {
     g.make_shadow_map(options_.shadow_map_size);
-    Vec3f lo, hi;
-    scene.particle_bounds(lo, hi);
-    if (!(lo.x() <= hi.x())) lo = hi = Vec3f::Zero();
-    // The obstacles' shadows whole too (not cut where the map would end), at their poses.
-    for (size_t t = 0; t < g.terrains.size(); ++t) {
-      const Eigen::AlignedBox3f& box = g.terrain_bounds[t];
-      if (!scene.terrains[t].casts_shadow || box.isEmpty()) continue;
-      for (int corner = 0; corner < 8; ++corner) {
-        const Vec3f local((corner & 1) ? box.max().x() : box.min().x(),
-                          (corner & 2) ? box.max().y() : box.min().y(),
-                          (corner & 4) ? box.max().z() : box.min().z());
-        const Vec3f p = (scene.terrains[t].pose * local.homogeneous()).head<3>();
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-      }
-    }
     const Vec3f centre = 0.5f * (lo + hi);
     const float size = (hi - lo).norm();
     const float reach = std::min(12.0f, std::max(2.0f, 2.0f * size));  // how far below
@@ -706,7 +731,12 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
   glDisable(GL_CULL_FACE);
   glDepthMask(GL_TRUE);
   glClearDepth(1.0);
-  glClear(GL_DEPTH_BUFFER_BIT);
+  // The colour too, to the horizon's: the ground and the sky are drawn single-sampled (below),
+  // so the samples of a body's edge pixel that the body does not cover keep what the buffer
+  // held when the pixel's centre is the body's. Uncleared, that was black or the last frame's
+  // picture: a dark fringe along silhouettes under multisampling (issue 40).
+  glClearColor(options_.sky_bottom.x(), options_.sky_bottom.y(), options_.sky_bottom.z(), 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -774,6 +804,10 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
   // edges meet at the faded horizon, and the bodies' edges over them stay smooth (their samples
   // were written first).
   glDisable(GL_MULTISAMPLE);
+  // The ground pushed back a few depth steps: a sheet lying on it (a cloth of thickness 0, the
+  // faces of a body resting on it) is drawn over it, not in stripes with it (issue 40, item 8).
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(1.0f, 4.0f);
   if (!g.terrains.empty() || scene.floor) {
     const auto [x0, y0, x1, y1] = shadow_rect;
     if (shadows && x1 > x0 && y1 > y0) {
@@ -797,6 +831,7 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
       draw_ground(use_mesh(false, options_.grid, false));
     }
   }
+  glDisable(GL_POLYGON_OFFSET_FILL);
 
   // Sky, behind everything: only the pixels nothing else covered are shaded.
   glDepthFunc(GL_LEQUAL);

@@ -6,6 +6,7 @@
 // gradient. The live window, the screenshot and `jelly render` share it. Needs a current
 // OpenGL 3.3 core context; GPU buffers are made when the scene's topology changes and only
 // refilled in place otherwise (no allocation per frame).
+#include <array>
 #include <memory>
 
 #include <jelly/viewer/camera.hpp>
@@ -34,6 +35,11 @@ class Renderer {
   // set to it). Restores the framebuffer binding it found.
   void draw(const RenderScene& scene, const Camera& camera, int width, int height);
 
+  // The rectangle of the last drawn picture (x0, y0, x1, y1 in pixels from its bottom left) that
+  // holds the bodies and the finite obstacles: where their silhouettes are (RenderTarget's FXAA
+  // pass is limited to it).
+  std::array<int, 4> edge_rect() const { return edge_rect_; }
+
   RenderOptions& options() { return options_; }
   const RenderOptions& options() const { return options_; }
 
@@ -41,6 +47,7 @@ class Renderer {
   struct Gpu;
   RenderOptions options_;
   std::unique_ptr<Gpu> gpu_;
+  std::array<int, 4> edge_rect_{0, 0, 0, 0};
 };
 
 }  // namespace jelly::viewer

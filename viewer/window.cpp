@@ -215,6 +215,12 @@ struct ViewerWindow::Impl {
   std::optional<PanelRect> banner_rect;    // the divergence banner, last frame
   PanelRect panel_rect;                    // the panel, last frame (empty when hidden)
   bool follow = false;  // the camera's target follows the bodies (default without --camera)
+  // Live, following: the camera also moves in until the bodies fill the picture (framed as their
+  // largest extent so far, so a bounce or a squash does not pump the zoom) until the user zooms
+  // (issue 40, items 3 and 9: a jelly sliding down a slope stayed as small as the first framing
+  // of its drop made it).
+  bool follow_zoom = false;
+  Vec3 follow_extent = Vec3::Zero();
   // Recording (live) and screenshots (F12): the current or last files, the last failure.
   std::string record_path, screenshot_path, record_message;
   bool screenshot_pending = false;
@@ -298,7 +304,7 @@ struct ViewerWindow::Impl {
     renderer = std::make_unique<Renderer>();
     glfwGetFramebufferSize(window, &fb_width, &fb_height);
     target = std::make_unique<RenderTarget>(std::max(fb_width, 1), std::max(fb_height, 1),
-                                            options.samples);
+                                            options.samples, options.fxaa);
   }
 
   float aspect() const {
@@ -325,6 +331,7 @@ struct ViewerWindow::Impl {
     builder = std::make_unique<SceneBuilder>(model, std::move(terrains), lo, hi);
     builder_generation = live->generation();
     positions = model.rest_position;
+    follow_extent = Vec3::Zero();
     const RenderScene old = std::move(scene);
     scene = builder->make_scene(positions, 0);
     if (!first) {
@@ -372,6 +379,7 @@ struct ViewerWindow::Impl {
       camera = framing_camera(lo, hi, builder->terrains(), 0, aspect(), {sight});
     }
     follow = options.camera.empty();  // a camera of the user's own stays where it was put
+    follow_zoom = follow;
     if (options.record) toggle_recording();
     if (!options.paused && !options.lockstep) live->set_playing(true);
   }
@@ -597,7 +605,10 @@ struct ViewerWindow::Impl {
     }
   }
 
-  void scroll(double dy) { camera.zoom(static_cast<float>(std::pow(0.9, dy))); }
+  void scroll(double dy) {
+    camera.zoom(static_cast<float>(std::pow(0.9, dy)));
+    follow_zoom = false;  // the user's distance is kept
+  }
 
   void key(int key) {
     switch (key) {
@@ -720,7 +731,7 @@ struct ViewerWindow::Impl {
       ImGui::RadioButton("strain", &coloring, 1);
       scene.spring_coloring = coloring ? SpringColoring::kStrain : SpringColoring::kType;
     }
-    ImGui::Checkbox("follow the bodies", &follow);
+    if (ImGui::Checkbox("follow the bodies", &follow)) follow_zoom = follow && !replay;
     ImGui::Checkbox("shadows", &renderer->options().shadows);
     ImGui::SameLine();
     ImGui::Checkbox("grid", &renderer->options().grid);
@@ -1045,13 +1056,23 @@ struct ViewerWindow::Impl {
     } else if (follow && positions.size() >= 3) {
       Vec3 lo, hi;
       bounds_of(positions, lo, hi);
-      camera.target += 0.1f * ((0.5 * (lo + hi)).cast<float>() - camera.target);
+      const Vec3 centre = 0.5 * (lo + hi);
+      camera.target += 0.1f * (centre.cast<float>() - camera.target);
+      if (follow_zoom) {
+        follow_extent = follow_extent.cwiseMax(hi - lo);
+        const Vec3 half = 0.5 * follow_extent;
+        const float close = frame_box((centre - half).cast<float>(), (centre + half).cast<float>(),
+                                      aspect(), camera.yaw_degrees, camera.pitch_degrees)
+                                .distance;
+        camera.distance += 0.03f * (close - camera.distance);
+      }
     }
     const auto draw_start = Clock::now();
     const double draw_cpu_start = thread_cpu_seconds();
     target->resize(fb_width, fb_height);
     target->bind();
     renderer->draw(scene, camera, fb_width, fb_height);
+    target->set_fxaa_rect(renderer->edge_rect());
     target->resolve();
     target->blit_to(0);
     if (options.stats) glFinish();

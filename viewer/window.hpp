@@ -26,6 +26,7 @@ struct ViewOptions {
   bool paused = false;  // live: start paused
   int start_frame = 0;  // replay: the frame shown first
   int samples = 4;      // multisampling
+  bool fxaa = false;    // FXAA after single-sampled drawing, in place of multisampling
   double speed = 1;     // simulated seconds per wall second; 0 = as fast as possible
   bool particles = false, springs = false;
   // Live: every shown frame advances the simulation by exactly one output interval on the

@@ -414,6 +414,9 @@ void bind_core(py::module_& m) {
                     "The distance its particles keep from terrains and obstacles (m): the scene "
                     "key thickness; by default the contact radius for a cloth, 0 for a body "
                     "with volume.")
+      .def_readonly("color", &Body::color,
+                    "Its colour in pictures and exports: the scene key color, sRGB [r, g, b] "
+                    "in [0, 1], or None (the viewer's palette by body index).")
       .def_property_readonly(
           "particles",
           [](const Body& b) {

@@ -82,6 +82,8 @@ TEST(Cli, ListShowsTheComponentsOfThisBuild) {
     EXPECT_EQ(r.out.find("\ncomponent  " + std::string(name) + " ") != std::string::npos, built)
         << name;
   }
+  // The program links the viewer layer (at least its exports): it names the component viewer.
+  EXPECT_NE(r.out.find("\ncomponent  viewer "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("\nintegrator arkode_dirk ") != std::string::npos,
             static_cast<bool>(JELLY_WITH_ARKODE));
   EXPECT_EQ(r.out.find("\nintegrator arkode_erk ") != std::string::npos,

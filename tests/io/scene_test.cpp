@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -604,6 +606,62 @@ TEST(BodyColor, ReadWrittenAndRecorded) {
   ASSERT_EQ(r.model.bodies.size(), 2u);
   EXPECT_FALSE(r.model.bodies[0].color);
   EXPECT_EQ(r.model.bodies[1].color, scene.bodies[1].color);
+
+  // ParaView: the coloured body's blocks (its springs and its surface) carry the colour as a
+  // field of every frame; the other body's none.
+  std::string xdmf;
+  {
+    std::ifstream in(dir.file("colors.xdmf"));
+    xdmf.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string field = "<Attribute Name=\"color\"";
+  const std::string values = ">0.10000000000000001 0.80000000000000004 0.20000000000000001<";
+  const size_t red = xdmf.find("<Grid Name=\"red\""), green = xdmf.find("<Grid Name=\"green\"");
+  ASSERT_NE(red, std::string::npos);
+  ASSERT_NE(green, std::string::npos);
+  int fields = 0;
+  for (size_t at = xdmf.find(field); at != std::string::npos; at = xdmf.find(field, at + 1)) {
+    ++fields;
+    EXPECT_NE(xdmf.find(values, at), std::string::npos);
+    EXPECT_FALSE(at > red && (green < red || at < green)) << "a colour in the red body's block";
+  }
+  EXPECT_EQ(fields % 2, 0);
+  EXPECT_GE(fields, 2 * static_cast<int>(r.time.size()));
+}
+
+// A body's thickness is written to its recording's body group and read back with the body
+// (issue 40: it was only in the scene JSON): a cloth's default (its contact radius), a set one,
+// a volume's 0.
+TEST(BodyThickness, RecordedAndReadBack) {
+  const std::string json = R"({
+    "bodies": [
+      {"kind": "cube", "name": "cube", "n": 3, "edge_length": 1, "origin": [-2, 0.5, 0]},
+      {"kind": "cloth", "name": "sheet", "nu": 4, "nv": 4, "size_u": 1, "size_v": 1,
+       "position": [2, 1, 0]},
+      {"kind": "cloth", "name": "thick", "nu": 4, "nv": 4, "size_u": 1, "size_v": 1,
+       "position": [4, 1, 0], "thickness": 0.125}
+    ],
+    "terrains": [], "integrator": {"name": "rk4", "dt": 0.001}, "duration": 0.01
+  })";
+  const Scene scene = parse_scene(json);
+  testing::TempDir dir;
+  const std::string path = dir.file("thickness.h5");
+  Simulator sim = make_simulator(scene);
+  ASSERT_EQ(sim.model().bodies.size(), 3u);
+  ASSERT_GT(sim.model().bodies[1].thickness, 0);
+  {
+    RecorderOptions options;
+    options.scene_json = scene_to_json(scene);
+    H5Recorder recorder(path, sim, options);
+    sim.add_observer(recorder);
+    ASSERT_TRUE(sim.run_until(0.01).ok());
+  }
+  const Recording r = read_recording(path);
+  ASSERT_EQ(r.model.bodies.size(), 3u);
+  EXPECT_EQ(r.model.bodies[0].thickness, 0);
+  EXPECT_EQ(r.model.bodies[1].thickness, sim.model().bodies[1].thickness);
+  EXPECT_EQ(r.model.bodies[1].thickness, sim.model().bodies[1].radius);
+  EXPECT_EQ(r.model.bodies[2].thickness, 0.125);
 }
 
 TEST(BodyColor, BadColorsNameTheField) {

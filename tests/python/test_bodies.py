@@ -101,6 +101,20 @@ def test_thickness_defaults_to_the_cloths_radius_and_is_kept_from_terrains():
         jelly.Simulator(scene_of([dict(cloth, thickness=-1)]))
 
 
+def test_color_is_the_scenes_and_kept_by_pickling():
+    cube = {"kind": "cube", "n": 3, "edge_length": 0.5, "origin": [0, 1, 0]}
+    sim = jelly.Simulator(scene_of([dict(cube, name="plain"),
+                                    dict(cube, name="green", origin=[2, 1, 0],
+                                         color=[0.1, 0.8, 0.2])]))
+    plain, green = sim.model.bodies
+    assert plain.color is None
+    assert list(green.color) == [0.1, 0.8, 0.2]
+    import pickle
+    assert list(pickle.loads(pickle.dumps(sim.model)).bodies[1].color) == [0.1, 0.8, 0.2]
+    with pytest.raises(jelly.InputError, match=r"bodies\[0\]\.color"):
+        jelly.Simulator(scene_of([dict(cube, name="bad", color=[0, 2, 0])]))
+
+
 def test_cloth_surface_is_its_flat_sheet():
     sim = jelly.Simulator(scene_of([{"kind": "cloth", "name": "c", "nu": 6, "nv": 4,
                                      "size_u": 2, "size_v": 1.5, "position": [0, 3, 0]}]))
