@@ -76,38 +76,170 @@ std::vector<int> ParticleSelection::resolve(const Model& model, const Body& body
   return out;
 }
 
+// Through the pin table's selection rows (the same for forces).
 ParticleSelection ParticleSelection::read(JsonFields& f) {
-  ParticleSelection s;
-  if (const Json* idx = f.value("indices")) {
-    if (!idx->is_array() || idx->empty()) {
-      throw InputError(f.path("indices"), json_text(*idx),
-                       "a list of at least one particle index (leave \"indices\", \"region\" "
-                       "and \"group\" out to choose the whole body)");
-    }
-    for (std::size_t i = 0; i < idx->size(); ++i) {
-      s.indices.push_back(json_integer((*idx)[i], json_element(f.path("indices"), i)));
-    }
+  PinSpec pin;
+  for (const Field<PinSpec>& row : pin_fields().fields) {
+    if (row.name != "path") row.read(f, pin, row.name);
   }
-  if (const Json* r = f.value("region")) {
-    JsonFields g(*r, f.path("region"));
-    const Vec3 lo = json_vec3(g.value("min") ? *g.value("min") : Json(), g.path("min"));
-    const Vec3 hi = json_vec3(g.value("max") ? *g.value("max") : Json(), g.path("max"));
-    g.reject_unknown();
-    require((lo.array() <= hi.array()).all(), g.path("max"), hi.transpose(),
-            "a corner >= min in every coordinate");
-    s.has_region = true;
-    s.region = Eigen::AlignedBox3d(lo, hi);
-  }
-  s.group = f.string_or("group", "");
-  return s;
+  return pin.select;
 }
 
 void ParticleSelection::write(Json& j) const {
-  if (!indices.empty()) j["indices"] = indices;
-  if (has_region) {
-    j["region"] = {{"min", json_of(region.min())}, {"max", json_of(region.max())}};
+  PinSpec pin;
+  pin.select = *this;
+  write_fields(pin_fields(), pin, j);  // the fixed path is not written
+}
+
+namespace {
+
+// A selection's rows (indices, region, group) of a struct whose member `Select` holds it, each
+// written only when given.
+template <typename S, ParticleSelection S::*Select>
+std::vector<Field<S>> selection_rows() {
+  Field<S> indices = object_field<S>(
+      "indices", FieldType::kList, "a list of at least one particle index",
+      "Particles by index in the body (with region and group: the union; none: the whole body)",
+      "[0, 2]",
+      [](JsonFields& f, S& s, std::string_view key) {
+        if (const Json* idx = f.value(key)) {
+          if (!idx->is_array() || idx->empty()) {
+            throw InputError(f.path(key), json_text(*idx),
+                             "a list of at least one particle index (leave \"indices\", "
+                             "\"region\" and \"group\" out to choose the whole body)");
+          }
+          for (std::size_t i = 0; i < idx->size(); ++i) {
+            (s.*Select).indices.push_back(json_integer((*idx)[i], json_element(f.path(key), i)));
+          }
+        }
+      },
+      [](const S& s, Json& j, std::string_view key) { j[std::string(key)] = (s.*Select).indices; });
+  indices.is_default = [](const S& s) { return (s.*Select).indices.empty(); };
+  indices.omit_default = true;
+  Field<S> region = object_field<S>(
+      "region", FieldType::kObject, "{\"min\": [x, y, z], \"max\": [x, y, z]}, min <= max",
+      "Particles inside this box at rest (world coordinates)",
+      R"({"min": [-100.0, -100.0, -100.0], "max": [100.0, 100.0, 100.0]})",
+      [](JsonFields& f, S& s, std::string_view key) {
+        if (const Json* r = f.value(key)) {
+          JsonFields g(*r, f.path(key));
+          const Vec3 lo = json_vec3(g.value("min") ? *g.value("min") : Json(), g.path("min"));
+          const Vec3 hi = json_vec3(g.value("max") ? *g.value("max") : Json(), g.path("max"));
+          g.reject_unknown();
+          require((lo.array() <= hi.array()).all(), g.path("max"), hi.transpose(),
+                  "a corner >= min in every coordinate");
+          (s.*Select).has_region = true;
+          (s.*Select).region = Eigen::AlignedBox3d(lo, hi);
+        }
+      },
+      [](const S& s, Json& j, std::string_view key) {
+        const Eigen::AlignedBox3d& r = (s.*Select).region;
+        j[std::string(key)] = {{"min", json_of(r.min())}, {"max", json_of(r.max())}};
+      });
+  region.is_default = [](const S& s) { return !(s.*Select).has_region; };
+  region.omit_default = true;
+  return {indices, region,
+          omit_default(string_field<Select, &ParticleSelection::group>(
+              "group", "a group of the body (a mesh's vertex group, a cloth's corner or edge)",
+              "Particles of a named group of the body"))};
+}
+
+}  // namespace
+
+const FieldTable<PinSpec>& pin_fields() {
+  static const FieldTable<PinSpec> table = [] {
+    std::vector<Field<PinSpec>> rows = selection_rows<PinSpec, &PinSpec::select>();
+    Field<PinSpec> path = json_value_field<&PinSpec::path>(
+        "path",
+        "\"fixed\" or a path {\"kind\": phases, keyframes, oscillation, circle or linear, ...}",
+        "Where the pinned particles go from their rest positions (docs/scenes.md, pins)",
+        R"({"kind": "oscillation", "amplitude": [0.0, 0.1, 0.0], "frequency": 1.0, "phase": 0.0})");
+    path.is_default = [](const PinSpec& p) { return p.path.is_fixed(); };
+    path.omit_default = true;
+    rows.push_back(path);
+    return FieldTable<PinSpec>{"PinSpec", "bodies[i].pins[j]",
+                               "Particles of the body held on a path", std::move(rows)};
+  }();
+  return table;
+}
+
+namespace {
+
+using ForceSpec = ExternalForceSpec;
+
+std::vector<std::string> external_force_kind_names() {
+  std::vector<std::string> out;
+  for (const auto& k : external_force_kinds()) out.emplace_back(k.name);
+  return out;
+}
+
+// One force kind's rows: kind, the selection, its vector (force or the wind's velocity and
+// drag), then the gust and the time window.
+FieldTable<ForceSpec> force_table(ExternalForceKind kind, std::string_view name,
+                                  std::string_view title) {
+  Field<ForceSpec> kind_row = object_field<ForceSpec>(
+      "kind", FieldType::kChoice, "one of " + quoted_names(external_force_kinds()),
+      "The force kind; its keys are its table's", "",
+      [](JsonFields& f, ForceSpec& e, std::string_view key) {
+        e.kind = external_force_kind_from_name(f.string(key), f.path(key));
+      },
+      [](const ForceSpec& e, Json& j, std::string_view key) {
+        j[std::string(key)] = std::string(external_force_kind_name(e.kind));
+      });
+  kind_row.required = true;
+  kind_row.constrained = true;
+  kind_row.choices = external_force_kind_names;
+  std::vector<Field<ForceSpec>> rows{kind_row};
+  for (Field<ForceSpec>& f : selection_rows<ForceSpec, &ForceSpec::select>()) rows.push_back(f);
+  if (kind == ExternalForceKind::kWind) {
+    rows.push_back(vec3_field<&ForceSpec::vector>("velocity", "m/s", range_finite(),
+                                                  "finite components", "Velocity of the air (w)"));
+    rows.push_back(required(number_field<&ForceSpec::drag>("drag", "N s/m", range_at_least(0),
+                                                           "a finite drag >= 0 N s/m",
+                                                           "Per particle: f = drag (w(t) - v)")));
+  } else {
+    rows.push_back(vec3_field<&ForceSpec::vector>(
+        "force", "N", range_finite(), "finite components",
+        kind == ExternalForceKind::kConstant
+            ? "The total, spread over the particles in proportion to their masses"
+            : "On each selected particle"));
   }
-  if (!group.empty()) j["group"] = group;
+  rows.push_back(number_field<&ForceSpec::gust>("gust", "", range_finite(),
+                                                "a finite relative amplitude",
+                                                "w(t) = w (1 + gust sin(2 pi gust_frequency t))"));
+  rows.push_back(number_field<&ForceSpec::gust_frequency>(
+      "gust_frequency", "Hz", range_at_least(0), "a finite frequency >= 0 Hz", "Of the gust"));
+  rows.push_back(number_field<&ForceSpec::start>("start", "s", range_at_least(0),
+                                                 "a finite time >= 0 s", "When it starts"));
+  rows.push_back(number_or_inf_field<&ForceSpec::end>("end", "s", range_or_infinite(FieldRange{}),
+                                                      "a time after start (or inf)",
+                                                      "When it stops (\"inf\": never)"));
+  return FieldTable<ForceSpec>{name, "bodies[i].forces[j]", title, std::move(rows),
+                               [](const ForceSpec& e, const std::string& prefix) {
+                                 require(!std::isnan(e.end) && e.end > e.start, prefix + "end",
+                                         e.end, "a time after start (or inf)");
+                               }};
+}
+
+}  // namespace
+
+const FieldTable<ExternalForceSpec>& external_force_fields(ExternalForceKind kind) {
+  static const FieldTable<ForceSpec> constant =
+      force_table(ExternalForceKind::kConstant, "ExternalForceSpec (constant)",
+                  "A force spread over the chosen particles by mass");
+  static const FieldTable<ForceSpec> point = force_table(
+      ExternalForceKind::kPoint, "ExternalForceSpec (point)", "A force on each chosen particle");
+  static const FieldTable<ForceSpec> wind = force_table(
+      ExternalForceKind::kWind, "ExternalForceSpec (wind)", "Drag towards the air's velocity");
+  switch (kind) {
+    case ExternalForceKind::kConstant:
+      return constant;
+    case ExternalForceKind::kPoint:
+      return point;
+    case ExternalForceKind::kWind:
+      return wind;
+  }
+  return constant;
 }
 
 namespace {
@@ -119,9 +251,7 @@ void read_body_pins(JsonFields& f, BodySpec& b, std::string_view key) {
   for (std::size_t i = 0; i < pins->size(); ++i) {
     JsonFields g((*pins)[i], json_element(f.path("pins"), i));
     PinSpec pin;
-    pin.select = ParticleSelection::read(g);
-    if (const Json* p = g.value("path")) pin.path = Path::read(*p, g.path("path"));
-    g.reject_unknown();
+    read_fields(pin_fields(), g, pin, g.prefix(), /*reject_unknown=*/true);
     b.pins.push_back(std::move(pin));
   }
 }
@@ -129,9 +259,8 @@ void read_body_pins(JsonFields& f, BodySpec& b, std::string_view key) {
 void write_body_pins(const BodySpec& b, Json& j, std::string_view key) {
   Json list = Json::array();
   for (const PinSpec& p : b.pins) {
-    Json pj;
-    p.select.write(pj);
-    if (!p.path.is_fixed()) pj["path"] = p.path.to_json();
+    Json pj = Json::object();
+    write_fields(pin_fields(), p, pj);
     list.push_back(pj);
   }
   j[std::string(key)] = list;
@@ -145,24 +274,10 @@ void read_body_forces(JsonFields& f, BodySpec& b, std::string_view key) {
   }
   for (std::size_t i = 0; i < forces->size(); ++i) {
     JsonFields g((*forces)[i], json_element(f.path("forces"), i));
+    const ExternalForceKind kind = external_force_kind_from_name(g.string("kind"), g.path("kind"));
     ExternalForceSpec e;
-    e.kind = external_force_kind_from_name(g.string("kind"), g.path("kind"));
-    e.select = ParticleSelection::read(g);
-    if (e.kind == ExternalForceKind::kWind) {
-      e.vector = g.vec3_or("velocity", e.vector);
-      e.drag = g.number("drag");
-    } else {
-      e.vector = g.vec3_or("force", e.vector);
-    }
-    e.gust = g.number_or("gust", e.gust);
-    e.gust_frequency = g.number_or("gust_frequency", e.gust_frequency);
-    e.start = g.number_or("start", e.start);
-    if (const Json* end = g.value("end")) {
-      e.end = (end->is_string() && end->get<std::string>() == "inf")
-                  ? std::numeric_limits<Real>::infinity()
-                  : json_number(*end, g.path("end"));
-    }
-    g.reject_unknown();
+    e.kind = kind;
+    read_fields(external_force_fields(kind), g, e, g.prefix(), /*reject_unknown=*/true);
     b.forces.push_back(std::move(e));
   }
 }
@@ -170,19 +285,8 @@ void read_body_forces(JsonFields& f, BodySpec& b, std::string_view key) {
 void write_body_forces(const BodySpec& b, Json& j, std::string_view key) {
   Json list = Json::array();
   for (const ExternalForceSpec& e : b.forces) {
-    Json fj;
-    fj["kind"] = std::string(external_force_kind_name(e.kind));
-    e.select.write(fj);
-    if (e.kind == ExternalForceKind::kWind) {
-      fj["velocity"] = json_of(e.vector);
-      fj["drag"] = e.drag;
-    } else {
-      fj["force"] = json_of(e.vector);
-    }
-    fj["gust"] = e.gust;
-    fj["gust_frequency"] = e.gust_frequency;
-    fj["start"] = e.start;
-    fj["end"] = std::isinf(e.end) ? Json("inf") : Json(e.end);
+    Json fj = Json::object();
+    write_fields(external_force_fields(e.kind), e, fj);
     list.push_back(fj);
   }
   j[std::string(key)] = list;
@@ -211,7 +315,7 @@ Field<BodySpec> body_kind_field() {
       },
       [](const BodySpec& b, Json& j, std::string_view key) {
         j[std::string(key)] = std::string(b.kind());
-        b.shape->write(j);
+        if (b.shape) b.shape->write(j);  // none: a default BodySpec (the reference's)
       });
   row.required = true;
   row.constrained = true;

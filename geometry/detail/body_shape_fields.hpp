@@ -13,7 +13,10 @@
 
 namespace jelly {
 
-const FieldTable<BodySpec>& body_fields();                   // geometry/body_spec.cpp
+const FieldTable<BodySpec>& body_fields();  // geometry/body_spec.cpp
+const FieldTable<PinSpec>& pin_fields();    // geometry/body_spec.cpp
+// The table of one external force kind (its keys differ: force, or velocity and drag).
+const FieldTable<ExternalForceSpec>& external_force_fields(ExternalForceKind kind);
 const FieldTable<SpringCoefficients>& spring_fields();       // geometry/lattice.cpp
 const FieldTable<Material>& material_fields();               // geometry/lattice.cpp
 const FieldTable<Pose>& pose_fields();                       // geometry/pose.cpp

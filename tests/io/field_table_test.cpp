@@ -21,10 +21,12 @@
 namespace jelly {
 namespace {
 
-// Two bodies and two terrains: a table at bodies[i] or terrains[i] is tried at index 1.
+// Two bodies and two terrains: a table at bodies[i] or terrains[i] is tried at index 1, one of
+// pins or forces at bodies[1].pins[0] or bodies[1].forces[0].
 const char* const kFieldScene = R"({
   "bodies": [{"kind": "cube", "name": "a", "n": 3},
-             {"kind": "cube", "name": "b", "n": 3, "origin": [5, 0, 0]}],
+             {"kind": "cube", "name": "b", "n": 3, "origin": [5, 0, 0],
+              "pins": [{"indices": [0]}], "forces": [{"kind": "constant"}]}],
   "terrains": [{"kind": "plane"}, {"kind": "slope"}],
   "integrator": {"name": "rk4"},
   "duration": 1
@@ -52,7 +54,9 @@ std::string tet_cube_file() {
 // The smallest object of each kind (its required keys), the element a kind's table is tried in.
 Json kind_object(const std::string& path, const std::string& kind) {
   Json j = {{"kind", kind}};
-  if (path == "bodies[i]") {
+  if (path == "bodies[i].forces[j]") {
+    if (kind == "wind") j["drag"] = 0.1;
+  } else if (path == "bodies[i]") {
     j["name"] = "b";
     if (kind == "voxelized") {
       j["file"] = asset("torus.obj");
@@ -165,11 +169,14 @@ std::vector<Json> field_bad_values(const FieldDoc& f) {
   return out;
 }
 
-// A table's path in the test scene: "terrains[i].contact" -> "terrains[1].contact".
+// A table's path in the test scene: "terrains[i].contact" -> "terrains[1].contact",
+// "bodies[i].pins[j]" -> "bodies[1].pins[0]".
 std::string table_scene_path(const std::string& path) {
   std::string out = path;
   for (std::size_t at = out.find("[i]"); at != std::string::npos; at = out.find("[i]"))
     out.replace(at, 3, "[1]");
+  for (std::size_t at = out.find("[j]"); at != std::string::npos; at = out.find("[j]"))
+    out.replace(at, 3, "[0]");
   return out;
 }
 
@@ -234,7 +241,8 @@ TEST(FieldTables, TheReferenceListsEveryIntegratorOptionTable) {
   ASSERT_GE(tables.size(), 5u);
   for (const FieldTableDoc& t : tables) {
     EXPECT_FALSE(t.fields.empty()) << t.name;
-    const bool kind_table = t.path == "terrains[i]" || t.path == "bodies[i]";
+    const bool kind_table =
+        t.path == "terrains[i]" || t.path == "bodies[i]" || t.path == "bodies[i].forces[j]";
     if (!t.used_by.empty()) {
       EXPECT_TRUE(kind_table || is_integrator_options(t)) << t.name;
     }
