@@ -165,17 +165,17 @@ def table_keys(fields_json):
     return keys
 
 
-def row_keys(row):
-    """The keys a row of a hand-written key table names in its first cell: `a`, `b.c` -> a, c;
-    `springs.{structural,shear,bending}.{ks,kd}` -> springs, ks, kd."""
+def row_declared(row, declared):
+    """Whether every key a row of a hand-written key table names in its first cell is declared:
+    `a`, `b.c` -> a, b, c; in `springs.{structural,shear,bending}.{ks,kd}` one declared key of
+    each set of alternatives (instances of one table) is enough."""
     cell = row.split("|")[1]
-    out = set()
     for code in re.findall(r"`([^`]+)`", cell):
-        parts = [p for p in code.split(".") if p and not p.startswith("{")]
-        out.update(parts)
-        for braces in re.findall(r"\{([^}]*)\}", code):
-            out.update(k.strip() for k in braces.split(","))
-    return out
+        for part in re.split(r"\.(?![^{]*\})", code):
+            names = {k.strip() for k in part.strip("{}").split(",") if k.strip()}
+            if names and not names & declared:
+                return False
+    return True
 
 
 def scene_keys_page(source, build, problems):
@@ -227,7 +227,7 @@ def scene_keys_page(source, build, problems):
             # key no field table declares.
             if header.split("|")[1].strip() not in ("key", "kind"):
                 continue
-            rows = [r for r in rows if not row_keys(r) <= declared]
+            rows = [r for r in rows if not row_declared(r, declared)]
             if rows:
                 if pending:
                     parts.append(pending + "\n")
