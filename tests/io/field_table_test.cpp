@@ -124,6 +124,9 @@ std::vector<Json> field_valid_values(const FieldDoc& f, const Json& element) {
         r.lo, r.hi, r.lo + 1, r.hi - 1, 2 * d, d + 1, d / 2, (r.lo + r.hi) / 2, 0.5, 1, 3};
     // A limit on the scene's size: more than the default, not the least it allows.
     if (f.name == "max_particles") candidates.insert(candidates.begin(), 2 * d);
+    // A required size the kind's object gives (a voxelized body's spacing): half of it.
+    if (element.contains(f.name) && element[f.name].is_number())
+      candidates.insert(candidates.begin(), element[f.name].get<double>() / 2);
     for (double c : candidates) {
       if (!std::isfinite(c) || !r.contains(c) || c == d) continue;
       if (is_integer_field(f)) {
