@@ -178,6 +178,12 @@ std::string_view field_type_name(FieldType type) {
       return "choice";
     case FieldType::kVec3:
       return "vec3";
+    case FieldType::kObject:
+      return "object";
+    case FieldType::kList:
+      return "list";
+    case FieldType::kFile:
+      return "file";
   }
   return "unknown";
 }
@@ -201,6 +207,24 @@ Vec3 json_field_vec3(JsonFields& f, std::string_view key, const Vec3& fallback) 
   return f.vec3_or(key, fallback);
 }
 std::string json_field_path(const JsonFields& f, std::string_view key) { return f.path(key); }
+const Json* json_field_value(JsonFields& f, std::string_view key) { return f.value(key); }
+std::string json_field_file(JsonFields& f, std::string_view key) {
+  // An empty name is left to the row's check, whose message says what file it takes.
+  const Json* v = f.value(key);
+  if (v != nullptr && v->is_string() && v->get<std::string>().empty()) return "";
+  return f.file(key);
+}
+void json_field_require(JsonFields& f, std::string_view key) {
+  if (f.value(key) == nullptr) throw InputError(f.path(key) + " is missing: it is required");
+}
+Real json_field_number_or_inf(JsonFields& f, std::string_view key, Real fallback) {
+  const Json* v = f.value(key);
+  if (v == nullptr) return fallback;
+  if (v->is_string() && v->get<std::string>() == "inf")
+    return std::numeric_limits<Real>::infinity();
+  if (!v->is_number()) throw InputError(f.path(key), json_text(*v), "a number or \"inf\"");
+  return v->get<Real>();
+}
 bool json_field_has(const JsonFields& f, std::string_view key) { return f.has(key); }
 void json_field_reject_unknown(const JsonFields& f) { f.reject_unknown(); }
 
@@ -214,6 +238,12 @@ void json_field_put(Json& out, std::string_view key, const std::string& value) {
 }
 void json_field_put(Json& out, std::string_view key, const Vec3& value) {
   out[std::string(key)] = json_of(value);
+}
+void json_field_put_or_inf(Json& out, std::string_view key, Real value) {
+  out[std::string(key)] = std::isinf(value) && value > 0 ? Json("inf") : Json(value);
+}
+void json_field_put_json(Json& out, std::string_view key, const Json& value) {
+  out[std::string(key)] = value;
 }
 
 // As require() shows values (errors.hpp), so that messages read as before the tables.

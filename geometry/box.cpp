@@ -4,18 +4,38 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {
 
+const FieldTable<BoxShape>& box_shape_fields() {
+  using B = BoxShape;
+  static const FieldTable<B> table{
+      "BoxShape",
+      "bodies[i]",
+      "A lattice of nx x ny x nz particles filling a box of the given size",
+      {
+          integer_field<&B::n, 0>("nx", "", range_closed(2, 2000), "an integer in [2, 2000]",
+                                  "Particles along the box's own x"),
+          integer_field<&B::n, 1>("ny", "", range_closed(2, 2000), "an integer in [2, 2000]",
+                                  "Particles along the box's own y"),
+          integer_field<&B::n, 2>("nz", "", range_closed(2, 2000), "an integer in [2, 2000]",
+                                  "Particles along the box's own z"),
+          vec3_each_field<&B::size>("size", "m", range_above(0), "three finite sizes > 0 (m)",
+                                    "Edge lengths along the box's own x, y, z"),
+          pose_position_field<&B::pose, &Pose::position>("Where the box's centre is"),
+          pose_rotation_field<&B::pose, &Pose::rotation_degrees>(),
+      },
+      // The pose's scale is no key of a box (its size is): only code can set it.
+      [](const B& s, const std::string& prefix) {
+        require(s.pose.scale == 1, prefix + "scale", s.pose.scale, "1 (give the size instead)");
+      },
+  };
+  return table;
+}
+
 void BoxShape::validate(const std::string& prefix) const {
-  const char* axes[3] = {"nx", "ny", "nz"};
-  for (int a = 0; a < 3; ++a) {
-    require(n[a] >= 2 && n[a] <= 2000, prefix + axes[a], n[a], "an integer in [2, 2000]");
-  }
-  require(size.allFinite() && size.minCoeff() > 0, prefix + "size", size.transpose(),
-          "three finite sizes > 0 (m)");
-  pose.validate(prefix);
-  require(pose.scale == 1, prefix + "scale", pose.scale, "1 (give the size instead)");
+  validate_fields(box_shape_fields(), *this, prefix);
 }
 
 BodyPart BoxShape::build(const Material& material, const std::string& prefix) const {
@@ -28,24 +48,11 @@ BodyPart BoxShape::build(const Material& material, const std::string& prefix) co
   return build_lattice(grid, material, "box");
 }
 
-void BoxShape::write(Json& j) const {
-  j["nx"] = n[0];
-  j["ny"] = n[1];
-  j["nz"] = n[2];
-  j["size"] = json_of(size);
-  j["position"] = json_of(pose.position);
-  j["rotation_degrees"] = json_of(pose.rotation_degrees);
-}
+void BoxShape::write(Json& j) const { write_fields(box_shape_fields(), *this, j); }
 
 std::unique_ptr<BodyShape> BoxShape::read(JsonFields& f) {
   auto s = std::make_unique<BoxShape>();
-  s->n[0] = f.integer_or("nx", s->n[0]);
-  s->n[1] = f.integer_or("ny", s->n[1]);
-  s->n[2] = f.integer_or("nz", s->n[2]);
-  s->size = f.vec3_or("size", s->size);
-  s->pose.position = f.vec3_or("position", s->pose.position);
-  s->pose.rotation_degrees = f.vec3_or("rotation_degrees", s->pose.rotation_degrees);
-  s->validate(f.prefix());
+  read_fields(box_shape_fields(), f, *s, f.prefix());
   return s;
 }
 

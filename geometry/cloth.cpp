@@ -5,16 +5,38 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {
 
+const FieldTable<ClothShape>& cloth_shape_fields() {
+  using C = ClothShape;
+  static const FieldTable<C> table{
+      "ClothShape",
+      "bodies[i]",
+      "A sheet of nu x nv particles in its own x-z plane (u along x, v along z)",
+      {
+          integer_field<&C::nu>("nu", "", range_closed(2, 10000), "an integer in [2, 10000]",
+                                "Particles along u"),
+          integer_field<&C::nv>("nv", "", range_closed(2, 10000), "an integer in [2, 10000]",
+                                "Particles along v"),
+          number_field<&C::size_u>("size_u", "m", range_above(0), "a finite size > 0 (m)",
+                                   "Length along u"),
+          number_field<&C::size_v>("size_v", "m", range_above(0), "a finite size > 0 (m)",
+                                   "Length along v"),
+          pose_position_field<&C::pose, &Pose::position>("Where the sheet's centre is"),
+          pose_rotation_field<&C::pose, &Pose::rotation_degrees>(),
+      },
+      // The pose's scale is no key of a cloth (its sizes are): only code can set it.
+      [](const C& s, const std::string& prefix) {
+        require(s.pose.scale == 1, prefix + "scale", s.pose.scale, "1 (give the sizes instead)");
+      },
+  };
+  return table;
+}
+
 void ClothShape::validate(const std::string& prefix) const {
-  require(nu >= 2 && nu <= 10000, prefix + "nu", nu, "an integer in [2, 10000]");
-  require(nv >= 2 && nv <= 10000, prefix + "nv", nv, "an integer in [2, 10000]");
-  require(std::isfinite(size_u) && size_u > 0, prefix + "size_u", size_u, "a finite size > 0 (m)");
-  require(std::isfinite(size_v) && size_v > 0, prefix + "size_v", size_v, "a finite size > 0 (m)");
-  pose.validate(prefix);
-  require(pose.scale == 1, prefix + "scale", pose.scale, "1 (give the sizes instead)");
+  validate_fields(cloth_shape_fields(), *this, prefix);
 }
 
 BodyPart ClothShape::build(const Material& material, const std::string& prefix) const {
@@ -86,24 +108,11 @@ long ClothShape::estimated_springs() const {
   return structural + shear + bending;
 }
 
-void ClothShape::write(Json& j) const {
-  j["nu"] = nu;
-  j["nv"] = nv;
-  j["size_u"] = size_u;
-  j["size_v"] = size_v;
-  j["position"] = json_of(pose.position);
-  j["rotation_degrees"] = json_of(pose.rotation_degrees);
-}
+void ClothShape::write(Json& j) const { write_fields(cloth_shape_fields(), *this, j); }
 
 std::unique_ptr<BodyShape> ClothShape::read(JsonFields& f) {
   auto s = std::make_unique<ClothShape>();
-  s->nu = f.integer_or("nu", s->nu);
-  s->nv = f.integer_or("nv", s->nv);
-  s->size_u = f.number_or("size_u", s->size_u);
-  s->size_v = f.number_or("size_v", s->size_v);
-  s->pose.position = f.vec3_or("position", s->pose.position);
-  s->pose.rotation_degrees = f.vec3_or("rotation_degrees", s->pose.rotation_degrees);
-  s->validate(f.prefix());
+  read_fields(cloth_shape_fields(), f, *s, f.prefix());
   return s;
 }
 

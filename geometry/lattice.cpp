@@ -3,21 +3,43 @@
 #include <cmath>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {
 
+const FieldTable<SpringCoefficients>& spring_fields() {
+  using C = SpringCoefficients;
+  static const FieldTable<C> table{
+      "SpringCoefficients",
+      "bodies[i].springs.structural",
+      "A spring type's coefficients (the same keys under structural, shear and bending)",
+      {
+          number_field<&C::ks>("ks", "N/m", range_at_least(0), "a finite stiffness >= 0",
+                               "Stiffness"),
+          number_field<&C::kd>("kd", "N s/m", range_at_least(0), "a finite damping >= 0",
+                               "Damping along the spring"),
+      },
+  };
+  return table;
+}
+
+const FieldTable<Material>& material_fields() {
+  using M = Material;
+  static const FieldTable<M> table{
+      "Material",
+      "bodies[i]",
+      "A body's masses (its springs: SpringCoefficients per spring type)",
+      {particle_mass_field<&M::particle_mass>(), density_field<&M::density>()},
+  };
+  return table;
+}
+
 void Material::validate(const std::string& prefix) const {
   for (int t = 0; t < kSpringTypeCount; ++t) {
-    const std::string name = prefix + "springs." + std::string(spring_type_name(SpringType(t)));
-    require(std::isfinite(springs[t].ks) && springs[t].ks >= 0, name + ".ks", springs[t].ks,
-            "a finite stiffness >= 0");
-    require(std::isfinite(springs[t].kd) && springs[t].kd >= 0, name + ".kd", springs[t].kd,
-            "a finite damping >= 0");
+    validate_fields(spring_fields(), springs[t],
+                    prefix + "springs." + std::string(spring_type_name(SpringType(t))) + ".");
   }
-  require(std::isfinite(particle_mass) && particle_mass > 0, prefix + "particle_mass",
-          particle_mass, "a finite mass > 0");
-  require(std::isfinite(density) && density >= 0, prefix + "density", density,
-          "a finite density >= 0 (0 = use particle_mass)");
+  validate_fields(material_fields(), *this, prefix);
 }
 
 bool LatticeGrid::is_occupied(int i, int j, int k) const {

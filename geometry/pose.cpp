@@ -5,6 +5,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {
 
@@ -15,23 +16,28 @@ Eigen::Matrix3d Pose::rotation() const {
       .toRotationMatrix();
 }
 
+const FieldTable<Pose>& pose_fields() {
+  static const FieldTable<Pose> table{
+      "Pose",
+      "bodies[i]",
+      "Where a mesh goes: scaled, then rotated, then moved",
+      {
+          pose_scale_field<&Pose::scale>(),
+          pose_position_field<&Pose::position>("Where the mesh's origin goes"),
+          pose_rotation_field<&Pose::rotation_degrees>(),
+      },
+  };
+  return table;
+}
+
 void Pose::validate(const std::string& prefix) const {
-  require(position.allFinite(), prefix + "position", position.transpose(), "finite coordinates");
-  require(rotation_degrees.allFinite(), prefix + "rotation_degrees", rotation_degrees.transpose(),
-          "finite angles (degrees)");
-  require(std::isfinite(scale) && scale > 0, prefix + "scale", scale, "a finite scale > 0");
+  validate_fields(pose_fields(), *this, prefix);
 }
 
 void Pose::read(JsonFields& f) {
-  scale = f.number_or("scale", scale);
-  position = f.vec3_or("position", position);
-  rotation_degrees = f.vec3_or("rotation_degrees", rotation_degrees);
+  for (const Field<Pose>& field : pose_fields().fields) field.read(f, *this, field.name);
 }
 
-void Pose::write(Json& j) const {
-  j["scale"] = scale;
-  j["position"] = json_of(position);
-  j["rotation_degrees"] = json_of(rotation_degrees);
-}
+void Pose::write(Json& j) const { write_fields(pose_fields(), *this, j); }
 
 }  // namespace jelly

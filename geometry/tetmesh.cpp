@@ -7,6 +7,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 #include <jelly/geometry/detail/mesh_file.hpp>
 #include <jelly/geometry/tet_mesh_io.hpp>
 
@@ -261,10 +262,27 @@ const TetMesh& TetmeshShape::mesh(const std::string& prefix) const {
   return cache->mesh;
 }
 
+const FieldTable<TetmeshShape>& tetmesh_shape_fields() {
+  using T = TetmeshShape;
+  static const FieldTable<T> table{
+      "TetmeshShape",
+      "bodies[i]",
+      "Springs along the edges of a tetrahedral mesh",
+      {
+          file_field<&T::file>("file", "the name of a .msh, .node or .ele file",
+                               "The tet mesh (Gmsh .msh, TetGen .node/.ele)"),
+          pose_scale_field<&T::pose, &Pose::scale>(),
+          pose_position_field<&T::pose, &Pose::position>("Where the mesh's origin goes"),
+          pose_rotation_field<&T::pose, &Pose::rotation_degrees>(),
+      },
+      // The mesh itself: read and checked.
+      [](const T& s, const std::string& prefix) { s.mesh(prefix); },
+  };
+  return table;
+}
+
 void TetmeshShape::validate(const std::string& prefix) const {
-  require(!file.empty(), prefix + "file", "\"\"", "the name of a .msh, .node or .ele file");
-  pose.validate(prefix);
-  mesh(prefix);
+  validate_fields(tetmesh_shape_fields(), *this, prefix);
 }
 
 BodyPart TetmeshShape::build(const Material& material, const std::string& prefix) const {
@@ -279,16 +297,11 @@ long TetmeshShape::estimated_springs() const {
   return std::atomic_load(&cache_)->edges;
 }
 
-void TetmeshShape::write(Json& j) const {
-  j["file"] = file;
-  pose.write(j);
-}
+void TetmeshShape::write(Json& j) const { write_fields(tetmesh_shape_fields(), *this, j); }
 
 std::unique_ptr<BodyShape> TetmeshShape::read(JsonFields& f) {
   auto s = std::make_unique<TetmeshShape>();
-  s->file = f.file("file");
-  s->pose.read(f);
-  s->validate(f.prefix());
+  read_fields(tetmesh_shape_fields(), f, *s, f.prefix());
   return s;
 }
 

@@ -8,6 +8,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 #include <jelly/geometry/winding_number.hpp>
 
 namespace jelly {
@@ -241,11 +242,33 @@ const MeshFile& VoxelizedShape::mesh(const std::string& prefix) const {
   return cache->mesh;
 }
 
+const FieldTable<VoxelizedShape>& voxelized_shape_fields() {
+  using V = VoxelizedShape;
+  static const FieldTable<V> table{
+      "VoxelizedShape",
+      "bodies[i]",
+      "A closed triangle mesh filled with the lattice",
+      {
+          file_field<&V::file>("file", "the name of an OBJ, STL or PLY file",
+                               "The closed mesh (OBJ, STL or PLY)"),
+          required(number_field<&V::spacing>("spacing", "m", range_above(0),
+                                             "a finite spacing > 0 (m)",
+                                             "Distance between lattice points (after scale)")),
+          pose_scale_field<&V::pose, &Pose::scale>(),
+          pose_position_field<&V::pose, &Pose::position>("Where the mesh's origin goes"),
+          pose_rotation_field<&V::pose, &Pose::rotation_degrees>(),
+      },
+      // The mesh itself: read, holes small enough, a lattice of sensible size.
+      [](const V& s, const std::string& prefix) { s.validate_mesh(prefix); },
+  };
+  return table;
+}
+
 void VoxelizedShape::validate(const std::string& prefix) const {
-  require(!file.empty(), prefix + "file", "\"\"", "the name of an OBJ, STL or PLY file");
-  require(std::isfinite(spacing) && spacing > 0, prefix + "spacing", spacing,
-          "a finite spacing > 0 (m)");
-  pose.validate(prefix);
+  validate_fields(voxelized_shape_fields(), *this, prefix);
+}
+
+void VoxelizedShape::validate_mesh(const std::string& prefix) const {
   const MeshFile& m = mesh(prefix);
   require_small_holes(std::atomic_load(&cache_)->topology, kMaxHoleSpacings * spacing / pose.scale,
                       prefix + "file", file,
@@ -270,18 +293,11 @@ long VoxelizedShape::estimated_particles() const {
   return voxel_grid_points(mesh().mesh.bounds(), spacing, pose.scale);
 }
 
-void VoxelizedShape::write(Json& j) const {
-  j["file"] = file;
-  j["spacing"] = spacing;
-  pose.write(j);
-}
+void VoxelizedShape::write(Json& j) const { write_fields(voxelized_shape_fields(), *this, j); }
 
 std::unique_ptr<BodyShape> VoxelizedShape::read(JsonFields& f) {
   auto s = std::make_unique<VoxelizedShape>();
-  s->file = f.file("file");
-  s->spacing = f.number("spacing");
-  s->pose.read(f);
-  s->validate(f.prefix());
+  read_fields(voxelized_shape_fields(), f, *s, f.prefix());
   return s;
 }
 

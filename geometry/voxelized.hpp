@@ -69,6 +69,8 @@ struct VoxelizedShape final : BodyShapeOf<VoxelizedShape> {
 
   // The mesh as read (validate() or the first call reads it).
   const MeshFile& mesh(const std::string& prefix = "") const;
+  // The checks of the mesh the file holds, after the fields' own (validate() runs both).
+  void validate_mesh(const std::string& prefix) const;
 
  private:
   struct Cache;

@@ -8,6 +8,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/io/detail/json_parse.hpp>
+#include <jelly/io/detail/scene_fields.hpp>
 #include <jelly/io/memory_estimate.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
@@ -85,12 +86,12 @@ void Scene::validate() const {
     particles += bodies[i].shape->estimated_particles();
     springs += bodies[i].shape->estimated_springs();
   }
-  require(max_particles > 0, "max_particles", max_particles, "a number of particles > 0");
+  // gravity, max_particles, duration, output_interval, threads (the other rows are objects).
+  validate_fields(scene_fields(), *this, "");
   require(particles <= max_particles, "bodies", std::to_string(particles) + " particles",
           "at most max_particles = " + std::to_string(max_particles) + " (they would need about " +
               bytes_text(estimate_memory_bytes(particles, springs, integrator.name, false)) +
               " of memory with " + integrator.name + "; raise max_particles if it allows)");
-  require(gravity.allFinite(), "gravity", gravity.transpose(), "finite components");
   for (std::size_t i = 0; i < terrains.size(); ++i) {
     const std::string prefix = "terrains[" + std::to_string(i) + "].";
     require(static_cast<bool>(terrains[i]), prefix + "kind", "none", "a terrain kind");
@@ -100,8 +101,8 @@ void Scene::validate() const {
   body_contact.validate("body_contact.");
   const IntegratorInfo& info = find_integrator(integrator.name, "integrator.name");
   if (info.options.validate) info.options.validate(integrator.options, "integrator.options.");
-  simulator_options(*this).validate();  // integrator.dt, output_interval, divergence.*
-  require(std::isfinite(duration) && duration > 0, "duration", duration, "a finite duration > 0 s");
+  validate_fields(integrator_spec_fields(), integrator, "integrator.");
+  simulator_options(*this).validate();  // divergence.*, crush.*
 }
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {

@@ -12,14 +12,7 @@
 
 namespace jelly {
 
-void SimulatorOptions::validate() const {
-  require(std::isfinite(dt) && dt > 0, "integrator.dt", dt, "a finite time step > 0 s");
-  require(std::isfinite(output_interval) && output_interval >= 0, "output_interval",
-          output_interval, "a finite interval >= 0 s (0 = every step)");
-  require(threads >= 0, "threads", threads, "an integer >= 0 (0 = all cores)");
-  divergence.validate();
-  crush.validate();
-}
+// SimulatorOptions::validate: simulator_options.cpp (its field table).
 
 Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integrator,
                      SimulatorOptions options)

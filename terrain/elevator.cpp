@@ -5,16 +5,40 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/terrain/detail/terrain_fields.hpp>
 
 namespace jelly {
 
+const FieldTable<ElevatorSpec>& elevator_fields() {
+  using E = ElevatorSpec;
+  static const FieldTable<E> table{
+      "ElevatorSpec",
+      "terrains[i]",
+      "A moving platform (the seed's elevator): a box's top face moving along y",
+      {
+          vec3_field<&E::center>("center", "m", range_finite(), "finite coordinates",
+                                 "The platform's centre at t = 0"),
+          number_field<&E::size_x>("size_x", "m", range_above(0), "a finite size > 0",
+                                   "Footprint along x"),
+          number_field<&E::size_z>("size_z", "m", range_above(0), "a finite size > 0",
+                                   "Footprint along z"),
+          number_field<&E::thickness>("thickness", "m", range_above(0), "a finite thickness > 0",
+                                      "How deep below the surface a particle still touches it"),
+          number_or_inf_field<&E::mass>("mass", "kg", range_or_infinite(range_above(0)),
+                                        "a mass > 0 (inf for an immovable platform)",
+                                        "Platform mass in the seed's collision formula"),
+          json_value_field<&E::motion>(
+              "motion", "\"seed\" or a list of phases [{duration, acceleration, stop_at_end}]",
+              "Constant-acceleration phases along y, repeated",
+              R"([{"duration": 1.0, "acceleration": 2.0, "stop_at_end": false}, )"
+              R"({"duration": 1.0, "acceleration": -2.0, "stop_at_end": true}])"),
+      },
+  };
+  return table;
+}
+
 void ElevatorSpec::validate(const std::string& prefix) const {
-  require(center.allFinite(), prefix + "center", center.transpose(), "finite coordinates");
-  require(std::isfinite(size_x) && size_x > 0, prefix + "size_x", size_x, "a finite size > 0");
-  require(std::isfinite(size_z) && size_z > 0, prefix + "size_z", size_z, "a finite size > 0");
-  require(std::isfinite(thickness) && thickness > 0, prefix + "thickness", thickness,
-          "a finite thickness > 0");
-  require(mass > 0, prefix + "mass", mass, "a mass > 0 (inf for an immovable platform)");
+  validate_fields(elevator_fields(), *this, prefix);
 }
 
 Elevator::Elevator(ElevatorSpec spec, ContactParams contact)
@@ -39,34 +63,11 @@ std::unique_ptr<Terrain> ElevatorSpec::make() const {
   return std::make_unique<Elevator>(*this, contact);
 }
 
-namespace {
-
-Real read_mass(const Json& j, const std::string& path) {
-  if (j.is_string() && j.get<std::string>() == "inf") return std::numeric_limits<Real>::infinity();
-  if (!j.is_number()) throw InputError(path, json_text(j), "a number or \"inf\"");
-  return j.get<Real>();
-}
-
-}  // namespace
-
-void ElevatorSpec::write(Json& j) const {
-  j["center"] = json_of(center);
-  j["size_x"] = size_x;
-  j["size_z"] = size_z;
-  j["thickness"] = thickness;
-  j["mass"] = std::isinf(mass) ? Json("inf") : Json(mass);
-  j["motion"] = motion.to_json();
-}
+void ElevatorSpec::write(Json& j) const { write_fields(elevator_fields(), *this, j); }
 
 std::unique_ptr<TerrainSpec> ElevatorSpec::read(JsonFields& f) {
   auto e = std::make_unique<ElevatorSpec>();
-  e->center = f.vec3_or("center", e->center);
-  e->size_x = f.number_or("size_x", e->size_x);
-  e->size_z = f.number_or("size_z", e->size_z);
-  e->thickness = f.number_or("thickness", e->thickness);
-  if (const Json* m = f.value("mass")) e->mass = read_mass(*m, f.path("mass"));
-  if (const Json* m = f.value("motion")) e->motion = ElevatorMotion::read(*m, f.path("motion"));
-  e->validate(f.prefix());
+  read_fields(elevator_fields(), f, *e, f.prefix());
   return e;
 }
 

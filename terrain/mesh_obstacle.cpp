@@ -5,8 +5,10 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 #include <jelly/geometry/detail/mesh_file.hpp>
 #include <jelly/geometry/mesh_io.hpp>
+#include <jelly/terrain/detail/terrain_fields.hpp>
 
 namespace jelly {
 
@@ -77,31 +79,40 @@ std::shared_ptr<const MeshObstacleShape> MeshObstacleSpec::shape(const std::stri
   return cache;
 }
 
+const FieldTable<MeshObstacleSpec>& mesh_obstacle_fields() {
+  using M = MeshObstacleSpec;
+  static const FieldTable<M> table{
+      "MeshObstacleSpec",
+      "terrains[i]",
+      "A closed triangle mesh obstacle",
+      {
+          file_field<&M::file>("file", "the name of an OBJ, STL or PLY file",
+                               "The closed mesh (OBJ, STL or PLY)"),
+          pose_scale_field<&M::pose, &Pose::scale>(),
+          pose_position_field<&M::pose, &Pose::position>("Where the mesh's origin is at t = 0"),
+          pose_rotation_field<&M::pose, &Pose::rotation_degrees>(),
+          obstacle_motion_field<&M::motion>(),
+          obstacle_spin_field<&M::angular_velocity_degrees>(),
+      },
+      // The mesh itself: read and checked.
+      [](const M& s, const std::string& prefix) { s.shape(prefix); },
+  };
+  return table;
+}
+
 void MeshObstacleSpec::validate(const std::string& prefix) const {
-  require(!file.empty(), prefix + "file", "\"\"", "the name of an OBJ, STL or PLY file");
-  pose.validate(prefix);
-  validate_angular_velocity(angular_velocity_degrees, prefix + "angular_velocity_degrees");
-  shape(prefix);
+  validate_fields(mesh_obstacle_fields(), *this, prefix);
 }
 
 std::unique_ptr<Terrain> MeshObstacleSpec::make() const {
   return std::make_unique<MeshObstacle>(*this, contact);
 }
 
-void MeshObstacleSpec::write(Json& j) const {
-  j["file"] = file;
-  pose.write(j);
-  j["motion"] = motion.to_json();
-  j["angular_velocity_degrees"] = json_of(angular_velocity_degrees);
-}
+void MeshObstacleSpec::write(Json& j) const { write_fields(mesh_obstacle_fields(), *this, j); }
 
 std::unique_ptr<TerrainSpec> MeshObstacleSpec::read(JsonFields& f) {
   auto s = std::make_unique<MeshObstacleSpec>();
-  s->file = f.file("file");
-  s->pose.read(f);
-  if (const Json* m = f.value("motion")) s->motion = Path::read(*m, f.path("motion"));
-  s->angular_velocity_degrees = f.vec3_or("angular_velocity_degrees", s->angular_velocity_degrees);
-  s->validate(f.prefix());
+  read_fields(mesh_obstacle_fields(), f, *s, f.prefix());
   return s;
 }
 

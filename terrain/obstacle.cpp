@@ -5,6 +5,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
+#include <jelly/terrain/detail/terrain_fields.hpp>
 
 namespace jelly {
 
@@ -118,77 +119,83 @@ TriangleMesh ObstacleGeometry::mesh() const {
   return {};
 }
 
+namespace {
+
+Field<ObstacleSpec> obstacle_center_field() {
+  return vec3_field<&ObstacleSpec::center>("center", "m", range_finite(), "finite coordinates",
+                                           "The centre at t = 0");
+}
+Field<ObstacleSpec> obstacle_radius_field() {
+  return required(number_field<&ObstacleSpec::geometry, &ObstacleGeometry::radius>(
+      "radius", "m", range_above(0), "a finite radius > 0 (m)", "Radius"));
+}
+Field<ObstacleSpec> obstacle_rotation_field() {
+  return vec3_field<&ObstacleSpec::rotation_degrees>(
+      "rotation_degrees", "degrees", range_finite(), "finite angles (degrees)",
+      "Rotation at t = 0 about x, then y, then z (axes fixed in space)");
+}
+
+// The rows of one shape: center, the shape's own, then rotation, motion and spin.
+FieldTable<ObstacleSpec> obstacle_table(std::string_view name, std::string_view title,
+                                        std::vector<Field<ObstacleSpec>> own) {
+  std::vector<Field<ObstacleSpec>> fields{obstacle_center_field()};
+  for (Field<ObstacleSpec>& f : own) fields.push_back(std::move(f));
+  fields.push_back(obstacle_rotation_field());
+  fields.push_back(obstacle_motion_field<&ObstacleSpec::motion>());
+  fields.push_back(obstacle_spin_field<&ObstacleSpec::angular_velocity_degrees>());
+  return FieldTable<ObstacleSpec>{name, "terrains[i]", title, std::move(fields)};
+}
+
+}  // namespace
+
+const FieldTable<ObstacleSpec>& obstacle_fields(ObstacleShape shape) {
+  static const FieldTable<ObstacleSpec> sphere =
+      obstacle_table("ObstacleSpec (sphere)", "A sphere obstacle", {obstacle_radius_field()});
+  static const FieldTable<ObstacleSpec> box =
+      obstacle_table("ObstacleSpec (box)", "An oriented box obstacle",
+                     {vec3_each_field<&ObstacleSpec::geometry, &ObstacleGeometry::size>(
+                         "size", "m", range_above(0), "three finite edge lengths > 0 (m)",
+                         "Edge lengths along its own x, y, z")});
+  static const FieldTable<ObstacleSpec> capsule = obstacle_table(
+      "ObstacleSpec (capsule)", "A capsule obstacle, its axis along its own y",
+      {obstacle_radius_field(),
+       required(number_field<&ObstacleSpec::geometry, &ObstacleGeometry::height>(
+           "height", "m", range_at_least(0), "a finite length >= 0 between the caps (m)",
+           "Length between the caps' centres"))});
+  static const FieldTable<ObstacleSpec> cylinder = obstacle_table(
+      "ObstacleSpec (cylinder)", "A capped cylinder obstacle, its axis along its own y",
+      {obstacle_radius_field(),
+       required(number_field<&ObstacleSpec::geometry, &ObstacleGeometry::height>(
+           "height", "m", range_above(0), "a finite length > 0 (m)", "Length along the axis"))});
+  switch (shape) {
+    case ObstacleShape::kSphere:
+      return sphere;
+    case ObstacleShape::kBox:
+      return box;
+    case ObstacleShape::kCapsule:
+      return capsule;
+    case ObstacleShape::kCylinder:
+      return cylinder;
+  }
+  return sphere;
+}
+
 void ObstacleSpec::validate(const std::string& prefix) const {
-  require(center.allFinite(), prefix + "center", center.transpose(), "finite coordinates");
-  require(rotation_degrees.allFinite(), prefix + "rotation_degrees", rotation_degrees.transpose(),
-          "finite angles (degrees)");
-  validate_angular_velocity(angular_velocity_degrees, prefix + "angular_velocity_degrees");
-  const ObstacleGeometry& g = geometry;
-  if (g.shape != ObstacleShape::kBox) {
-    require(std::isfinite(g.radius) && g.radius > 0, prefix + "radius", g.radius,
-            "a finite radius > 0 (m)");
-  } else {
-    require(g.size.allFinite() && g.size.minCoeff() > 0, prefix + "size", g.size.transpose(),
-            "three finite edge lengths > 0 (m)");
-  }
-  if (g.shape == ObstacleShape::kCylinder) {
-    require(std::isfinite(g.height) && g.height > 0, prefix + "height", g.height,
-            "a finite length > 0 (m)");
-  } else if (g.shape == ObstacleShape::kCapsule) {
-    require(std::isfinite(g.height) && g.height >= 0, prefix + "height", g.height,
-            "a finite length >= 0 between the caps (m)");
-  }
+  validate_fields(obstacle_fields(geometry.shape), *this, prefix);
 }
 
 std::unique_ptr<Terrain> ObstacleSpec::make() const {
   return std::make_unique<Obstacle>(*this, contact);
 }
 
-void ObstacleSpec::write(Json& j) const {
-  j["center"] = json_of(center);
-  switch (geometry.shape) {
-    case ObstacleShape::kSphere:
-      j["radius"] = geometry.radius;
-      break;
-    case ObstacleShape::kBox:
-      j["size"] = json_of(geometry.size);
-      break;
-    case ObstacleShape::kCapsule:
-    case ObstacleShape::kCylinder:
-      j["radius"] = geometry.radius;
-      j["height"] = geometry.height;
-      break;
-  }
-  j["rotation_degrees"] = json_of(rotation_degrees);
-  j["motion"] = motion.to_json();
-  j["angular_velocity_degrees"] = json_of(angular_velocity_degrees);
-}
+void ObstacleSpec::write(Json& j) const { write_fields(obstacle_fields(geometry.shape), *this, j); }
 
 namespace {
 
 std::unique_ptr<TerrainSpec> read_obstacle(JsonFields& f, ObstacleShape shape) {
   auto spec = std::make_unique<ObstacleSpec>();
-  ObstacleGeometry& g = spec->geometry;
-  g.shape = shape;
-  spec->center = f.vec3_or("center", spec->center);
-  switch (shape) {
-    case ObstacleShape::kSphere:
-      g.radius = f.number("radius");
-      break;
-    case ObstacleShape::kBox:
-      g.size = f.vec3_or("size", g.size);
-      break;
-    case ObstacleShape::kCapsule:
-    case ObstacleShape::kCylinder:
-      g.radius = f.number("radius");
-      g.height = f.number("height");
-      break;
-  }
-  spec->rotation_degrees = f.vec3_or("rotation_degrees", spec->rotation_degrees);
-  if (const Json* m = f.value("motion")) spec->motion = Path::read(*m, f.path("motion"));
-  spec->angular_velocity_degrees =
-      f.vec3_or("angular_velocity_degrees", spec->angular_velocity_degrees);
-  spec->validate(f.prefix());
+  spec->geometry.shape = shape;
+  read_fields(obstacle_fields(shape), f, *spec, f.prefix());
   return spec;
 }
 

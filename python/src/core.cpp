@@ -14,8 +14,10 @@
 #include <jelly/core/pins.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/core/surface.hpp>
+#include <jelly/geometry/detail/body_shape_fields.hpp>
 
 #include "common.hpp"
+#include "fields.hpp"
 
 namespace jelly::python {
 
@@ -278,14 +280,14 @@ void bind_core(py::module_& m) {
       },
       "The spring type names, by type index: ['structural', 'shear', 'bending'].");
 
-  py::class_<SpringCoefficients>(m, "SpringCoefficients",
-                                 "Stiffness ks (N/m) and damping kd (N s/m) of one spring type.")
+  py::class_<SpringCoefficients> spring_coefficients(
+      m, "SpringCoefficients", "Stiffness ks (N/m) and damping kd (N s/m) of one spring type.");
+  def_fields(spring_coefficients, spring_fields(), "springs.structural");
+  spring_coefficients
       .def(py::init([](Real ks, Real kd) {
              return SpringCoefficients{ks, kd};
            }),
            py::arg("ks") = 1400, py::arg("kd") = 50, "Coefficients ks (N/m) and kd (N s/m).")
-      .def_readwrite("ks", &SpringCoefficients::ks, "Stiffness (N/m).")
-      .def_readwrite("kd", &SpringCoefficients::kd, "Damping (N s/m).")
       .def("__repr__", [](const SpringCoefficients& c) {
         return "SpringCoefficients(ks=" + to_text(c.ks) + ", kd=" + to_text(c.kd) + ")";
       });

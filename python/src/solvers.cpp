@@ -318,17 +318,11 @@ void bind_solvers(py::module_& m) {
   divergence.def_readwrite("max_energy", &DivergenceGuard::max_energy,
                            "J; inf = not checked (not a scene key).");
 
-  py::class_<SimulatorOptions>(m, "SimulatorOptions",
-                               "Time step, output interval and divergence limits.")
-      .def(py::init<>(), "dt 0.001 s, a frame every step.")
-      .def_readwrite("dt", &SimulatorOptions::dt, "Time step (s), > 0.")
-      .def_readwrite("output_interval", &SimulatorOptions::output_interval,
-                     "Seconds between observer frames; 0 = every step.")
+  py::class_<SimulatorOptions> simulator_options(
+      m, "SimulatorOptions", "Time step, output interval, threads and divergence limits.");
+  def_fields(simulator_options, simulator_options_fields());
+  simulator_options.def(py::init<>(), "dt 0.001 s, a frame every step.")
       .def_readwrite("divergence", &SimulatorOptions::divergence, "The DivergenceGuard.")
-      .def_readwrite("threads", &SimulatorOptions::threads,
-                     "Threads for the force loop, the solves and the contact; 0 = all cores or "
-                     "one thread, chosen step by step from which runs faster (the same "
-                     "results bit for bit for any count).")
       .def("validate", &SimulatorOptions::validate,
            "Raises InputError naming the first invalid option.");
 

@@ -4,6 +4,7 @@
 #include <jelly/core/json.hpp>
 #include <jelly/terrain/contact_params.hpp>
 #include <jelly/terrain/detail/contact_fields.hpp>
+#include <jelly/terrain/detail/terrain_fields.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 #include <jelly/terrain/terrain.hpp>
@@ -132,16 +133,10 @@ void bind_terrain(py::module_& m) {
       .def_property_readonly("point", &Plane::point, "A point of the plane.")
       .def_property_readonly("unit_normal", &Plane::unit_normal, "Its outward unit normal.");
 
-  py::class_<ElevatorSpec>(m, "ElevatorSpec",
-                           "The seed elevator's platform; its motion is the seed cycle.")
-      .def(py::init<>(), "The seed elevator: 5 x 5 m at y = 1, mass 1, the seed motion.")
-      .def_readwrite("center", &ElevatorSpec::center, "Platform centre at t = 0 (m).")
-      .def_readwrite("size_x", &ElevatorSpec::size_x, "Footprint along x (m).")
-      .def_readwrite("size_z", &ElevatorSpec::size_z, "Footprint along z (m).")
-      .def_readwrite("thickness", &ElevatorSpec::thickness,
-                     "Depth below the surface that still touches (m).")
-      .def_readwrite("mass", &ElevatorSpec::mass,
-                     "Platform mass of the seed formula (kg; inf = immovable).")
+  py::class_<ElevatorSpec> elevator(m, "ElevatorSpec",
+                                    "The seed elevator's platform; its motion is the seed cycle.");
+  def_fields(elevator, elevator_fields(), "elevator");
+  elevator.def(py::init<>(), "The seed elevator: 5 x 5 m at y = 1, mass 1, the seed motion.")
       .def(
           "validate", [](const ElevatorSpec& s) { s.validate("elevator."); },
           "Raises InputError naming the first invalid field.");
