@@ -18,8 +18,9 @@
 //     (no spring changes length), and the state takes the particles' projection as far as the
 //     total energy stays at or below the energy at the start of the step (bisection on a blend
 //     of the two): an integrator that loses energy keeps losing it through the contact. The
-//     blend's energy is the energy after the velocity passes plus what the blend changes: the
-//     kinetic energy of the pairs' particles, the springs of those particles (a translation
+//     particles' projection whole is checked on the whole model; a bisected blend's energy is
+//     the energy after the velocity passes plus what the blend changes: the kinetic energy of
+//     the pairs' particles, the springs of those particles and between bodies (a translation
 //     changes no spring within a body) and gravity's (linear in the blend).
 // Pinned particles count as infinitely heavy (and a body with pins is not translated). Linear
 // momentum is conserved exactly; angular momentum is conserved exactly by the normal response
