@@ -133,6 +133,20 @@ void BodyContact::prepare(const Model& model) {
   for (int i = 0; i < n; ++i)
     std::sort(neighbours_.begin() + neighbour_start_[i],
               neighbours_.begin() + neighbour_start_[i + 1]);
+  // The springs of each particle (CSR, in spring order), and the springs whose ends are in
+  // different bodies (a translation of one body changes their length).
+  spring_start_ = neighbour_start_;
+  springs_of_.resize(neighbours_.size());
+  std::copy(neighbour_start_.begin(), neighbour_start_.end() - 1, fill.begin());
+  cross_springs_.clear();
+  for (int k = 0; k < s.size(); ++k) {
+    springs_of_[fill[s.a[k]]++] = k;
+    springs_of_[fill[s.b[k]]++] = k;
+    if (body_[s.a[k]] != body_[s.b[k]]) cross_springs_.push_back(k);
+  }
+  particle_mark_.assign(n, 0);
+  spring_mark_.assign(s.size(), 0);
+  blend_v_.setZero(3 * n);
 }
 
 bool BodyContact::joined(int i, int j) const {
@@ -445,55 +459,151 @@ void BodyContact::projection_passes(const Model& model, const VecX& x) {
   }
 }
 
-void BodyContact::blend(const Model& model, Real share, const VecX& x, const VecX& v, State& out) {
+void BodyContact::prepare_blend(const Model& model) {
   const int np = model.num_particles();
-  out.x = x + share * moved_ + (1 - share) * shifted_;
-  out.v = v;
-  // The projection moved particles without changing their velocities, which changes the
-  // angular momentum by dL = sum m_i dx_i x v_i. It is taken back by tangential impulses Q_p on
-  // the pairs (Q_p on j, -Q_p on i, torque d_p x Q_p with d_p = x_j - x_i after the
-  // projection), the smallest that do it: Q_p = mu x d_p with K mu = -dL,
-  // K = sum_p (|d_p|^2 I - d_p d_p^T) (solved on K's range: with all d_p parallel, dL has no
-  // part along them).
-  Vec3 dl = Vec3::Zero();
-  for (int i = 0; i < np; ++i) {
-    const Vec3 dx = particle(out.x, i) - particle(x, i);
-    if (!dx.isZero()) dl += model.mass[i] * dx.cross(particle(v, i));
-  }
-  if (dl.isZero()) return;
-  Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
+  // Only the pairs' particles move apart from their body's translation (moved_, and shifted_
+  // of self-contact pairs) and take the lever's impulses: their springs, and the springs
+  // between bodies, are the only ones a blend stretches.
+  blend_particles_.clear();
+  blend_springs_.clear();
+  const auto add_spring = [&](int k) {
+    if (spring_mark_[k]) return;
+    spring_mark_[k] = 1;
+    blend_springs_.push_back(k);
+  };
   for (const BroadPhase::Pair& p : contacts_) {
-    if (inverse_mass_[p.first] + inverse_mass_[p.second] <= 0) continue;
-    const Vec3 d = particle(out.x, p.second) - particle(out.x, p.first);
+    for (const int i : {p.first, p.second}) {
+      if (particle_mark_[i]) continue;
+      particle_mark_[i] = 1;
+      blend_particles_.push_back(i);
+      for (int e = spring_start_[i]; e < spring_start_[i + 1]; ++e) add_spring(springs_of_[e]);
+    }
+  }
+  for (const int k : cross_springs_) add_spring(k);
+  for (const int i : blend_particles_) particle_mark_[i] = 0;
+  for (const int k : blend_springs_) spring_mark_[k] = 0;
+  // The projection moved particles without changing their velocities, which changes the
+  // angular momentum by dL = sum m_i dx_i x v_i, dx = share moved + (1 - share) shifted: linear
+  // in the share. Gravity's energy -sum m_i g . dx_i too. moved_ is zero but at the pairs'
+  // particles; shifted_ holds the bodies' translations.
+  lever_moved_.setZero();
+  lever_shifted_.setZero();
+  gravity_moved_ = 0;
+  gravity_shifted_ = 0;
+  for (const int i : blend_particles_) {
+    const Vec3 m = particle(moved_, i);
+    lever_moved_ += model.mass[i] * m.cross(Vec3(particle(start_.v, i)));
+    gravity_moved_ -= model.mass[i] * model.gravity.dot(m);
+  }
+  for (int i = 0; i < np; ++i) {
+    const Vec3 s = particle(shifted_, i);
+    if (s.isZero()) continue;
+    lever_shifted_ += model.mass[i] * s.cross(Vec3(particle(start_.v, i)));
+    gravity_shifted_ -= model.mass[i] * model.gravity.dot(s);
+  }
+  // The pairs' and springs' vectors x_b - x_a as lines in the share; the energy the blend
+  // changes measured from start_'s kinetic energy of the pairs' particles and elastic energy
+  // of their springs.
+  const auto line = [&](int a, int b) {
+    return BlendLine{Vec3(particle(start_.x, b) - particle(start_.x, a)),
+                     Vec3(particle(moved_, b) - particle(moved_, a)),
+                     Vec3(particle(shifted_, b) - particle(shifted_, a))};
+  };
+  pair_lines_.resize(contacts_.size());
+  pair_d_.resize(contacts_.size());
+  for (size_t p = 0; p < contacts_.size(); ++p)
+    pair_lines_[p] = line(contacts_[p].first, contacts_[p].second);
+  blend_start_energy_ = 0;
+  for (const int i : blend_particles_)
+    blend_start_energy_ += 0.5 * model.mass[i] * particle(start_.v, i).squaredNorm();
+  const Springs& s = model.springs;
+  spring_lines_.resize(blend_springs_.size());
+  for (size_t e = 0; e < blend_springs_.size(); ++e) {
+    const int k = blend_springs_[e];
+    spring_lines_[e] = line(s.a[k], s.b[k]);
+    const Real stretch = spring_lines_[e].at_start.norm() - s.rest_length[k];
+    blend_start_energy_ += 0.5 * s.ks[k] * stretch * stretch;
+  }
+}
+
+Vec3 BodyContact::lever_multiplier(const Vec3& dl) const {
+  // dL is taken back by tangential impulses Q_p on the pairs (Q_p on j, -Q_p on i, torque
+  // d_p x Q_p with d_p = x_j - x_i after the projection), the smallest that do it:
+  // Q_p = mu x d_p with K mu = -dL, K = sum_p (|d_p|^2 I - d_p d_p^T) (solved on K's range: with
+  // all d_p parallel, dL has no part along them).
+  if (dl.isZero()) return Vec3::Zero();
+  Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
+  for (size_t p = 0; p < contacts_.size(); ++p) {
+    if (inverse_mass_[contacts_[p].first] + inverse_mass_[contacts_[p].second] <= 0) continue;
+    const Vec3& d = pair_d_[p];
     k += d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(k);
   const Real largest = eigen.eigenvalues().maxCoeff();
-  if (!(largest > 0)) return;
+  if (!(largest > 0)) return Vec3::Zero();
   Vec3 inverse = Vec3::Zero();
   for (int e = 0; e < 3; ++e) {
     const Real value = eigen.eigenvalues()[e];
     if (value > 1e-12 * largest) inverse[e] = 1 / value;
   }
-  const Vec3 mu =
-      eigen.eigenvectors() * inverse.asDiagonal() * (eigen.eigenvectors().transpose() * -dl);
-  for (const BroadPhase::Pair& p : contacts_) {
-    const int i = p.first, j = p.second;
-    const Real wi = inverse_mass_[i], wj = inverse_mass_[j];
+  return eigen.eigenvectors() * inverse.asDiagonal() * (eigen.eigenvectors().transpose() * -dl);
+}
+
+namespace {
+// The lever's impulses mu x d_p on the pairs, applied to velocities v (a pinned particle takes
+// no velocity: its partner takes the pair's whole torque, its lever measured from the pin).
+void apply_lever_impulses(const Model& model, const std::vector<BroadPhase::Pair>& pairs,
+                          const VecX& inverse_mass, const Vec3& mu, const std::vector<Vec3>& d,
+                          VecX& v) {
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const int i = pairs[p].first, j = pairs[p].second;
+    const Real wi = inverse_mass[i], wj = inverse_mass[j];
     if (wi + wj <= 0) continue;
-    const Vec3 d = particle(out.x, j) - particle(out.x, i);
-    // (A pinned particle takes no velocity: its partner takes the pair's whole torque, its
-    // lever measured from the pin.)
-    const Vec3 q = mu.cross(d);
+    const Vec3 q = mu.cross(d[p]);
     if (wi > 0 && wj > 0) {
-      particle(out.v, i) -= q / model.mass[i];
-      particle(out.v, j) += q / model.mass[j];
+      particle(v, i) -= q / model.mass[i];
+      particle(v, j) += q / model.mass[j];
     } else if (wj > 0) {
-      particle(out.v, j) += q / model.mass[j];
+      particle(v, j) += q / model.mass[j];
     } else {
-      particle(out.v, i) -= q / model.mass[i];
+      particle(v, i) -= q / model.mass[i];
     }
   }
+}
+}  // namespace
+
+void BodyContact::blend(const Model& model, Real share, State& out) {
+  out.x = start_.x + share * moved_ + (1 - share) * shifted_;
+  out.v = start_.v;
+  Vec3 dl = Vec3::Zero();
+  for (int i = 0; i < model.num_particles(); ++i) {
+    const Vec3 dx = particle(out.x, i) - particle(start_.x, i);
+    if (!dx.isZero()) dl += model.mass[i] * dx.cross(particle(start_.v, i));
+  }
+  pair_d_.resize(contacts_.size());
+  for (size_t p = 0; p < contacts_.size(); ++p)
+    pair_d_[p] = particle(out.x, contacts_[p].second) - particle(out.x, contacts_[p].first);
+  const Vec3 mu = lever_multiplier(dl);
+  if (!mu.isZero()) apply_lever_impulses(model, contacts_, inverse_mass_, mu, pair_d_, out.v);
+}
+
+Real BodyContact::blend_energy_change(const Model& model, Real share) {
+  // Kinetic: the velocities blend() gives the pairs' particles.
+  for (const int i : blend_particles_) particle(blend_v_, i) = particle(start_.v, i);
+  for (size_t p = 0; p < contacts_.size(); ++p) pair_d_[p] = pair_lines_[p].at(share);
+  const Vec3 mu = lever_multiplier(share * lever_moved_ + (1 - share) * lever_shifted_);
+  if (!mu.isZero()) apply_lever_impulses(model, contacts_, inverse_mass_, mu, pair_d_, blend_v_);
+  Real energy = share * gravity_moved_ + (1 - share) * gravity_shifted_;
+  for (const int i : blend_particles_)
+    energy += 0.5 * model.mass[i] * particle(blend_v_, i).squaredNorm();
+  // Elastic: ks (|xa - xb| - l0)^2 / 2 of the springs the blend stretches.
+  const Springs& s = model.springs;
+  for (size_t e = 0; e < blend_springs_.size(); ++e) {
+    const int k = blend_springs_[e];
+    const Real stretch = spring_lines_[e].at(share).norm() - s.rest_length[k];
+    energy += 0.5 * s.ks[k] * stretch * stretch;
+  }
+  return energy - blend_start_energy_;
 }
 
 void BodyContact::resolve(const Model& model, const State& before, State& state, Real h) {
@@ -535,12 +645,17 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
       // the overlap is still removed, with the least elastic work.
       const Real budget = total_energy(model, before);
       const Real scale = std::max(std::abs(budget), kinetic_energy(model, before.v));
-      const auto fits = [&](Real share) {
-        blend(model, share, start_.x, start_.v, state);
-        return total_energy(model, state) <= budget + 1e-12 * scale;
-      };
-      if (!fits(1)) {
+      // Most steps take the particles' projection whole: its energy summed over the model.
+      blend(model, 1, state);
+      if (!(total_energy(model, state) <= budget + 1e-12 * scale)) {
         ++stats_.limited;
+        // The bisection's blends: start_'s energy, summed once over the model, plus what each
+        // blend changes, summed over the pairs' particles and springs.
+        const Real start_energy = total_energy(model, start_);
+        prepare_blend(model);
+        const auto fits = [&](Real share) {
+          return start_energy + blend_energy_change(model, share) <= budget + 1e-12 * scale;
+        };
         Real lo = 0, hi = 1;
         if (fits(0)) {
           for (int k = 0; k < 12; ++k) {
@@ -548,7 +663,7 @@ void BodyContact::resolve(const Model& model, const State& before, State& state,
             (fits(mid) ? lo : hi) = mid;
           }
         }
-        blend(model, lo, start_.x, start_.v, state);
+        blend(model, lo, state);
       }
     }
   }

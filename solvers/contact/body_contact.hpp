@@ -17,7 +17,11 @@
 //     (docs/contact.md). So the projection is also computed as translations of whole bodies
 //     (no spring changes length), and the state takes the particles' projection as far as the
 //     total energy stays at or below the energy at the start of the step (bisection on a blend
-//     of the two): an integrator that loses energy keeps losing it through the contact.
+//     of the two): an integrator that loses energy keeps losing it through the contact. The
+//     particles' projection whole is checked on the whole model; a bisected blend's energy is
+//     the energy after the velocity passes plus what the blend changes: the kinetic energy of
+//     the pairs' particles, the springs of those particles and between bodies (a translation
+//     changes no spring within a body) and gravity's (linear in the blend).
 // Pinned particles count as infinitely heavy (and a body with pins is not translated). Linear
 // momentum is conserved exactly; angular momentum is conserved exactly by the normal response
 // and the projection (the projection's lever is taken back by the smallest tangential pair
@@ -121,8 +125,19 @@ class BodyContact {
   bool velocity_passes(const State& before, State& state, Real h);
   void projection_passes(const Model& model, const VecX& x);
   // The state for the blend `share` (1: the particles' projection, 0: the translations) from
-  // x, v: positions x + blend, velocities v with the projection's lever taken back.
-  void blend(const Model& model, Real share, const VecX& x, const VecX& v, State& out);
+  // start_: positions x + blend, velocities v with the projection's lever taken back.
+  void blend(const Model& model, Real share, State& out);
+  // What blend_energy_change() needs, once per resolve: the angular momentum and gravitational
+  // energy of the two projections (linear in the share), the pairs' particles and the springs
+  // they touch (with the springs between bodies), each spring's and pair's vector as a line in
+  // the share, and their part of start_'s energy.
+  void prepare_blend(const Model& model);
+  // The multiplier mu of the tangential impulses mu x d_p that take back the projection's
+  // angular momentum dl, d_p = pair_d_[p] the pairs' vectors (zero when there is none).
+  Vec3 lever_multiplier(const Vec3& dl) const;
+  // The total energy of blend(share) less the energy of start_, summed over the pairs' particles
+  // and springs only.
+  Real blend_energy_change(const Model& model, Real share);
 
   BodyContactParams params_;
   BroadPhase broad_;
@@ -131,6 +146,8 @@ class BodyContact {
   VecX radius_, inverse_mass_, padded_;
   std::vector<int> body_;
   std::vector<int> neighbour_start_, neighbours_;  // CSR, sorted
+  std::vector<int> spring_start_, springs_of_;     // CSR: the springs of each particle
+  std::vector<int> cross_springs_;                 // springs joining two bodies (or none)
   std::vector<BroadPhase::Pair> candidates_, contacts_;
   // collide()'s set: its pairs, the position it was found at, each particle's reach.
   std::vector<BroadPhase::Pair> collisions_;
@@ -146,6 +163,19 @@ class BodyContact {
   std::vector<Real> body_inverse_mass_;  // [bodies] 0 with a pin
   std::vector<int> body_share_;          // [bodies]
   State start_;                          // after the velocity passes
+  // prepare_blend()'s results and blend_energy_change()'s work arrays.
+  struct BlendLine {  // a vector at the share s: at_start + s by_particles + (1 - s) by_bodies
+    Vec3 at_start, by_particles, by_bodies;
+    Vec3 at(Real s) const { return at_start + s * by_particles + (1 - s) * by_bodies; }
+  };
+  std::vector<int> blend_particles_, blend_springs_;  // the pairs' particles, their springs
+  std::vector<char> particle_mark_, spring_mark_;     // [N], [springs] all 0 between resolves
+  std::vector<BlendLine> pair_lines_, spring_lines_;  // [pairs] x_j - x_i, [blend_springs_]
+  std::vector<Vec3> pair_d_;                          // [pairs] x_j - x_i at one share
+  VecX blend_v_;                                      // [3N] velocities of blend_particles_
+  Vec3 lever_moved_, lever_shifted_;                  // sum m dx x v of moved_, shifted_
+  Real gravity_moved_ = 0, gravity_shifted_ = 0;      // -sum m g . dx of moved_, shifted_
+  Real blend_start_energy_ = 0;  // start_'s kinetic and elastic energy of the pairs' part
 };
 
 }  // namespace jelly

@@ -106,25 +106,32 @@ void Xpbd::prepare(const Model& model, Real hs) {
   }
 }
 
-bool Xpbd::direction(const VecX& x, const Constraint& c, Real n[3], Real& length) const {
-  const Real* xa = x.data() + 3 * c.a;
-  const Real* xb = x.data() + 3 * c.b;
+namespace {
+// The unit direction n = (xa - xb) / |xa - xb| and the length of the spring a-b at positions px
+// (the direction at rest for a collapsed spring); false when it has none. File-local so that the
+// sweeps' calls (one per spring) are inlined: a member of the exported class was called through
+// the PLT from within the library.
+inline bool xpbd_spring_direction(const Real* px, const Real* rest_position, int a, int b,
+                                  Real rest, Real n[3], Real& length) {
+  const Real* xa = px + 3 * a;
+  const Real* xb = px + 3 * b;
   const Real d[3] = {xa[0] - xb[0], xa[1] - xb[1], xa[2] - xb[2]};
   length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  if (length >= kDegenerateLength * c.rest && length > 0) {
+  if (length >= kDegenerateLength * rest && length > 0) {
     const Real inv = 1.0 / length;
     for (int q = 0; q < 3; ++q) n[q] = d[q] * inv;
     return true;
   }
   // Collapsed: the direction at rest.
-  const Real* ra = rest_position_.data() + 3 * c.a;
-  const Real* rb = rest_position_.data() + 3 * c.b;
+  const Real* ra = rest_position + 3 * a;
+  const Real* rb = rest_position + 3 * b;
   for (int q = 0; q < 3; ++q) n[q] = ra[q] - rb[q];
   const Real r = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   if (!(r > 0)) return false;
   for (int q = 0; q < 3; ++q) n[q] /= r;
   return true;
 }
+}  // namespace
 
 void Xpbd::sweep(VecX& x, int threads) {
   Real* px = x.data();
@@ -133,6 +140,7 @@ void Xpbd::sweep(VecX& x, int threads) {
   Real* lambda = lambda_.data();
   Real* impulse = impulse_.data();
   const Constraint* constraints = constraints_.data();
+  const Real* rest = rest_position_.data();
   // Every spring's impulse from the same positions (each writes only its own entries) ...
   parallel::for_ranges(threads, static_cast<long>(constraints_.size()), [&](long begin, long end) {
     for (long k = begin; k < end; ++k) {
@@ -142,7 +150,7 @@ void Xpbd::sweep(VecX& x, int threads) {
       Real* out = impulse + 3 * k;
       Real n[3];
       Real length = 0;
-      if (!direction(x, c, n, length)) {
+      if (!xpbd_spring_direction(px, rest, c.a, c.b, c.rest, n, length)) {
         out[0] = out[1] = out[2] = 0;
         continue;
       }
@@ -193,7 +201,7 @@ void Xpbd::sweep_in_order(VecX& x) {
     Real* xb = px + 3 * c.b;
     Real n[3];
     Real length = 0;
-    if (!direction(x, c, n, length)) continue;
+    if (!xpbd_spring_direction(px, rest_position_.data(), c.a, c.b, c.rest, n, length)) continue;
     const Real* a0 = p0 + 3 * c.a;
     const Real* b0 = p0 + 3 * c.b;
     Real moved = 0;

@@ -66,9 +66,6 @@ class Xpbd final : public Integrator {
   void sweep(VecX& x, int threads);
   // One Gauss-Seidel sweep over the springs in the model's order (XpbdSweep::kGaussSeidel).
   void sweep_in_order(VecX& x);
-  // The unit direction n = (xa - xb) / |xa - xb| and the length of spring c at x (the direction
-  // at rest for a collapsed spring); false when it has none.
-  bool direction(const VecX& x, const Constraint& c, Real n[3], Real& length) const;
   void sweep_anchors(const AnchorSprings& anchors, Real hs, VecX& x);
   // Pinned particles (inverse mass 0 in the sweeps) at their paths' positions at time t.
   void place_pins(const Pins& pins, Real t, VecX& x) const;
