@@ -113,10 +113,9 @@ TEST(FitAdjoint, AutoFallsBackToNumericAndSaysWhy) {
       << fallback.report();
 }
 
-// Two cubes colliding in the air (frictionless contact between the bodies inside the solve, no
-// restitution): the adjoint path fits through the contact. The windows restart without the
-// recording's carried pairs, so the minimum is close to the truth, not on it.
-TEST(FitAdjoint, RecoversKsAndKdThroughContactBetweenBodies) {
+// Two cubes colliding in the air (contact between the bodies inside the solve, no restitution)
+// with friction `mu`.
+Trajectory colliding_cubes(Real mu) {
   Model model;
   for (int b = 0; b < 2; ++b) {
     BodySpec spec;
@@ -128,27 +127,66 @@ TEST(FitAdjoint, RecoversKsAndKdThroughContactBetweenBodies) {
     spec.shape = shape;
     spec.material.particle_mass = 0.1;
     spec.material.springs = kTruth;
-    spec.velocity = Vec3(b == 0 ? 1.5 : 0, 0, 0);
+    spec.velocity = Vec3(b == 0 ? 1.5 : 0, b == 0 ? 0.3 : 0, 0);
     add_body(model, spec, "bodies[" + std::to_string(b) + "].");
   }
   BodyContactParams contact;
-  contact.friction = 0;
-  contact.static_friction = 0;
+  contact.friction = mu;
+  contact.static_friction = mu;
   contact.restitution = 0;
   Trajectory recording =
       simulate_trajectory(model, initial_state(model), {}, "implicit_euler", kAdjointFitDt,
                           testing::kFrameInterval, testing::kDuration, true, {}, contact);
   for (int type = 0; type < kSpringTypeCount; ++type)
     recording.model.springs.set_coefficients(static_cast<SpringType>(type), {1400, 30});
-  FitOptions options;
-  options.gradients = FitGradients::kAdjoint;
-  options.compute_covariance = false;
-  const FitResult result = fit_recording(recording, options);
-  std::cout << result.report();
-  EXPECT_EQ(result.gradient_path, "adjoint");
-  EXPECT_TRUE(result.converged) << result.report();
-  EXPECT_NEAR(result.at("ks").value, 1000, 0.01 * 1000) << result.report();
-  EXPECT_NEAR(result.at("kd").value, 20, 0.01 * 20) << result.report();
+  return recording;
+}
+
+// The windows' replays at the truth: with the recording's carried contact state at each window's
+// start (stored) they are the recording; rebuilt from the interval before each window they come
+// closer to it than replays that start afresh (every integrator state empty, as windows did).
+TEST(FitAdjoint, WindowsStartWithTheRecordingsCarriedContactState) {
+  Trajectory recording = colliding_cubes(0.5);
+  for (int type = 0; type < kSpringTypeCount; ++type)
+    recording.model.springs.set_coefficients(static_cast<SpringType>(type), kTruth[type]);
+  const Real window = FitOptions().window;
+  const Real stored = replay_cost(recording, window);
+  Trajectory rebuilt_recording = recording;
+  rebuilt_recording.integrator_states.clear();
+  const Real rebuilt = replay_cost(rebuilt_recording, window);
+  Trajectory afresh_recording = recording;
+  for (std::vector<Real>& state : afresh_recording.integrator_states) state.clear();
+  const Real afresh = replay_cost(afresh_recording, window);
+  std::cout << "replay cost at the truth: stored " << stored << ", rebuilt " << rebuilt
+            << ", afresh " << afresh << " m^2\n";
+  EXPECT_EQ(stored, 0);
+  EXPECT_LT(rebuilt, afresh);
+  EXPECT_GT(afresh, 0);
+}
+
+// The adjoint path fits through the contact. Each window starts with the contact pairs the
+// recording's run carried into its first frame (their stick or slide mode and friction
+// viscosity): the replays at the truth are the recording, so the truth is the minimum, with
+// friction too. Without the recorded integrator states (a `jelly run` recording) they are rebuilt
+// by replaying the interval before the window: the minimum is then near the truth.
+TEST(FitAdjoint, RecoversKsAndKdThroughContactBetweenBodies) {
+  for (const Real mu : {0.0, 0.5}) {
+    for (const bool stored : {true, false}) {
+      SCOPED_TRACE("friction " + std::to_string(mu) + (stored ? ", stored" : ", rebuilt"));
+      Trajectory recording = colliding_cubes(mu);
+      if (!stored) recording.integrator_states.clear();
+      FitOptions options;
+      options.gradients = FitGradients::kAdjoint;
+      options.compute_covariance = false;
+      const FitResult result = fit_recording(recording, options);
+      std::cout << result.report();
+      EXPECT_EQ(result.gradient_path, "adjoint");
+      EXPECT_TRUE(result.converged) << result.report();
+      const Real tolerance = stored ? 1e-4 : 0.01;
+      EXPECT_NEAR(result.at("ks").value, 1000, tolerance * 1000) << result.report();
+      EXPECT_NEAR(result.at("kd").value, 20, tolerance * 20) << result.report();
+    }
+  }
 }
 
 // The windows' adjoint passes shared between threads: the same fit, bit for bit, on 1, 2 and 3
