@@ -68,9 +68,8 @@ void set_parameter(Model& model, const FitParameter& p, Real value) {
 // Replays one window with the model's coefficients and writes x_replay - x_recorded for each
 // compared frame into `residuals`. Returns false if the integrator fails or the state blows up.
 bool replay_window(const Trajectory& trajectory, const Model& model, const Window& w,
-                   const State& start, double* residuals,
-                   const std::vector<Real>* carried = nullptr) {
-  Simulator sim = window_simulator(trajectory, model, w.first, start, 0, carried);
+                   const State& start, double* residuals) {
+  Simulator sim = window_simulator(trajectory, model, w.first, start);
   const Eigen::Index n = model.num_dofs();
   for (int k = w.first + 1; k <= w.last; ++k) {
     const long steps = std::lround((trajectory.times[k] - trajectory.times[k - 1]) / trajectory.dt);
@@ -159,10 +158,6 @@ RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, co
     if (fitted) start.v = fitted_velocities[w];
     return start;
   };
-  // The windows' carried integrator states (the model is fixed here: computed once each).
-  std::vector<std::vector<Real>> carried(windows.size());
-  for (size_t w = 0; w < windows.size(); ++w)
-    carried[w] = window_start_state(trajectory, model, windows[w].first);
   for (int k = 0; k < trajectory.frames(); ++k) {
     // Windows whose restart state depends on frame k.
     std::vector<size_t> restarts;
@@ -188,10 +183,10 @@ RestartAwareCovariance restart_aware_covariance(const Trajectory& trajectory, co
         minus.resize(rows);
         perturbed.positions[k][c] = trajectory.positions[k][c] + delta;
         const bool ok_plus =
-            replay_window(trajectory, model, windows[w], start_state(w), plus.data(), &carried[w]);
+            replay_window(trajectory, model, windows[w], start_state(w), plus.data());
         perturbed.positions[k][c] = trajectory.positions[k][c] - delta;
         const bool ok_minus =
-            replay_window(trajectory, model, windows[w], start_state(w), minus.data(), &carried[w]);
+            replay_window(trajectory, model, windows[w], start_state(w), minus.data());
         perturbed.positions[k][c] = trajectory.positions[k][c];
         out.replays += 2;
         if (!ok_plus || !ok_minus) continue;

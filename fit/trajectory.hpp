@@ -27,7 +27,7 @@ struct Trajectory {
   // Empty, or [T]: the integrator's internal_state() at each frame as the recorded run carried
   // it (implicit_euler's contact pairs between bodies with their friction state, its terrains'
   // contact set; simulate_trajectory keeps them). An implicit_euler window replayed from frame k
-  // starts with it; without it the state is rebuilt by replaying the interval before frame k.
+  // starts with it; without it (a `jelly run` recording) windows start afresh.
   std::vector<std::vector<Real>> integrator_states;
   TerrainFactory terrains;  // empty = no terrain
   // Contact between bodies (and within one) as the recording ran it; every replay uses it.

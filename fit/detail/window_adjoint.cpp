@@ -14,8 +14,9 @@ GradientResult fit_window_gradient(const Trajectory& trajectory, const Model& mo
   require(trajectory.integrator == "implicit_euler", "recording integrator", trajectory.integrator,
           "implicit_euler for exact gradients");
   // One thread: the fit's windows are its unit of parallel work, and results must not depend on
-  // the thread count. The recording's carried contact state at frame `first` is rebuilt
-  // (held by the adjoint: the first step's friction viscosities are constants of the window).
+  // the thread count. The recording's carried contact state at frame `first`, when it holds
+  // one (the adjoint holds it: the first step's friction viscosities are constants of the
+  // window).
   Simulator sim = window_simulator(trajectory, model, first, start, 1);
   // The step after which each compared frame is reached; frame_at[step] = recording frame or -1.
   GradientProblem problem;

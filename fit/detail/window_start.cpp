@@ -1,6 +1,5 @@
 #include <jelly/fit/detail/window_start.hpp>
 
-#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -24,29 +23,18 @@ Simulator fresh_window_simulator(const Trajectory& trajectory, const Model& mode
 
 }  // namespace
 
-std::vector<Real> window_start_state(const Trajectory& trajectory, const Model& model, int first,
-                                     int threads) {
-  if (first <= 0 || trajectory.integrator != "implicit_euler") return {};
-  if (!trajectory.integrator_states.empty())  // as the recording's run carried it
-    return trajectory.integrator_states[first];
-  Simulator before =
-      fresh_window_simulator(trajectory, model, trajectory.state(first - 1), threads);
-  const long steps =
-      std::lround((trajectory.times[first] - trajectory.times[first - 1]) / trajectory.dt);
-  for (long i = 0; i < steps; ++i)
-    if (!before.step().ok) return {};
-  if (!before.state().x.allFinite()) return {};
-  return before.integrator().internal_state();
+std::vector<Real> window_start_state(const Trajectory& trajectory, int first) {
+  if (first <= 0 || trajectory.integrator != "implicit_euler" ||
+      trajectory.integrator_states.empty())
+    return {};
+  return trajectory.integrator_states[first];  // as the recording's run carried it
 }
 
 Simulator window_simulator(const Trajectory& trajectory, const Model& model, int first,
-                           const State& start, int threads, const std::vector<Real>* carried) {
+                           const State& start, int threads) {
   Simulator sim = fresh_window_simulator(trajectory, model, start, threads);
-  if (carried != nullptr) {
-    sim.integrator().restore_internal_state(*carried);
-  } else if (first > 0 && trajectory.integrator == "implicit_euler") {
-    sim.integrator().restore_internal_state(window_start_state(trajectory, model, first, threads));
-  }
+  const std::vector<Real> carried = window_start_state(trajectory, first);
+  if (!carried.empty()) sim.integrator().restore_internal_state(carried);
   return sim;
 }
 
