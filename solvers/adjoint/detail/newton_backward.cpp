@@ -1,7 +1,9 @@
 #include <jelly/solvers/adjoint/detail/newton_backward.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <Eigen/Dense>
 
@@ -59,8 +61,8 @@ void MatrixFreeNewtonBackward::add_damper_transposed(const VecX& p, VecX& y) con
     const Real* q = u + 3;
     const size_t a = 3 * static_cast<size_t>(ends[2 * sp]);
     const size_t b = 3 * static_cast<size_t>(ends[2 * sp + 1]);
-    const Real t = u[0] * (pp[a] - pp[b]) + u[1] * (pp[a + 1] - pp[b + 1]) +
-                   u[2] * (pp[a + 2] - pp[b + 2]);
+    const Real t =
+        u[0] * (pp[a] - pp[b]) + u[1] * (pp[a + 1] - pp[b + 1]) + u[2] * (pp[a + 2] - pp[b + 2]);
     for (int c = 0; c < 3; ++c) {
       yp[a + c] += q[c] * t;
       yp[b + c] -= q[c] * t;
