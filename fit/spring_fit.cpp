@@ -21,6 +21,7 @@
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/fit/detail/window_adjoint.hpp>
+#include <jelly/fit/detail/window_start.hpp>
 #include <jelly/fit/implicit_euler_ceres.hpp>
 #include <jelly/solvers/simulator.hpp>
 
@@ -68,12 +69,7 @@ void set_parameter(Model& model, const FitParameter& p, Real value) {
 // compared frame into `residuals`. Returns false if the integrator fails or the state blows up.
 bool replay_window(const Trajectory& trajectory, const Model& model, const Window& w,
                    const State& start, double* residuals) {
-  SimulatorOptions options;
-  options.dt = trajectory.dt;
-  Simulator sim(model, start,
-                make_fit_integrator(trajectory.integrator, trajectory.integrator_options), options);
-  sim.set_body_contact(trajectory.body_contact);
-  for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
+  Simulator sim = window_simulator(trajectory, model, w.first, start);
   const Eigen::Index n = model.num_dofs();
   for (int k = w.first + 1; k <= w.last; ++k) {
     const long steps = std::lround((trajectory.times[k] - trajectory.times[k - 1]) / trajectory.dt);

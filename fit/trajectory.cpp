@@ -29,6 +29,9 @@ void Trajectory::validate() const {
   require(velocities.empty() || static_cast<int>(velocities.size()) == t_count,
           "recording.velocities.size", velocities.size(),
           "0 (none recorded) or one frame per time (" + std::to_string(t_count) + ")");
+  require(integrator_states.empty() || static_cast<int>(integrator_states.size()) == t_count,
+          "recording.integrator_states.size", integrator_states.size(),
+          "0 (none recorded) or one per frame (" + std::to_string(t_count) + ")");
   const Eigen::Index n = model.num_dofs();
   for (int k = 0; k < t_count; ++k) {
     require(std::isfinite(times[k]), at("times", k), times[k], "a finite time");
@@ -120,6 +123,7 @@ Trajectory simulate_trajectory(const Model& model, const State& initial, Terrain
     trajectory.times.push_back(sim.state().t);
     trajectory.positions.push_back(sim.state().x);
     if (record_velocities) trajectory.velocities.push_back(sim.state().v);
+    trajectory.integrator_states.push_back(sim.integrator().internal_state());
   };
   record();
   const long frames = std::lround(duration / frame_interval);

@@ -24,7 +24,12 @@ struct Trajectory {
   std::vector<Real> times;       // [T] s, strictly increasing
   std::vector<VecX> positions;   // [T] frames of 3N positions (m)
   std::vector<VecX> velocities;  // empty, or [T] frames of 3N velocities (m/s)
-  TerrainFactory terrains;       // empty = no terrain
+  // Empty, or [T]: the integrator's internal_state() at each frame as the recorded run carried
+  // it (implicit_euler's contact pairs between bodies with their friction state, its terrains'
+  // contact set; simulate_trajectory keeps them). An implicit_euler window replayed from frame k
+  // starts with it; without it (a `jelly run` recording) windows start afresh.
+  std::vector<std::vector<Real>> integrator_states;
+  TerrainFactory terrains;  // empty = no terrain
   // Contact between bodies (and within one) as the recording ran it; every replay uses it.
   BodyContactParams body_contact;
   std::string integrator = "rk4";  // the integrator the recording was made with

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/fit/detail/window_start.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {
@@ -13,15 +13,11 @@ GradientResult fit_window_gradient(const Trajectory& trajectory, const Model& mo
                                    int last, const State& start, const WindowFrameLoss& loss) {
   require(trajectory.integrator == "implicit_euler", "recording integrator", trajectory.integrator,
           "implicit_euler for exact gradients");
-  SimulatorOptions options;
-  options.dt = trajectory.dt;
   // One thread: the fit's windows are its unit of parallel work, and results must not depend on
-  // the thread count.
-  options.threads = 1;
-  Simulator sim(model, start,
-                make_fit_integrator(trajectory.integrator, trajectory.integrator_options), options);
-  sim.set_body_contact(trajectory.body_contact);
-  for (auto& terrain : trajectory.make_terrains()) sim.add_terrain(std::move(terrain));
+  // the thread count. The recording's carried contact state at frame `first`, when it holds
+  // one (the adjoint holds it: the first step's friction viscosities are constants of the
+  // window).
+  Simulator sim = window_simulator(trajectory, model, first, start, 1);
   // The step after which each compared frame is reached; frame_at[step] = recording frame or -1.
   GradientProblem problem;
   std::vector<int> frame_at;

@@ -96,6 +96,7 @@ void bind_adjoint(py::module_& m) {
         out["pair_projected_steps"] = g.pair_projected_steps;
         out["newton_unconverged_steps"] = g.newton_unconverged_steps;
         out["backward_solver"] = g.backward_solver;
+        out["backward_iterations"] = g.backward_iterations;
         out["forward_seconds"] = g.forward_seconds;
         out["backward_seconds"] = g.backward_seconds;
         return out;

@@ -18,6 +18,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/solvers/adjoint/detail/newton_backward.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
@@ -408,7 +409,14 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   exact_options.definiteness = DefinitenessFix::kNone;
   exact_options.exact_damper = true;
   VecX x1(n), v1(n);
-  if (newton) {
+  // Newton after a matrix-free forward (no pairs between bodies): its band system, exact, and
+  // BiCGSTAB with block Jacobi (solvers/adjoint/detail/newton_backward.hpp).
+  std::optional<MatrixFreeNewtonBackward> newton_free;
+  std::vector<Real> newton_projectors, newton_viscosities;
+  if (newton && ie->linear_solver_name() == "cg_jacobi_matrix_free" && pair_blocks.empty()) {
+    newton_free.emplace(model, options.cg_tolerance >= 1e-6);
+    out.backward_solver = "bicgstab_block_jacobi_matrix_free";
+  } else if (newton) {
     jacobian.emplace(model, pair_blocks);
     a = jacobian->make_matrix();
     filtered = jacobian->make_matrix();
@@ -523,7 +531,12 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         v0b = dvb;
       // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
       // mu.
-      if (newton) {
+      if (newton_free) {
+        v1 = r.v + r.dv;
+        x1 = r.x + h * v1;
+        if (!newton_free->assemble(model, x1, v1, h, threads))
+          throw std::runtime_error("gradient: a spring collapsed at step " + std::to_string(k));
+      } else if (newton) {
         v1 = r.v + r.dv;
         x1 = r.x + h * v1;
         jacobian->assemble(model, x1, v1, exact_options, k_matrix, d_matrix, threads);
@@ -549,7 +562,9 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         add_external_damping(model.external_forces, t1, damping);
         for (int i = 0; i < np; ++i) {
           if (damping[i] == 0) continue;
-          if (free)
+          if (newton_free)
+            newton_free->add_diagonal(i, h * damping[i]);
+          else if (free)
             free->band.add_diagonal(i, h * damping[i]);
           else
             for (int d = 0; d < 3; ++d) jacobian->add_to_diagonal(a, 3 * i + d, h * damping[i]);
@@ -647,7 +662,27 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       // The forward step's matrix, filtered by its constraints; mu = filtered^-1 dvb, lambda = S
       // mu.
       LinearResult solved;
-      if (newton) {
+      if (newton_free) {
+        newton_projectors.resize(9 * cons.size());
+        newton_viscosities.resize(cons.size());
+        for (size_t ci = 0; ci < cons.size(); ++ci) {
+          const Mat3 sc = adjoint_free_projector(cons[ci]);
+          std::copy(sc.data(), sc.data() + 9, newton_projectors.data() + 9 * ci);
+          newton_viscosities[ci] =
+              cons[ci].kind == ConstraintKind::kSlide ? cons[ci].viscosity : 0.0;
+        }
+        const ProductFilter filter =
+            cons.empty()
+                ? ProductFilter{}
+                : ProductFilter{slot.data(), newton_projectors.data(), newton_viscosities.data()};
+        // (mu starts from the later step's adjoint: consecutive steps' are close.)
+        solved = newton_free->solve(dvb, mu, filter, options.cg_tolerance,
+                                    options.cg_max_iterations, threads);
+        if (!solved.ok() || !mu.allFinite())
+          throw std::runtime_error("gradient: the backward solve of step " + std::to_string(k) +
+                                   " failed: " + solved.message);
+        out.backward_iterations += solved.iterations;
+      } else if (newton) {
         std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
         adjoint_filter_general(filtered, cons, slot);
         bool ok = false;
@@ -691,6 +726,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
           solved = free->cg.solve(
               [&](const VecX& in, VecX& y) { free->band.multiply(in, y, threads, filter); }, dvb,
               mu, options.cg_tolerance, options.cg_max_iterations, threads);
+          out.backward_iterations += solved.iterations;
         }
       } else {
         std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered.valuePtr());
@@ -707,7 +743,9 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       // The prescribed velocity changes z (and the sliding friction's C w0): their adjoint is
       // dvb - A lambda at the constrained particles.
       if (!cons.empty()) {
-        if (newton)
+        if (newton_free)
+          newton_free->multiply_transposed(lambda, a_lambda, threads);
+        else if (newton)
           a_lambda.noalias() = a.transpose() * lambda;
         else if (free)
           free->band.multiply(lambda, a_lambda, threads);

@@ -71,8 +71,11 @@ struct GradientResult {
   // adjoint is of the converged step, so it is approximate there).
   long newton_unconverged_steps = 0;
   // "cholmod", "ldlt", "cg_jacobi", "cg_lagged_cholmod", "cg_jacobi_matrix_free" or (Newton)
-  // "sparse_lu" (up to 1000 unknowns), "bicgstab_jacobi"
+  // "sparse_lu" (assembled, up to 1000 unknowns), "bicgstab_jacobi" (assembled, above),
+  // "bicgstab_block_jacobi_matrix_free" (after a matrix-free forward)
   std::string backward_solver;
+  // The iterations of the matrix-free backward solves (CG, BiCGSTAB), summed over the steps.
+  long backward_iterations = 0;
   double forward_seconds = 0, backward_seconds = 0;
 };
 

@@ -113,6 +113,20 @@ State jittered(State s, Real dx, Real dv) {
   return s;
 }
 
+// One derivative: the adjoint's value against the central difference of the loss along a change
+// of the simulator `edit(sim, e)` of step `eps` (or, for the problem's own data, `edit(sim,
+// problem, e)`).
+using ProblemEdit = std::function<void(Simulator&, GradientProblem&, Real)>;
+void check_derivative(const AdjointCase& c, Real adjoint, Real eps, const ProblemEdit& edit,
+                      const std::string& what) {
+  expect_close(adjoint, central_difference(c, eps, edit), kTolerance, what);
+}
+void check_derivative(const AdjointCase& c, Real adjoint, Real eps,
+                      const std::function<void(Simulator&, Real)>& edit, const std::string& what) {
+  check_derivative(
+      c, adjoint, eps, [&](Simulator& s, GradientProblem&, Real e) { edit(s, e); }, what);
+}
+
 // Checks every parameter kind of body `body` (and the state, gravity, the pins' targets). The
 // steps: 1e-6 relative (1e-4 for kd, whose gradients are small enough for round-off to show at
 // 1e-6), 1e-8 m for the positions (a spring near its rest length, where the definiteness clamp
@@ -123,67 +137,56 @@ void check_every_kind(const AdjointCase& c, int body, const std::vector<SpringTy
   const Model& m = probe.model();
   for (SpringType t : types) {
     const int at = kSpringTypeCount * body + static_cast<int>(t);
-    const int first = m.bodies[body].first_spring;
-    int sp = first;
+    int sp = m.bodies[body].first_spring;
     while (m.springs.type[sp] != t) ++sp;
     const SpringCoefficients base{m.springs.ks[sp], m.springs.kd[sp]};
     const std::string name(spring_type_name(t));
-    expect_close(g.ks[at],
-                 central_difference(c, 1e-6 * base.ks,
-                                    [&](Simulator& s, GradientProblem&, Real e) {
-                                      s.set_spring_coefficients(body, t, {base.ks + e, base.kd});
-                                    }),
-                 kTolerance, name + ".ks");
-    expect_close(g.kd[at],
-                 central_difference(c, 1e-4 * base.kd,
-                                    [&](Simulator& s, GradientProblem&, Real e) {
-                                      s.set_spring_coefficients(body, t, {base.ks, base.kd + e});
-                                    }),
-                 kTolerance, name + ".kd");
+    check_derivative(
+        c, g.ks[at], 1e-6 * base.ks,
+        [&](Simulator& s, Real e) {
+          s.set_spring_coefficients(body, t, {base.ks + e, base.kd});
+        },
+        name + ".ks");
+    check_derivative(
+        c, g.kd[at], 1e-4 * base.kd,
+        [&](Simulator& s, Real e) {
+          s.set_spring_coefficients(body, t, {base.ks, base.kd + e});
+        },
+        name + ".kd");
   }
   const Real mass = m.mass[m.bodies[body].first_particle];
-  expect_close(g.particle_mass[body],
-               central_difference(c, 1e-6 * mass,
-                                  [&](Simulator& s, GradientProblem&, Real e) {
-                                    s.set_particle_mass(body, mass + e);
-                                  }),
-               kTolerance, "mass");
+  check_derivative(
+      c, g.particle_mass[body], 1e-6 * mass,
+      [&](Simulator& s, Real e) { s.set_particle_mass(body, mass + e); }, "mass");
   for (int d = 0; d < 3; ++d) {
-    expect_close(g.gravity[d],
-                 central_difference(c, 1e-6,
-                                    [&](Simulator& s, GradientProblem&, Real e) {
-                                      Vec3 gravity = s.model().gravity;
-                                      gravity[d] += e;
-                                      s.set_gravity(gravity);
-                                    }),
-                 kTolerance, "gravity[" + std::to_string(d) + "]");
+    check_derivative(
+        c, g.gravity[d], 1e-6,
+        [&](Simulator& s, Real e) {
+          Vec3 gravity = s.model().gravity;
+          gravity[d] += e;
+          s.set_gravity(gravity);
+        },
+        "gravity[" + std::to_string(d) + "]");
   }
   // The initial state and the pins' targets along random directions.
   const VecX dir_x = random_vector(m.num_dofs(), 11), dir_v = random_vector(m.num_dofs(), 12);
-  expect_close(g.initial_position.dot(dir_x),
-               central_difference(c, 1e-8,
-                                  [&](Simulator& s, GradientProblem&, Real e) {
-                                    s.mutable_state().x += e * dir_x;  // (contacts kept)
-                                  }),
-               kTolerance, "initial positions");
-  expect_close(g.initial_velocity.dot(dir_v),
-               central_difference(c, 1e-7,
-                                  [&](Simulator& s, GradientProblem&, Real e) {
-                                    s.mutable_state().v += e * dir_v;
-                                  }),
-               kTolerance, "initial velocities");
+  check_derivative(
+      c, g.initial_position.dot(dir_x), 1e-8,
+      [&](Simulator& s, Real e) { s.mutable_state().x += e * dir_x; },  // (contacts kept)
+      "initial positions");
+  check_derivative(
+      c, g.initial_velocity.dot(dir_v), 1e-7,
+      [&](Simulator& s, Real e) { s.mutable_state().v += e * dir_v; }, "initial velocities");
   if (!c.targets.empty()) {
     const VecX dir = random_vector(3 * static_cast<int>(c.targets.size()), 13);
     Real adjoint = 0;
     for (size_t k = 0; k < c.targets.size(); ++k)
       adjoint += g.pin_targets[k].dot(dir.segment<3>(3 * k));
-    expect_close(adjoint,
-                 central_difference(c, 1e-7,
-                                    [&](Simulator&, GradientProblem& p, Real e) {
-                                      for (size_t k = 0; k < p.pin_targets.size(); ++k)
-                                        p.pin_targets[k] += e * dir.segment<3>(3 * k);
-                                    }),
-                 kTolerance, "pin targets");
+    check_derivative(c, adjoint, 1e-7, ProblemEdit([&](Simulator&, GradientProblem& p, Real e) {
+                       for (size_t k = 0; k < p.pin_targets.size(); ++k)
+                         p.pin_targets[k] += e * dir.segment<3>(3 * k);
+                     }),
+                     "pin targets");
   }
 }
 
@@ -261,7 +264,7 @@ TEST(ImplicitEulerAdjoint, CubeOnACoulombSlopeAgreesWithFiniteDifferences) {
 // The cube sliding down a slope of little friction (mu = 0.2 < tan 20 degrees), from a state
 // 15 steps into the slide: every step's friction viscosity is set by the previous step's solve
 // (traced through it), the first one's before the run (a constant).
-AdjointCase sliding_cube() {
+AdjointCase sliding_cube(Real mu = 0.2) {
   AdjointCase c;
   c.steps = 10;
   Model model = build_cube(testing::small_cube(3, 0.6));
@@ -269,11 +272,11 @@ AdjointCase sliding_cube() {
   for (int t = 0; t < kSpringTypeCount; ++t)
     model.springs.set_coefficients(static_cast<SpringType>(t), {400.0 + 100 * t, 4.0 + t});
   const State s0 = jittered(testing::cube_on_slope(model, 20), 1e-4, 0.005);
-  c.make = [model, s0] {
+  c.make = [model, s0, mu] {
     Simulator sim = testing::make_sim(model, s0, "implicit_euler", 1.0 / 100);
     ContactParams contact;
-    contact.friction = 0.2;
-    contact.static_friction = 0.2;
+    contact.friction = mu;
+    contact.static_friction = mu;
     contact.restitution = 0;
     sim.add_terrain(std::make_unique<Plane>(Plane::slope(20, Vec3::Zero(), contact)));
     for (int k = 0; k < 15; ++k) sim.step();
@@ -455,27 +458,64 @@ TEST(ImplicitEulerAdjoint, NewtonWithCubesInContactAgreesWithFiniteDifferences) 
   }
 }
 
-// Newton above 1000 unknowns: the backward solve is BiCGSTAB (to a tight cg_tolerance here).
+// Newton above 1000 unknowns: after the matrix-free CG forward (the default there) the backward
+// solve is the matrix-free BiCGSTAB with block Jacobi; after an assembled forward (CHOLMOD) it
+// is BiCGSTAB on the assembled exact Jacobian (both to a tight cg_tolerance here).
 TEST(ImplicitEulerAdjoint, NewtonWithBiCgStabAgreesWithFiniteDifferences) {
-  AdjointCase c;
-  c.steps = 4;
-  Model model = build_cube(testing::small_cube(7, 0.6));
-  model.mass.setConstant(0.02);
-  model.springs.set_coefficients(SpringType::kStructural, {400, 4});
-  const State s0 = jittered(rest_state(model), 1e-2, 0.3);
-  c.make = [model, s0] {
-    ImplicitEulerOptions o;
-    o.newton_iterations = 60;
-    o.newton_tolerance = 1e-10;
-    o.cg_tolerance = 1e-13;
-    SimulatorOptions so;
-    so.dt = 0.01;
-    return Simulator(model, s0, std::make_unique<ImplicitEuler>(o), so);
-  };
-  const GradientResult g = gradient_of(c);
-  EXPECT_EQ(g.backward_solver, "bicgstab_jacobi");
-  EXPECT_EQ(g.newton_unconverged_steps, 0);
-  check_every_kind(c, 0, {SpringType::kStructural});
+  for (const bool assembled : {false, true}) {
+    SCOPED_TRACE(assembled ? "assembled" : "matrix-free");
+    AdjointCase c;
+    c.steps = 4;
+    Model model = build_cube(testing::small_cube(7, 0.6));
+    model.mass.setConstant(0.02);
+    model.springs.set_coefficients(SpringType::kStructural, {400, 4});
+    const State s0 = jittered(rest_state(model), 1e-2, 0.3);
+    c.make = [model, s0, assembled] {
+      ImplicitEulerOptions o;
+      o.newton_iterations = 60;
+      o.newton_tolerance = 1e-10;
+      o.cg_tolerance = 1e-13;
+      if (assembled) o.linear_solver = ImplicitLinearSolver::kCholmod;
+      SimulatorOptions so;
+      so.dt = 0.01;
+      return Simulator(model, s0, std::make_unique<ImplicitEuler>(o), so);
+    };
+    const GradientResult g = gradient_of(c);
+    EXPECT_EQ(g.backward_solver,
+              assembled ? "bicgstab_jacobi" : "bicgstab_block_jacobi_matrix_free");
+    EXPECT_EQ(g.newton_unconverged_steps, 0);
+    if (!assembled) {
+      EXPECT_GT(g.backward_iterations, 0);
+    }
+    check_every_kind(c, 0, {SpringType::kStructural});
+  }
+}
+
+// Newton after a matrix-free CG forward with contacts (the cube sticking on the slope, and
+// sliding down a frictionless one: Newton's viscosities are held, so none here): the
+// matrix-free BiCGSTAB backward solve filtered by the constraints.
+TEST(ImplicitEulerAdjoint, NewtonMatrixFreeWithContactsAgreesWithFiniteDifferences) {
+  for (const bool sliding : {false, true}) {
+    SCOPED_TRACE(sliding ? "sliding" : "sticking");
+    AdjointCase c = sliding ? sliding_cube(0) : cube_on_slope();
+    const std::function<Simulator()> direct = c.make;
+    c.make = [direct] {
+      Simulator sim = direct();
+      ImplicitEulerOptions o;
+      o.newton_iterations = 60;
+      o.newton_tolerance = 1e-12;
+      o.linear_solver = ImplicitLinearSolver::kCg;
+      o.cg_tolerance = 1e-13;
+      sim.set_integrator(std::make_unique<ImplicitEuler>(o));
+      return sim;
+    };
+    const GradientResult g = gradient_of(c);
+    EXPECT_EQ(g.backward_solver, "bicgstab_block_jacobi_matrix_free");
+    EXPECT_EQ(g.newton_unconverged_steps, 0);
+    EXPECT_GT(g.contact_steps, 9 * c.steps / 2);
+    EXPECT_EQ(g.slide_steps, 0);
+    check_every_kind(c, 0, {SpringType::kShear});
+  }
 }
 
 // CG forward and backward (tight tolerance): the gradient agrees to CG's accuracy.
