@@ -259,7 +259,7 @@ void BM_MatrixFreeCgIterations(benchmark::State& bench) {
       kIterations, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_MatrixFreeCgIterations)
-    ->ArgsProduct({{40}, {1, 2}, {0, 1}})
+    ->ArgsProduct({{20, 40}, {1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
