@@ -132,7 +132,9 @@ struct DeformedCubeSystem {
   VecX kw;            // K v of the last assembly
   const char* error = nullptr;
 
-  DeformedCubeSystem(int n, int threads, bool single_precision = false)
+  // whole_rows: assemble and multiply each thread's rows as one block (every band over the
+  // whole range, as before 2026-11-29) instead of the default blocks of rows (the same bits).
+  DeformedCubeSystem(int n, int threads, bool single_precision = false, bool whole_rows = false)
       : model(build_cube([n] {
           CubeSpec spec;
           spec.n = n;
@@ -144,6 +146,7 @@ struct DeformedCubeSystem {
       error = "the cube's springs do not fill their bands";
       return;
     }
+    if (whole_rows) system.set_row_block(model.num_particles());
     state = rest_state(model);
     for (int i = 0; i < state.x.size(); ++i) state.x[i] += 1e-3 * std::sin(0.37 * i);
     kw.resize(model.num_dofs());
@@ -182,11 +185,13 @@ struct DeformedCubeSystem {
   }
 };
 
-// One product y = A p (the inner loop of implicit_euler's CG); arguments n, the threads and
-// whether the coefficients are in single precision (1; implicit_euler's at cg_tolerance >= 1e-6).
+// One product y = A p (the inner loop of implicit_euler's CG); arguments n, the threads,
+// whether the coefficients are in single precision (1; implicit_euler's at cg_tolerance >= 1e-6)
+// and whether each thread's rows are one block (1: the loop order before 2026-11-29).
 void BM_MatrixFreeProduct(benchmark::State& bench) {
   const int threads = static_cast<int>(bench.range(1));
-  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads, bench.range(2) != 0);
+  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads, bench.range(2) != 0,
+                                bench.range(3) != 0);
   if (!cube.usable(bench)) return;
   const VecX p = cube.vector();
   VecX y(p.size());
@@ -197,15 +202,16 @@ void BM_MatrixFreeProduct(benchmark::State& bench) {
   cube.count_springs(bench);
 }
 BENCHMARK(BM_MatrixFreeProduct)
-    ->ArgsProduct({{20, 40}, {1, 2}, {0, 1}})
+    ->ArgsProduct({{20, 40}, {1, 2}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 // One assembly of the matrix-free system (implicit_euler's per-step A = M - h D - h^2 K and
-// K v, core/detail/band_system.hpp) on the deformed cube; arguments n and the threads.
+// K v, core/detail/band_system.hpp) on the deformed cube; arguments n, the threads and whether
+// each thread's rows are one block (as BM_MatrixFreeProduct).
 void BM_MatrixFreeAssembly(benchmark::State& bench) {
   const int threads = static_cast<int>(bench.range(1));
-  DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads);
+  DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads, false, bench.range(2) != 0);
   if (!cube.usable(bench)) return;
   cube.state.v = 0.1 * cube.vector();  // moving: the dampers' terms too
   for (auto _ : bench) {
@@ -218,19 +224,19 @@ void BM_MatrixFreeAssembly(benchmark::State& bench) {
   cube.count_springs(bench);
 }
 BENCHMARK(BM_MatrixFreeAssembly)
-    ->Args({40, 1})
-    ->Args({40, 2})
+    ->ArgsProduct({{20, 40}, {1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 // A solve of 100 iterations of implicit_euler's matrix-free block-Jacobi CG
 // (solvers/linear/cg_solver.hpp) on the same system from x = 0: 101 products (the starting
 // residual's and one per iteration) plus CG's vector operations, ordered sums and
-// preconditioner; s_per_cg_iteration is the solve's time / 100. Arguments n, the threads and
-// single precision (as BM_MatrixFreeProduct).
+// preconditioner; s_per_cg_iteration is the solve's time / 100. Arguments n, the threads, single
+// precision and whole rows (as BM_MatrixFreeProduct).
 void BM_MatrixFreeCgIterations(benchmark::State& bench) {
   const int threads = static_cast<int>(bench.range(1));
-  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads, bench.range(2) != 0);
+  const DeformedCubeSystem cube(static_cast<int>(bench.range(0)), threads, bench.range(2) != 0,
+                                bench.range(3) != 0);
   if (!cube.usable(bench)) return;
   MatrixFreeCg cg;
   const LinearResult blocks = cg.set_diagonal_blocks(
@@ -259,7 +265,7 @@ void BM_MatrixFreeCgIterations(benchmark::State& bench) {
       kIterations, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_MatrixFreeCgIterations)
-    ->ArgsProduct({{40}, {1, 2}, {0, 1}})
+    ->ArgsProduct({{20, 40}, {1, 2}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

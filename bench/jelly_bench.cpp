@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
       ->add_option(
           "--preconditioners", speed.preconditioners,
           "implicit_euler's cg_preconditioner values (jacobi, cholmod, multigrid, amg; direct: "
-          "its CHOLMOD solver instead of CG), a row "
+          "its CHOLMOD solver instead of CG; amg_v: amg with amg_cycle v), a row "
           "each, labelled implicit_euler[name] (default: its default only)")
       ->delimiter(',');
   speed_cmd
@@ -146,12 +146,13 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->capture_default_str();
   speed_cmd->add_flag("--interleave", speed.interleave,
-                      "run the thread counts in alternation (blocks of steps in turn): a change "
-                      "of the machine's speed falls on all of them alike; the peak memory then "
-                      "covers them together");
+                      "run the rows in alternation (blocks of steps in turn: the slope's thread "
+                      "counts, sizes and preconditioners, or one scene's): a change of the "
+                      "machine's speed falls on all of them alike; the peak memory then covers "
+                      "them together");
   speed_cmd
       ->add_option("--interleave-block", speed.interleave_block,
-                   "steps of one thread count before the next one's, with --interleave")
+                   "steps of one row before the next one's, with --interleave")
       ->capture_default_str();
 
   SeedOptions seed;

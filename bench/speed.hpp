@@ -14,6 +14,8 @@ namespace jelly::bench {
 
 // The --preconditioners value that runs implicit_euler with CHOLMOD instead of CG.
 inline constexpr const char* kDirectCholmod = "direct";
+// The --preconditioners value that runs cg_preconditioner "amg" with amg_cycle "v".
+inline constexpr const char* kAmgVCycle = "amg_v";
 
 struct SpeedOptions {
   std::vector<std::string> integrators;  // empty: every registered integrator
@@ -24,8 +26,8 @@ struct SpeedOptions {
   // dt; rows labelled "integrator[preconditioner]@file stem", n = the scene's index.
   std::vector<std::string> scenes;
   // implicit_euler's cg_preconditioner values, a row each (labelled "implicit_euler[name]"),
-  // and kDirectCholmod for its linear_solver "cholmod" (a factorization every step); empty: its
-  // default only.
+  // kDirectCholmod for its linear_solver "cholmod" (a factorization every step) and kAmgVCycle
+  // for amg with amg_cycle "v"; empty: its default only.
   std::vector<std::string> preconditioners;
   Real ks = 1400;  // N/m, every spring type (kd stays the seed's 50)
   // Thread counts, each a row (the scaling table); 0 = all cores.

@@ -17,6 +17,13 @@ constexpr long kMinSlotsPerThread = 8192;
 // Per-thread buffers of a pass over a band's slots: c1, c2, e1, ux, uy, uz, tx, ty, tz.
 constexpr size_t kBuffers = 9;
 
+// Rows per block of assemble() and multiply() for bands reaching `max_offset` particles: a block
+// reads the inputs of its rows and of the max_offset particles on either side (positions and input,
+// 48 bytes a particle) and computes the terms of block + offset slots per band, so blocks much
+// longer than the largest offset waste no work, and short enough that what a block touches stays in
+// a core's L2 cache (docs/implicit.md, "Matrix-free CG on lattices").
+int row_block_for(int max_offset) { return std::max(8192, 2 * max_offset); }
+
 struct Ends {
   const Real *xa, *ya, *za, *xb, *yb, *zb;
 };
@@ -202,6 +209,7 @@ BandSystem::BandSystem(const SpringBands& bands, int num_particles, bool single_
   }
   for (const auto& band : bands.bands()) slots_total_ += band.slots();
   stride_ = static_cast<size_t>(num_particles) + static_cast<size_t>(bands.max_offset());
+  block_ = std::max(1, row_block_for(bands.max_offset()));
   mass_.assign(num_particles, 0.0);
   diagonal_.assign(6 * static_cast<size_t>(num_particles), 0.0);
   positions_.assign(3 * static_cast<size_t>(num_particles), 0.0);
@@ -260,33 +268,39 @@ bool BandSystem::assemble(const Model& model, const VecX& x, const VecX& v, Defi
     Real* ty = tx + stride;
     Real* tz = ty + stride;
     int collapsed = 0;
-    for (size_t k = 0; k < bands.size(); ++k) {
-      const SpringBands::Band& band = bands[k];
-      const SpringBands::Band::Reach r = band.reach(p0, p1);
-      if (r.lo >= r.hi) continue;
-      const int a = band.first + r.lo, b = a + band.offset;
-      const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
-      const Ends ev{sv + a, sv + n + a, sv + 2 * n + a, sv + b, sv + n + b, sv + 2 * n + b};
-      const Ends ew{sw + a, sw + n + a, sw + 2 * n + a, sw + b, sw + n + b, sw + 2 * n + b};
-      collapsed += band_blocks(r.hi - r.lo, fix_code, alpha, beta, ex, ev, ew,
-                               band.rest.data() + r.lo, band.ks.data() + r.lo,
-                               band.kd.data() + r.lo, c1, c2, e1, ux, uy, uz, tx, ty, tz);
-      // This thread stores the slots whose first particle is its own.
-      Slots& out = slots_[k];
-      if (r.a0 < r.a1) {
-        const int q = r.a0 - a, slot = r.a0 - band.first, len = r.a1 - r.a0;
-        if (single_) {  // rounded to the nearest float
-          std::copy(e1 + q, e1 + q + len, out.e1_single.data() + slot);
-          std::copy(c2 + q, c2 + q + len, out.c2_single.data() + slot);
-        } else {
-          std::copy(e1 + q, e1 + q + len, out.e1.data() + slot);
-          std::copy(c2 + q, c2 + q + len, out.c2.data() + slot);
+    // Block by block as multiply() (every band for one block of rows, then the next; a block's
+    // rows the same bits as a thread's range would give them).
+    for (int q0 = p0; q0 < p1; q0 += block_) {
+      const int q1 = std::min(p1, q0 + block_);
+      for (size_t k = 0; k < bands.size(); ++k) {
+        const SpringBands::Band& band = bands[k];
+        const SpringBands::Band::Reach r = band.reach(q0, q1);
+        if (r.lo >= r.hi) continue;
+        const int a = band.first + r.lo, b = a + band.offset;
+        const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
+        const Ends ev{sv + a, sv + n + a, sv + 2 * n + a, sv + b, sv + n + b, sv + 2 * n + b};
+        const Ends ew{sw + a, sw + n + a, sw + 2 * n + a, sw + b, sw + n + b, sw + 2 * n + b};
+        const int found = band_blocks(r.hi - r.lo, fix_code, alpha, beta, ex, ev, ew,
+                                      band.rest.data() + r.lo, band.ks.data() + r.lo,
+                                      band.kd.data() + r.lo, c1, c2, e1, ux, uy, uz, tx, ty, tz);
+        // This block stores the slots whose first particle is its own.
+        Slots& out = slots_[k];
+        if (r.a0 < r.a1) {
+          const int q = r.a0 - a, slot = r.a0 - band.first, len = r.a1 - r.a0;
+          if (single_) {  // rounded to the nearest float
+            std::copy(e1 + q, e1 + q + len, out.e1_single.data() + slot);
+            std::copy(c2 + q, c2 + q + len, out.c2_single.data() + slot);
+          } else {
+            std::copy(e1 + q, e1 + q + len, out.e1.data() + slot);
+            std::copy(c2 + q, c2 + q + len, out.c2.data() + slot);
+          }
+          add_slot_terms(n, r.a0, len, q, true, c1, c2, ux, uy, uz, tx, ty, tz, acc, diag);
         }
-        add_slot_terms(n, r.a0, len, q, true, c1, c2, ux, uy, uz, tx, ty, tz, acc, diag);
-      }
-      if (r.b0 < r.b1) {
-        add_slot_terms(n, r.b0, r.b1 - r.b0, r.b0 - b, false, c1, c2, ux, uy, uz, tx, ty, tz, acc,
-                       diag);
+        collapsed += found;
+        if (r.b0 < r.b1) {
+          add_slot_terms(n, r.b0, r.b1 - r.b0, r.b0 - b, false, c1, c2, ux, uy, uz, tx, ty, tz, acc,
+                         diag);
+        }
       }
     }
     collapsed_[part] = collapsed;
@@ -434,6 +448,7 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, ProductFilter fil
   const std::vector<SpringBands::Band>& bands = bands_->bands();
   const int team = this->team(threads);
   const size_t stride = stride_;
+  const int block = block_;
   const Real* sx = positions_.data();
   Real* sp = scratch_.data();
   Real* acc = sp + 3 * static_cast<size_t>(n);
@@ -453,10 +468,7 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, ProductFilter fil
         // Summed as Eigen's 3x3 product does (a0 + (a1 + a2)): the same bits as S_c p_c.
         for (int c = 0; c < 3; ++c) q[c] = f[c] * q0 + (f[3 + c] * q1 + f[6 + c] * q2);
       }
-      for (int c = 0; c < 3; ++c) {
-        sp[c * n + i] = q[c];
-        acc[c * n + i] = mass_[i] * q[c];
-      }
+      for (int c = 0; c < 3; ++c) sp[c * n + i] = q[c];
     }
     double seconds = std::chrono::duration<double>(Clock::now() - start).count();
 #pragma omp barrier
@@ -464,49 +476,60 @@ void BandSystem::multiply(const VecX& p, VecX& y, int threads, ProductFilter fil
     Real* tx = band_.data() + static_cast<size_t>(part) * kBuffers * stride;
     Real* ty = tx + stride;
     Real* tz = ty + stride;
-    for (size_t k = 0; k < bands.size(); ++k) {
-      const SpringBands::Band& band = bands[k];
-      const SpringBands::Band::Reach r = band.reach(p0, p1);
-      if (r.lo >= r.hi) continue;
-      const int a = band.first + r.lo, b = a + band.offset;
-      const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
-      const Ends ep{sp + a, sp + n + a, sp + 2 * n + a, sp + b, sp + n + b, sp + 2 * n + b};
-      const Slots& s = slots_[k];
-      if (single_) {
-        band_products_single(r.hi - r.lo, ex, ep, s.e1_single.data() + r.lo,
-                             s.c2_single.data() + r.lo, tx, ty, tz);
-      } else {
-        band_products(r.hi - r.lo, ex, ep, s.e1.data() + r.lo, s.c2.data() + r.lo, tx, ty, tz);
+    // The thread's rows block by block (block_ particles), every band for one block before the
+    // next: a block's rows, and the inputs within the bands' reach of it, stay in the cache
+    // through its bands (each band a pass over the whole range read them from memory once per
+    // band at n = 40). A block is computed as a thread's range would be (the slots at its
+    // boundaries by both blocks), so each row is the same bits for any block size.
+    for (int q0 = p0; q0 < p1; q0 += block) {
+      const int q1 = std::min(p1, q0 + block);
+      for (int i = q0; i < q1; ++i) {
+        for (int c = 0; c < 3; ++c) acc[c * n + i] = mass_[i] * sp[c * n + i];
       }
-      band_kernels::add_ends(a, b, r.a0, r.a1, r.b0, r.b1, tx, ty, tz, acc, acc + n, acc + 2 * n);
-    }
-    for (int i = p0; i < p1; ++i) {
-      for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c * n + i];
-    }
-    if (!extra_column_.empty()) {
-      for (int i = p0; i < p1; ++i) {
-        for (int e = extra_start_[i]; e < extra_start_[i + 1]; ++e) {
-          const Real* b = extra_value_.data() + 9 * static_cast<size_t>(e);
-          const int j = extra_column_[e];
-          const Real q0 = sp[j], q1 = sp[n + j], q2 = sp[2 * n + j];
-          for (int c = 0; c < 3; ++c)
-            y[3 * i + c] += b[3 * c] * q0 + b[3 * c + 1] * q1 + b[3 * c + 2] * q2;
+      for (size_t k = 0; k < bands.size(); ++k) {
+        const SpringBands::Band& band = bands[k];
+        const SpringBands::Band::Reach r = band.reach(q0, q1);
+        if (r.lo >= r.hi) continue;
+        const int a = band.first + r.lo, b = a + band.offset;
+        const Ends ex{sx + a, sx + n + a, sx + 2 * n + a, sx + b, sx + n + b, sx + 2 * n + b};
+        const Ends ep{sp + a, sp + n + a, sp + 2 * n + a, sp + b, sp + n + b, sp + 2 * n + b};
+        const Slots& s = slots_[k];
+        if (single_) {
+          band_products_single(r.hi - r.lo, ex, ep, s.e1_single.data() + r.lo,
+                               s.c2_single.data() + r.lo, tx, ty, tz);
+        } else {
+          band_products(r.hi - r.lo, ex, ep, s.e1.data() + r.lo, s.c2.data() + r.lo, tx, ty, tz);
+        }
+        band_kernels::add_ends(a, b, r.a0, r.a1, r.b0, r.b1, tx, ty, tz, acc, acc + n, acc + 2 * n);
+      }
+      for (int i = q0; i < q1; ++i) {
+        for (int c = 0; c < 3; ++c) y[3 * i + c] = acc[c * n + i];
+      }
+      if (!extra_column_.empty()) {
+        for (int i = q0; i < q1; ++i) {
+          for (int e = extra_start_[i]; e < extra_start_[i + 1]; ++e) {
+            const Real* b = extra_value_.data() + 9 * static_cast<size_t>(e);
+            const int j = extra_column_[e];
+            const Real v0 = sp[j], v1 = sp[n + j], v2 = sp[2 * n + j];
+            for (int c = 0; c < 3; ++c)
+              y[3 * i + c] += b[3 * c] * v0 + b[3 * c + 1] * v1 + b[3 * c + 2] * v2;
+          }
         }
       }
-    }
-    if (filter.scale != nullptr) {
-      for (int i = p0; i < p1; ++i) {
-        if (filter.slot[i] < 0) continue;
-        // y_i -> S y_i + c (S p_i) + (p_i - S p_i), with S p_i the filtered input kept in sp
-        // (c times it: Eigen's (c S) p_i in the former ImplicitContact::filter_output differed
-        // in the last bits for sliding contacts).
-        const Real* f = filter.map + 9 * static_cast<size_t>(filter.slot[i]);
-        const Real scale = filter.scale[filter.slot[i]];
-        const Real y0 = y[3 * i], y1 = y[3 * i + 1], y2 = y[3 * i + 2];
-        for (int c = 0; c < 3; ++c) {
-          const Real sy = f[c] * y0 + (f[3 + c] * y1 + f[6 + c] * y2);
-          const Real sq = sp[c * n + i];
-          y[3 * i + c] = sy + scale * sq + (p[3 * i + c] - sq);
+      if (filter.scale != nullptr) {
+        for (int i = q0; i < q1; ++i) {
+          if (filter.slot[i] < 0) continue;
+          // y_i -> S y_i + c (S p_i) + (p_i - S p_i), with S p_i the filtered input kept in sp
+          // (c times it: Eigen's (c S) p_i in the former ImplicitContact::filter_output
+          // differed in the last bits for sliding contacts).
+          const Real* f = filter.map + 9 * static_cast<size_t>(filter.slot[i]);
+          const Real scale = filter.scale[filter.slot[i]];
+          const Real y0 = y[3 * i], y1 = y[3 * i + 1], y2 = y[3 * i + 2];
+          for (int c = 0; c < 3; ++c) {
+            const Real sy = f[c] * y0 + (f[3 + c] * y1 + f[6 + c] * y2);
+            const Real sq = sp[c * n + i];
+            y[3 * i + c] = sy + scale * sq + (p[3 * i + c] - sq);
+          }
         }
       }
     }

@@ -17,7 +17,9 @@ command: that line comes from the CSV's own metadata, never from prose. The plot
 (scripts/plot_bench.py) are drawn into --img from the same files.
 
 Tables: stability, speed, budget, bullet, core (performance.md; core from Google Benchmark's
-JSON output), integrators (integrators.md: the decision table). The commands that regenerate the CSV files are on those pages;
+JSON output), integrators (integrators.md: the decision table), implicit_growth,
+implicit_scenes and matrix_free (implicit.md: implicit_euler's cost against size, its
+preconditioners on scene files, and the matrix-free product and CG iteration). The commands that regenerate the CSV files are on those pages;
 `make docs` does not run them (the CSV files are committed).
 
 --check renders without writing and exits 1 if a page differs from what its CSV files give
@@ -354,10 +356,106 @@ def render_bullet(data):
     return "\n\n".join([table(header, body), measured(meta)])
 
 
-def render_core(data):
+def statistics_per_step(data, folder):
+    """{item: {key: value per step}} from the speed_statistics.csv of `folder`."""
+    rows, _ = read_table(os.path.join(data, folder, "speed_statistics.csv"))
+    out = {}
+    for r in rows:
+        out.setdefault(int(r["item"]), {})[r["key"]] = r["per_step"]
+    return out
+
+
+def variant(label):
+    """(preconditioner, scene) of a row label 'implicit_euler[name]@scene'."""
+    match = re.match(r"^[a-z_]+(?:\[([a-z_]+)\])?(?:@(.+))?$", label)
+    if not match:
+        return label, ""
+    return match.group(1) or "default", match.group(2) or ""
+
+
+PRECONDITIONERS = {"jacobi": "block Jacobi", "multigrid": "multigrid", "amg": "amg (W-cycle)",
+                   "amg_v": "amg (V-cycle)", "direct": "CHOLMOD", "default": "default"}
+
+
+def ratio(a, b):
+    return f"{a / b:.1f}x" if finite(a) and finite(b) and b > 0 else ""
+
+
+def render_implicit_growth(data, folder="implicit_growth"):
+    """implicit_euler on the slope's cubes: cost per step and per CG iteration against n, and
+    the growth from the smallest size to each larger one (same preconditioner and threads)."""
+    rows, meta = read_table(os.path.join(data, folder, "speed.csv"))
+    stats = statistics_per_step(data, folder)
+    rows = [r for r in rows if r["status"] in COMPLETED]
+    if not rows:
+        raise InputProblem(os.path.join(data, folder, "speed.csv") + ": no completed row")
+    keys = unique((variant(r["integrator"])[0], int(r["threads"])) for r in rows)
+    body = []
+    for preconditioner, t in keys:
+        mine = sorted((r for r in rows if variant(r["integrator"])[0] == preconditioner
+                       and int(r["threads"]) == t), key=lambda r: r["n"])
+        base = None
+        for r in mine:
+            st = stats.get(int(r["item"]), {})
+            its, solves = st.get("cg_iterations", math.nan), st.get("linear_solves", math.nan)
+            per_iteration = st.get("solve_seconds", math.nan) / its if its else math.nan
+            cells = [PRECONDITIONERS.get(preconditioner, preconditioner),
+                     str(t) if t else "default (chosen)",
+                     f"{int(r['n'])} ({int(r['particles']):,})",
+                     seconds(r["step_seconds"]),
+                     sig(its / solves) if finite(solves) and solves > 0 else "",
+                     seconds(per_iteration), seconds(st.get("assembly_seconds", math.nan))]
+            if base is None:
+                base = (r, per_iteration)
+                cells += ["", ""]
+            else:
+                particles = r["particles"] / base[0]["particles"]
+                cells += [f"{ratio(r['step_seconds'], base[0]['step_seconds'])} "
+                          f"({particles:g}x particles)", ratio(per_iteration, base[1])]
+            body.append(cells)
+    header = ["preconditioner", "threads", "n (particles)", "time / step",
+              "CG iterations / solve", "time / CG iteration", "assembly / step",
+              "growth of the step time", "growth per CG iteration"]
+    first = rows[0]
+    intro = (f"implicit_euler on the seed slope (the cube lowered onto it; spring stiffness "
+             f"the command's `--ks`, 1,400 N/m when absent), dt = {sig(first['dt'] * 1e3)} ms, {int(first['steps'])} timed steps per row, the rows "
+             "run in alternation (`--interleave`). Time per CG iteration: the statistics' "
+             "`solve_seconds` over `cg_iterations`; assembly: `assembly_seconds` (forces, A and "
+             "the right-hand side).")
+    return "\n\n".join([intro, table(header, body), measured(meta)])
+
+
+def render_implicit_scenes(data):
+    """implicit_euler's preconditioners on scene files (jelly-bench speed --scenes)."""
+    rows, meta = read_table(os.path.join(data, "implicit_scenes", "speed.csv"))
+    stats = statistics_per_step(data, "implicit_scenes")
+    body = []
+    for r in rows:
+        preconditioner, scene = variant(r["integrator"])
+        st = stats.get(int(r["item"]), {})
+        its, solves = st.get("cg_iterations", math.nan), st.get("linear_solves", math.nan)
+        ok = r["status"] in COMPLETED
+        body.append([scene, integer(3 * r["particles"]),
+                     PRECONDITIONERS.get(preconditioner, preconditioner),
+                     sig(its / solves) if ok and finite(its) and its > 0 and solves > 0 else "-",
+                     sig(solves) if ok else "",
+                     sig(r["step_seconds"]) if ok else r["status"].replace("_", " "),
+                     sig(st.get("solve_seconds", math.nan)) if ok else "",
+                     sig(st.get("factorization_seconds", math.nan)) if ok else ""])
+    header = ["scene", "unknowns", "solver", "CG its / solve", "solves / step", "s / step",
+              "solve s / step", "setup or factorization s / step"]
+    first = rows[0]
+    intro = (f"implicit_euler at dt = {sig(first['dt'] * 1e3)} ms, {int(first['steps'])} timed "
+             "steps per row, the rows of a scene in alternation (`--interleave`); from "
+             "`speed.csv` and `speed_statistics.csv` (`step_seconds`, and per step "
+             "`cg_iterations`, `linear_solves`, `solve_seconds`, `factorization_seconds`).")
+    return "\n\n".join([intro, table(header, body), measured(meta)])
+
+
+def render_core(data, folder="core"):
     """Google Benchmark's JSON output (--benchmark_out_format=json): medians of the repetitions."""
     import json
-    path = os.path.join(data, "core", "core.json")
+    path = os.path.join(data, folder, "core.json")
     if not os.path.isfile(path):
         raise InputProblem(f"{path}: no such file (run the jelly_core_benchmark command the page "
                            "names)")
@@ -396,7 +494,12 @@ def render_core(data):
 
 
 RENDERERS = {"stability": render_stability, "speed": render_speed, "budget": render_budget,
-             "integrators": render_integrators, "bullet": render_bullet, "core": render_core}
+             "integrators": render_integrators, "bullet": render_bullet, "core": render_core,
+             "implicit_growth": render_implicit_growth,
+             "implicit_growth_stiff": lambda data: render_implicit_growth(
+                 data, "implicit_growth_stiff"),
+             "implicit_scenes": render_implicit_scenes,
+             "matrix_free": lambda data: render_core(data, "matrix_free")}
 PLOTS = [("stability/stability.csv", "plot_stability", "bench_stability.png"),
          ("speed/speed.csv", "plot_speed", "bench_speed.png"),
          ("budget/budget.csv", "plot_budget", "bench_budget.png")]

@@ -64,6 +64,12 @@ class BandSystem {
   // y = A p, or y = A p filtered by `filter` (when its slot is not null). No allocation after
   // the first call with this thread count.
   void multiply(const VecX& p, VecX& y, int threads, ProductFilter filter = {}) const;
+  // assemble() and multiply() compute their rows in blocks of this many particles (every band
+  // for one block, then the next: what a block reads stays in the cache); set from the bands'
+  // largest offset. Any block size gives the same bits (a block's rows are computed as a
+  // thread's range is).
+  int row_block() const { return block_; }
+  void set_row_block(int particles) { block_ = particles > 0 ? particles : 1; }
   // The rows of y = A p at the given particles only (distinct; the other rows of y are left as
   // they are): the same bits as multiply's without a filter, for a few particles (the
   // contacts' impulses) instead of a whole product; split between up to `threads` threads when
@@ -93,6 +99,7 @@ class BandSystem {
   bool single_ = false;
   long slots_total_ = 0;         // slots of all bands
   size_t stride_ = 0;            // per-thread buffer length: N + the largest offset
+  int block_ = 0;                // rows per block of assemble() and multiply()
   std::vector<Slots> slots_;     // per band
   std::vector<Real> mass_;       // [N] m + the diagonal additions
   std::vector<Real> diagonal_;   // [6N] xx, yy, zz, xy, xz, yz of the spring part of A_ii

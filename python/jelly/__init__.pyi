@@ -288,6 +288,7 @@ class ImplicitEulerOptions:
     contact_screening_tolerance: float
     cg_max_iterations: int
     refactor_iterations: int
+    amg_cycle: str  # "w" or "v" (cg_preconditioner "amg")
     ordering: str
     contact: str
     contact_iterations: int

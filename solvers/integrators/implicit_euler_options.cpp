@@ -28,6 +28,15 @@ const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds() {
   return table;
 }
 
+const std::vector<EnumName<AmgCycle>>& amg_cycles() {
+  static const std::vector<EnumName<AmgCycle>> table{
+      {AmgCycle::kW, "w",
+       "Chebyshev smoothing of degree 2 on level 0 and 4 below, a W-cycle below level 1"},
+      {AmgCycle::kV, "v", "a V-cycle, Chebyshev smoothing of degree 2 on every level"},
+  };
+  return table;
+}
+
 const std::vector<EnumName<ImplicitContactMode>>& implicit_contact_modes() {
   static const std::vector<EnumName<ImplicitContactMode>> table{
       {ImplicitContactMode::kImplicit, "implicit",
@@ -69,6 +78,8 @@ const FieldTable<ImplicitEulerOptions>& implicit_euler_fields() {
               "refactor_iterations", "", range_at_least(1), "an integer >= 1",
               "CG iterations that trigger a new CHOLMOD preconditioner (amg: a refresh of its "
               "coarse levels; 1 = every step)"),
+          choice_field<&O::amg_cycle, &amg_cycles>("amg_cycle",
+                                                   "The cycle of cg_preconditioner amg"),
           choice_field<&O::ordering, &cholmod_orderings>("ordering",
                                                          "CHOLMOD's fill-reducing ordering"),
           choice_field<&O::contact, &implicit_contact_modes>("contact",

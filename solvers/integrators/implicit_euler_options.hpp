@@ -31,6 +31,13 @@ enum class CgPreconditionerKind {
 };
 const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds();
 
+// The cycle of cg_preconditioner = amg (docs/implicit.md, "Algebraic multigrid on any body").
+enum class AmgCycle {
+  kW,  // Chebyshev smoothing of degree 2 on level 0 and 4 below, levels below 1 visited twice
+  kV,  // a V-cycle, Chebyshev smoothing of degree 2 on every level
+};
+const std::vector<EnumName<AmgCycle>>& amg_cycles();
+
 // How coulomb terrains enter the step.
 enum class ImplicitContactMode {
   kImplicit,   // constraints inside the linear solve, with friction and restitution
@@ -54,6 +61,7 @@ struct ImplicitEulerOptions {
   Real cg_tolerance = 1e-5;  // relative residual |b - A x| / |b|
   int cg_max_iterations = 1000;
   int refactor_iterations = 20;
+  AmgCycle amg_cycle = AmgCycle::kW;                   // cg_preconditioner = amg: its cycle
   CholmodOrdering ordering = CholmodOrdering::kMetis;  // CHOLMOD's fill-reducing ordering
   ImplicitContactMode contact = ImplicitContactMode::kImplicit;
   // kImplicit: at most this many linear solves per step while the active set changes.

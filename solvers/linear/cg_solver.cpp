@@ -362,7 +362,8 @@ CgSolver::CgSolver(CgOptions options) : impl_(std::make_unique<Impl>(options)) {
   if (options.preconditioner == CgPreconditioner::kLaggedCholesky)
     impl_->factor_ = std::make_unique<CholmodSolver>(options.cholmod);
   if (options.preconditioner == CgPreconditioner::kAmg)
-    impl_->amg_ = std::make_unique<SmoothedAggregation>();
+    impl_->amg_ = std::make_unique<SmoothedAggregation>(SmoothedAggregation::Options{
+        options.amg_fine_degree, options.amg_coarse_degree, options.amg_w_cycle});
 }
 
 CgSolver::~CgSolver() = default;

@@ -32,6 +32,11 @@ struct CgOptions {
   // Lagged Cholesky: when a solve with an old factor has not converged after this many
   // iterations, refactor at once and solve again.
   int lagged_iteration_limit = 30;
+  // Amg: the Chebyshev smoothers' degrees on level 0 and on the coarse levels, and whether
+  // levels below 1 are visited twice (a W-cycle).
+  int amg_fine_degree = 2;
+  int amg_coarse_degree = 4;
+  bool amg_w_cycle = true;
   CholmodOptions cholmod;
 };
 

@@ -128,6 +128,26 @@ TEST_F(BenchCli, InterleavedThreadCountsGiveTheSameRows) {
   EXPECT_THAT(r.err, HasSubstr("--interleave-block = 0 is invalid"));
 }
 
+// --interleave with several sizes of the slope (which it alternates since 2026-11-29): every
+// size's row completes with its steps and is marked as sharing its peak memory. (The order of
+// the steps is not visible in the output; this checks that the runs of two sizes kept together
+// each finish.)
+TEST_F(BenchCli, InterleavedSizesRunTogether) {
+  const Result r = bench(
+      "speed --sizes 4,5 --steps 4 --warmup-steps 1 --threads 1 --integrators "
+      "rk4 --interleave --interleave-block 1 --out '" +
+      (dir_ / "sizes").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = read_file(dir_ / "sizes" / "speed.csv");
+  for (const std::string row : {"\n0,rk4,4,1,64,", "\n1,rk4,5,1,125,"}) {
+    const auto at = csv.find(row);
+    ASSERT_NE(at, std::string::npos) << row;
+    const std::string line = csv.substr(at + 1, csv.find('\n', at + 1) - at - 1);
+    EXPECT_THAT(line, HasSubstr(",4,completed,")) << line;
+    EXPECT_EQ(line.substr(line.rfind(',')), ",0") << line;  // memory_per_configuration
+  }
+}
+
 // The `cores` of a table's metadata are the ones the run could use (its CPU affinity: taskset,
 // a Slurm task's allocation), which its default thread count follows; `hardware_cores` the
 // machine's.

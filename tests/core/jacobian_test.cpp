@@ -324,7 +324,8 @@ TEST(BandSystem, ProductsEqualTheAssembledMatrix) {
 // q = p with q_i = S_i p_i and the output y_i = S_i (A q)_i + c_i S_i p_i + (p_i - S_i p_i) at
 // the filtered particles, against that formula on the assembled matrix; and with a few hundred
 // particles filtered (more than one thread's worth of rows for multiply_rows), the same bits on
-// 1, 2 and 3 threads and over repeated calls (the balanced split moves between them).
+// 1, 2 and 3 threads, over repeated calls (the balanced split moves between them) and for any
+// size of the product's blocks.
 TEST(BandSystem, FilteredProductsAndRowsAreTheSameOnAnyThreadCount) {
   CubeSpec spec;
   spec.n = 12;  // 1,728 particles
@@ -375,18 +376,41 @@ TEST(BandSystem, FilteredProductsAndRowsAreTheSameOnAnyThreadCount) {
         projector * expected.segment<3>(3 * i) + scale[slot[i]] * si + (pi - si);
   }
 
-  VecX first_y, first_rows;
+  VecX first_y, first_rows, first_kw;
+  std::vector<Real> first_diagonal;
   for (int threads : {1, 2, 3}) {
     BandSystem system(bands, np);
     VecX kw(model.num_dofs());
     ASSERT_TRUE(system.assemble(model, s.x, s.v, o.definiteness, alpha, beta, p, kw, threads));
-    for (int call = 0; call < 3; ++call) {
-      VecX y(model.num_dofs());
-      system.multiply(p, y, threads, filter);
-      EXPECT_LT((y - expected).norm(), 1e-13 * expected.norm()) << threads;
-      if (first_y.size() == 0) first_y = y;
-      EXPECT_TRUE(y == first_y) << threads << " threads, call " << call;
+    // The rows' blocks: one for the whole cube (the default at this size), blocks longer and
+    // shorter than the largest band offset (288), and a block of one particle; assembled again
+    // with each, the same K w and diagonal blocks too.
+    const int whole_block = system.row_block();
+    EXPECT_GE(whole_block, np);
+    for (int block : {whole_block, 500, 100, 1}) {
+      system.set_row_block(block);
+      VecX kw_again(model.num_dofs());
+      ASSERT_TRUE(
+          system.assemble(model, s.x, s.v, o.definiteness, alpha, beta, p, kw_again, threads));
+      if (first_kw.size() == 0) first_kw = kw_again;
+      EXPECT_TRUE(kw_again == first_kw) << threads << " threads, block " << block;
+      std::vector<Real> diagonal;
+      for (int i : {0, 143, 144, 700, np - 1}) {
+        Real d[9];
+        system.diagonal_block(i, d);
+        diagonal.insert(diagonal.end(), d, d + 9);
+      }
+      if (first_diagonal.empty()) first_diagonal = diagonal;
+      EXPECT_TRUE(diagonal == first_diagonal) << threads << " threads, block " << block;
+      for (int call = 0; call < 3; ++call) {
+        VecX y(model.num_dofs());
+        system.multiply(p, y, threads, filter);
+        EXPECT_LT((y - expected).norm(), 1e-13 * expected.norm()) << threads;
+        if (first_y.size() == 0) first_y = y;
+        EXPECT_TRUE(y == first_y) << threads << " threads, block " << block << ", call " << call;
+      }
     }
+    system.set_row_block(whole_block);
     // The rows alone, on up to `threads` threads: the unfiltered product's rows, bit for bit.
     VecX whole(model.num_dofs());
     system.multiply(p, whole, threads);

@@ -49,6 +49,10 @@ std::unique_ptr<LinearSolver> make_linear_solver(ImplicitLinearSolver kind, bool
   cg.tolerance = options.cg_tolerance;
   cg.max_iterations = options.cg_max_iterations;
   cg.refactor_iterations = options.refactor_iterations;
+  if (options.amg_cycle == AmgCycle::kV) {
+    cg.amg_coarse_degree = 2;
+    cg.amg_w_cycle = false;
+  }
   cg.cholmod = cholmod;
   return std::make_unique<CgSolver>(cg);
 }

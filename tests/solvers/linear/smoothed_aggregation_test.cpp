@@ -105,51 +105,55 @@ SparseMatrix filtered(const Model& model, const std::vector<int>& pinned,
   return a;
 }
 
-// The V-cycle B is a symmetric positive definite operator: u^T B w = w^T B u and w^T B w > 0 on
-// random vectors, with pinned particles and sliding contacts filtered into the matrix, on a tet
-// body and on a cloth; and B r is the same bits on 1, 2 and 3 threads.
+// The cycle B (the W-cycle and the V-cycle of amg_cycle) is a symmetric positive definite
+// operator: u^T B w = w^T B u and w^T B w > 0 on random vectors, with pinned particles and
+// sliding contacts filtered into the matrix, on a tet body and on a cloth; and B r is the same
+// bits on 1, 2 and 3 threads.
 TEST(SmoothedAggregation, IsSymmetricPositiveDefiniteWithPinsAndContacts) {
-  for (const bool cloth : {false, true}) {
-    const Model model = cloth ? cloth_model(40) : tet_model(12);
-    const int np = model.num_particles();
-    std::vector<int> pinned, sliding;
-    for (int i = 0; i < np; i += 37) pinned.push_back(i);
-    for (int i = 5; i < np; i += 11) sliding.push_back(i);
-    VecX x;
-    const SparseMatrix a = filtered(model, pinned, sliding, x);
-    SmoothedAggregation amg;
-    ASSERT_TRUE(amg.setup(a, x, 1).ok());
-    EXPECT_GE(amg.levels(), 2) << (cloth ? "cloth" : "tets");
-    std::mt19937 rng(11);
-    std::normal_distribution<Real> g;
-    const int n = static_cast<int>(a.rows());
-    VecX u(n), w(n), bu(n), bw(n);
-    for (int trial = 0; trial < 10; ++trial) {
-      for (int i = 0; i < n; ++i) {
-        u[i] = g(rng);
-        w[i] = g(rng);
+  for (const bool cloth : {false, true})
+    for (const SmoothedAggregation::Options cycle :
+         {SmoothedAggregation::Options{}, SmoothedAggregation::Options{2, 2, false}}) {
+      const Model model = cloth ? cloth_model(40) : tet_model(12);
+      const int np = model.num_particles();
+      std::vector<int> pinned, sliding;
+      for (int i = 0; i < np; i += 37) pinned.push_back(i);
+      for (int i = 5; i < np; i += 11) sliding.push_back(i);
+      VecX x;
+      const SparseMatrix a = filtered(model, pinned, sliding, x);
+      SmoothedAggregation amg(cycle);
+      ASSERT_TRUE(amg.setup(a, x, 1).ok());
+      EXPECT_GE(amg.levels(), 2) << (cloth ? "cloth" : "tets");
+      std::mt19937 rng(11);
+      std::normal_distribution<Real> g;
+      const int n = static_cast<int>(a.rows());
+      VecX u(n), w(n), bu(n), bw(n);
+      for (int trial = 0; trial < 10; ++trial) {
+        for (int i = 0; i < n; ++i) {
+          u[i] = g(rng);
+          w[i] = g(rng);
+        }
+        amg.apply(u, bu, 1);
+        amg.apply(w, bw, 1);
+        const Real scale = u.norm() * bw.norm();
+        EXPECT_NEAR(u.dot(bw), w.dot(bu), 1e-12 * scale);
+        EXPECT_GT(w.dot(bw), 0);
+        EXPECT_GT(u.dot(bu), 0);
       }
-      amg.apply(u, bu, 1);
-      amg.apply(w, bw, 1);
-      const Real scale = u.norm() * bw.norm();
-      EXPECT_NEAR(u.dot(bw), w.dot(bu), 1e-12 * scale);
-      EXPECT_GT(w.dot(bw), 0);
-      EXPECT_GT(u.dot(bu), 0);
+      for (const int threads : {2, 3}) {
+        SmoothedAggregation other(cycle);
+        ASSERT_TRUE(other.setup(a, x, threads).ok());
+        VecX bu_t(n);
+        other.apply(u, bu_t, threads);
+        EXPECT_TRUE(bu_t == bu) << threads << " threads";
+      }
     }
-    for (const int threads : {2, 3}) {
-      SmoothedAggregation other;
-      ASSERT_TRUE(other.setup(a, x, threads).ok());
-      VecX bu_t(n);
-      other.apply(u, bu_t, threads);
-      EXPECT_TRUE(bu_t == bu) << threads << " threads";
-    }
-  }
 }
 
 // CG iterations to 1e-8 from zero on the tet box's system (stiff: the springs dominate the mass)
-// at two refinements: amg's grow by at most 1.3x from 8^3 to 16^3 cells, block Jacobi's double.
+// at two refinements: amg's grow by at most 1.3x from 8^3 to 16^3 cells, block Jacobi's double;
+// amg's V-cycle (amg_cycle "v") needs fewer than block Jacobi (its counts printed).
 TEST(SmoothedAggregation, IterationsHardlyGrowWithTheBody) {
-  const auto iterations = [](int cells, CgPreconditioner preconditioner) {
+  const auto iterations = [](int cells, CgPreconditioner preconditioner, bool v_cycle = false) {
     const Model model = tet_model(cells, 4e6);
     VecX x;
     std::vector<int> pinned;
@@ -159,6 +163,10 @@ TEST(SmoothedAggregation, IterationsHardlyGrowWithTheBody) {
     CgOptions o;
     o.preconditioner = preconditioner;
     o.tolerance = 1e-8;
+    if (v_cycle) {
+      o.amg_coarse_degree = 2;
+      o.amg_w_cycle = false;
+    }
     CgSolver cg(o);
     cg.set_coordinates(x);
     EXPECT_TRUE(cg.analyze(a).ok());
@@ -172,16 +180,23 @@ TEST(SmoothedAggregation, IterationsHardlyGrowWithTheBody) {
   };
   const int amg8 = iterations(8, CgPreconditioner::kAmg);
   const int amg16 = iterations(16, CgPreconditioner::kAmg);
+  const int v8 = iterations(8, CgPreconditioner::kAmg, true);
+  const int v16 = iterations(16, CgPreconditioner::kAmg, true);
   const int jacobi8 = iterations(8, CgPreconditioner::kJacobi);
   const int jacobi16 = iterations(16, CgPreconditioner::kJacobi);
   RecordProperty("amg_8", amg8);
   RecordProperty("amg_16", amg16);
   RecordProperty("jacobi_8", jacobi8);
   RecordProperty("jacobi_16", jacobi16);
-  std::printf("CG iterations, 8^3 / 16^3 cells: amg %d / %d, block Jacobi %d / %d\n", amg8, amg16,
-              jacobi8, jacobi16);
+  RecordProperty("amg_v_8", v8);
+  RecordProperty("amg_v_16", v16);
+  std::printf(
+      "CG iterations, 8^3 / 16^3 cells: amg %d / %d, amg V-cycle %d / %d, block Jacobi "
+      "%d / %d\n",
+      amg8, amg16, v8, v16, jacobi8, jacobi16);
   EXPECT_LE(amg16, 1.3 * amg8);
   EXPECT_LT(amg16, jacobi16);
+  EXPECT_LT(v16, jacobi16);
   EXPECT_GT(jacobi16, 1.5 * jacobi8);
 }
 
