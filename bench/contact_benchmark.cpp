@@ -1,8 +1,9 @@
 // Broad and narrow phase of body-body contact (docs/contact.md, "What contact costs"): two n^3
 // cubes side by side, their facing layers overlapping by 1 % of the contact distance (n^2
 // contact pairs), one BodyContact::resolve per iteration on a fresh copy of the state (the copy
-// is not timed), alone or after the collision phase (BodyContact::collide). Counters: particles, pairs, ns per particle, and the broad phase alone.
-// Run on one core: taskset -c 0 build/bench/jelly_contact_benchmark (the manual times and the
+// is not timed), alone or after the collision phase (BodyContact::collide). Counters: particles,
+// pairs, ns per particle, and the broad phase alone. Run on one core: taskset -c 0
+// build/bench/jelly_contact_benchmark (the manual times and the
 // *_ms counters are wall clock; on a shared machine read the CPU column).
 #include <chrono>
 #include <cstdio>

@@ -206,8 +206,9 @@ void BodyContact::collide(const Model& model, const State& state, Real h) {
   reach_.resize(n);
   padded_.resize(n);
   for (int i = 0; i < n; ++i) {
-    reach_[i] = radius_[i] > 0 ? kCollideShare * radius_[i] + 2 * h * particle(state.v, i).norm() + fall
-                               : 0;
+    reach_[i] = radius_[i] > 0
+                    ? kCollideShare * radius_[i] + 2 * h * particle(state.v, i).norm() + fall
+                    : 0;
     padded_[i] = radius_[i] + reach_[i];
   }
   if (padded_.allFinite()) {

@@ -56,8 +56,8 @@ struct BodyContactParams {
 class BodyContact {
  public:
   struct Stats {
-    long pairs = 0;    // contact pairs resolved, summed over the steps
-    long limited = 0;  // steps whose projection was limited to keep the energy (translations)
+    long pairs = 0;     // contact pairs resolved, summed over the steps
+    long limited = 0;   // steps whose projection was limited to keep the energy (translations)
     long collided = 0;  // steps whose pairs came from collide()'s set
     long searched = 0;  // steps that searched again (no collide(), or a particle beyond its reach)
     double broad_seconds = 0;   // time in the broad phase

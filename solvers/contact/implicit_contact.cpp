@@ -209,9 +209,8 @@ bool ImplicitContact::begin_step(const Model& model, const Terrains& terrains, c
     Contact& old = contacts_[ci];
     if (old.pinned || old.release || old.particle >= np) continue;
     if (!terrain_index_.empty()) {
-      old.terrain = old.terrain < static_cast<int>(terrain_index_.size())
-                        ? terrain_index_[old.terrain]
-                        : -1;
+      old.terrain =
+          old.terrain < static_cast<int>(terrain_index_.size()) ? terrain_index_[old.terrain] : -1;
     }
     if (old.terrain < 0 || old.terrain >= static_cast<int>(terrains.size())) continue;
     slot_[old.particle] = ci;

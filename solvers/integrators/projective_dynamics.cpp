@@ -184,10 +184,9 @@ void ProjectiveDynamics::set_anchor_weights(const Dynamics& dynamics, const Stat
   for (const ForceJacobian::Block& b : jacobian_.blocks()) {
     if (b.i != b.j) continue;
     const Mat3 stiffness = -(b.dfdx + b.dfdv / h);
-    const Real largest =
-        Eigen::SelfAdjointEigenSolver<Mat3>(0.5 * (stiffness + stiffness.transpose()),
-                                            Eigen::EigenvaluesOnly)
-            .eigenvalues()[2];
+    const Real largest = Eigen::SelfAdjointEigenSolver<Mat3>(
+                             0.5 * (stiffness + stiffness.transpose()), Eigen::EigenvaluesOnly)
+                             .eigenvalues()[2];
     if (largest > 0) add(b.i, std::exp2(std::ceil(std::log2(largest))));
   }
 }

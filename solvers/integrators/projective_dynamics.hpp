@@ -106,7 +106,7 @@ class ProjectiveDynamics final : public Integrator {
   std::vector<Real> penalty_;        // [N]: what the factor holds beyond A (anchors, contacts)
   std::vector<Real> anchor_weight_;  // [N]: k + c / h of the anchor springs
   std::vector<int> anchored_;
-  ForceJacobian jacobian_;  // the added forces' blocks at the step's start
+  ForceJacobian jacobian_;    // the added forces' blocks at the step's start
   std::vector<char> pinned_;  // [N]
   std::vector<int> pinned_list_;
   std::vector<int> penalized_list_, rows_;

@@ -220,6 +220,12 @@ def make_sandbox(source, build):
     os.symlink(build, os.path.join(root, "build"))
     os.makedirs(os.path.join(root, "out"))
     os.makedirs(os.path.join(root, "docs", "img"))
+    # The folders benchmarks write their CSV/JSON into (the sandbox's, not the committed ones).
+    bench = os.path.join(source, "docs", "bench")
+    if os.path.isdir(bench):
+        for name in os.listdir(bench):
+            if os.path.isdir(os.path.join(bench, name)):
+                os.makedirs(os.path.join(root, "docs", "bench", name))
     bin_dir = os.path.join(root, ".bin")
     os.makedirs(bin_dir)
     for name, rel in (("jelly", "cli/jelly"), ("jelly-bench", "bench/jelly-bench")):

@@ -407,7 +407,8 @@ TEST(LiveModel, ARemovedTerrainMidRunEqualsARunThatNeverHadIt) {
   ASSERT_EQ(edited.state().x, never.state().x);
   Real lowest = 1;  // the cube rests on the slope at the removal
   for (int i = 0; i < never.model().num_particles(); ++i)
-    lowest = std::min(lowest, never.terrains()[0]->signed_distance(particle(never.state().x, i), 0.6));
+    lowest =
+        std::min(lowest, never.terrains()[0]->signed_distance(particle(never.state().x, i), 0.6));
   ASSERT_LT(lowest, 1e-6);
   edited.remove_terrain(0);
   edited.run_until(0.9);
