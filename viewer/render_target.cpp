@@ -189,8 +189,8 @@ void RenderTarget::bind() {
 
 void RenderTarget::resolve() {
   if (fxaa_) {
-    // FXAA costs about what 4x multisampling does per pixel on llvmpipe: it runs only where
-    // silhouettes are, the rest is copied.
+    // FXAA runs only over the rectangle that holds the silhouettes (its cost per pixel is
+    // measured in docs/viewer.md); the rest is copied.
     const auto [x0, y0, x1, y1] = fxaa_rect_;
     const bool whole = x0 <= 0 && y0 <= 0 && x1 >= width_ && y1 >= height_;
     if (!whole) {
