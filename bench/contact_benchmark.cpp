@@ -12,6 +12,7 @@
 #include <benchmark/benchmark.h>
 
 #include <jelly/jelly.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/contact/broad_phase.hpp>
 #include <jelly/terrain/mesh_obstacle.hpp>
 

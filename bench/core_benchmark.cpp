@@ -10,6 +10,7 @@
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/jelly.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
 #include <jelly/terrain/plane.hpp>
 

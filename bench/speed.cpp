@@ -13,6 +13,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/io/scene.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly::bench {

@@ -7,8 +7,7 @@
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/body_contact_params.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {

@@ -7,6 +7,7 @@
 #include <jelly/io/detail/checkpoint_h5.hpp>
 #include <jelly/io/detail/h5.hpp>
 #include <jelly/io/detail/json_parse.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 
 namespace jelly {
 

@@ -8,6 +8,8 @@
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/detail/team_chooser.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
@@ -26,7 +28,9 @@ Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integ
     : model_(std::move(model)),
       state_(std::move(state)),
       integrator_(std::move(integrator)),
-      options_(options) {
+      options_(options),
+      contacts_(std::make_unique<ContactSolver>()),
+      body_contact_(std::make_unique<BodyContact>()) {
   model_.validate();
   options_.validate();
   bands_ = std::make_unique<const SpringBands>(model_);
@@ -40,6 +44,9 @@ Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integ
 Simulator::~Simulator() = default;
 Simulator::Simulator(Simulator&&) noexcept = default;
 Simulator& Simulator::operator=(Simulator&&) noexcept = default;
+
+const ContactSolver& Simulator::contacts() const { return *contacts_; }
+const BodyContact& Simulator::body_contact() const { return *body_contact_; }
 
 void Simulator::check_terrain(const Terrain* terrain, size_t index) const {
   require(terrain != nullptr, "terrain", "null", "a terrain");
@@ -187,10 +194,10 @@ void Simulator::model_changed() {
 }
 
 void Simulator::set_body_contact(const BodyContactParams& params) {
-  body_contact_ = BodyContact(params);
+  *body_contact_ = BodyContact(params);
 }
 
-void Simulator::check_no_overlap() { body_contact_.check_no_overlap(model_, state_.x); }
+void Simulator::check_no_overlap() { body_contact_->check_no_overlap(model_, state_.x); }
 
 void Simulator::set_threads(int threads) {
   require(threads >= 0, "threads", threads, "an integer >= 0 (0 = all cores)");
@@ -325,15 +332,15 @@ void Simulator::set_state(State state) {
   require(state.x.size() == model_.num_dofs() && state.v.size() == model_.num_dofs(),
           "state.x.size", state.x.size(), "3 x the number of particles");
   assign_state(state_, state);
-  contacts_.clear();
+  contacts_->clear();
   next_output_ = state_.t;
   frames_ = 0;
 }
 
 SimulatorSnapshot Simulator::snapshot() const {
   SimulatorSnapshot s{state_,
-                      contacts_.seed_contacts(),
-                      contacts_.contact_count(),
+                      contacts_->seed_contacts(),
+                      contacts_->contact_count(),
                       total_steps_,
                       next_output_,
                       integrator_->internal_state(),
@@ -378,7 +385,7 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
   }
   integrator_->restore_internal_state(snapshot.integrator_state);
   assign_state(state_, s);
-  contacts_.restore(std::move(snapshot.seed_contacts), snapshot.contact_count);
+  contacts_->restore(std::move(snapshot.seed_contacts), snapshot.contact_count);
   total_steps_ = snapshot.total_steps;
   next_output_ = snapshot.next_output;
   frames_ = 0;
@@ -410,9 +417,9 @@ int Simulator::step_threads() {
 StepResult Simulator::step() {
   const auto start = std::chrono::steady_clock::now();
   const int threads = step_threads();
-  const bool bodies = body_contact_.active(model_);
-  const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_, threads,
-                          bodies ? &body_contact_ : nullptr, &forces_);
+  const bool bodies = body_contact_->active(model_);
+  const Dynamics dynamics(model_, *contacts_, &terrains_, bands_.get(), &anchors_, threads,
+                          bodies ? body_contact_.get() : nullptr, &forces_);
   parallel::copy(threads, state_.x, before_.x);
   parallel::copy(threads, state_.v, before_.v);
   before_.t = state_.t;
@@ -429,7 +436,7 @@ StepResult Simulator::step() {
   }
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
-  finish_step(result, contacts_, bodies ? &body_contact_ : nullptr, model_, terrains_, before_,
+  finish_step(result, *contacts_, bodies ? body_contact_.get() : nullptr, model_, terrains_, before_,
               state_, options_.dt, threads);
   ++total_steps_;
   if (team_ && options_.threads == 0)
@@ -510,8 +517,8 @@ RunReport Simulator::run_until(Real t_end) {
   note_forces(report);
   report.statistics = integrator_->statistics();
   report_crushed_bodies(model_, state_.x, options_.crush, report);
-  if (body_contact_.active(model_)) {
-    const BodyContact::Stats& b = body_contact_.stats();
+  if (body_contact_->active(model_)) {
+    const BodyContact::Stats& b = body_contact_->stats();
     report.statistics["body_contact_pairs"] = static_cast<double>(b.pairs);
     report.statistics["body_contact_energy_limited"] = static_cast<double>(b.limited);
     report.statistics["broad_phase_ms"] = 1e3 * b.broad_seconds;

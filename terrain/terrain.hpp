@@ -46,4 +46,7 @@ class Terrain {
   ContactParams contact_;
 };
 
+// A scene's terrains, in order (indices name them in messages and snapshots).
+using Terrains = std::vector<std::unique_ptr<Terrain>>;
+
 }  // namespace jelly

@@ -8,6 +8,7 @@
 #include <jelly/core/measures.hpp>
 #include <jelly/io/run_limits.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/detail/run_fields.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
 #include <jelly/solvers/integrators/registry.hpp>

@@ -18,6 +18,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>

@@ -8,6 +8,7 @@
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/external_force.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 
 namespace jelly::arkode {
 

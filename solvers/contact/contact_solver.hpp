@@ -21,8 +21,6 @@
 
 namespace jelly {
 
-using Terrains = std::vector<std::unique_ptr<Terrain>>;
-
 class ContactSolver {
  public:
   // A contact carried into the next step (the seed model's): it gets the contact and friction

@@ -5,6 +5,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {

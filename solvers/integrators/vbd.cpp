@@ -5,6 +5,7 @@
 
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 #include <jelly/terrain/terrain.hpp>

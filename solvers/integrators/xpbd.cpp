@@ -8,6 +8,7 @@
 
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/contact/detail/position_contact.hpp>
 
 namespace jelly {

@@ -16,6 +16,7 @@
 #include <jelly/core/measures.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/elevator.hpp>
 #include <jelly/terrain/plane.hpp>

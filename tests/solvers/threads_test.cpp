@@ -10,6 +10,7 @@
 #include <jelly/core/forces.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/plane.hpp>

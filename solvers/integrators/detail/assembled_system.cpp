@@ -4,6 +4,7 @@
 
 #include <jelly/core/detail/anchor_jacobian.hpp>
 #include <jelly/core/detail/clock.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/linear/cg_solver.hpp>
 #include <jelly/solvers/linear/cholmod_solver.hpp>

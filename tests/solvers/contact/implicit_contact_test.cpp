@@ -11,6 +11,7 @@
 #include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>

@@ -7,6 +7,7 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/obstacle.hpp>
 

@@ -11,6 +11,8 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/projective_dynamics.hpp>
 #include <jelly/solvers/integrators/registry.hpp>

@@ -10,6 +10,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/contact_solver.hpp>
 #include <jelly/solvers/integrators/detail/vertex_colouring.hpp>
 #include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
