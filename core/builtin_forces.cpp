@@ -1,7 +1,7 @@
 #include <jelly/core/builtin_forces.hpp>
 
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/core/external_force.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/core/forces.hpp>
 
 namespace jelly {

@@ -7,7 +7,6 @@
 #include <memory>
 #include <vector>
 
-#include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 
@@ -52,7 +51,7 @@ class ExternalForces final : public Force {
   const Model* model_;
 };
 
-// Springs from particles to points (core/anchor_springs.hpp).
+// Springs from particles to points (core/force.hpp).
 class AnchorForce final : public Force {
  public:
   explicit AnchorForce(AnchorSprings anchors) : anchors_(std::move(anchors)) {}

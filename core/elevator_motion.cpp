@@ -1,4 +1,4 @@
-#include <jelly/core/elevator_motion.hpp>
+#include <jelly/core/pins.hpp>
 
 #include <cmath>
 #include <string>

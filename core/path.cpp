@@ -1,4 +1,4 @@
-#include <jelly/core/path.hpp>
+#include <jelly/core/pins.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,6 @@
 #include <string>
 
 #include <jelly/fit/spring_fit.hpp>
-#include <jelly/fit/trajectory.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/io/scene.hpp>
 

@@ -1,4 +1,4 @@
-#include <jelly/fit/trajectory.hpp>
+#include <jelly/fit/spring_fit.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/box.hpp>

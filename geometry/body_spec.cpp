@@ -5,7 +5,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 
 namespace jelly {
 

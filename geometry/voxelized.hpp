@@ -7,7 +7,6 @@
 #include <vector>
 
 #include <jelly/geometry/body_shape.hpp>
-#include <jelly/geometry/lattice.hpp>
 #include <jelly/geometry/mesh_io.hpp>
 #include <jelly/geometry/pose.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>

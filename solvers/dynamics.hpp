@@ -8,7 +8,6 @@
 // acceleration(), stage_acceleration(), added_force_jacobians(), model(), threads(). The
 // Simulator constructs it; the accessors of contact and the force loop's bands return types of
 // internal headers, for jelly's own methods.
-#include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/terrain/terrain.hpp>

@@ -14,9 +14,8 @@
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/body_contact_params.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
-#include <jelly/solvers/divergence_guard.hpp>
-#include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/run_report.hpp>
+#include <jelly/solvers/integrators/integrator.hpp>
 
 namespace jelly {
 

@@ -1,4 +1,4 @@
-#include <jelly/terrain/contact_params.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 #include <cmath>
 

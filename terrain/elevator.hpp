@@ -4,9 +4,9 @@
 // does not touch it and falls past.
 #include <string>
 
-#include <jelly/core/elevator_motion.hpp>
+#include <jelly/core/pins.hpp>
 #include <jelly/terrain/terrain.hpp>
-#include <jelly/terrain/terrain_spec.hpp>
+#include <jelly/terrain/terrain_kinds.hpp>
 
 namespace jelly {
 

@@ -10,12 +10,12 @@
 #include <string>
 #include <string_view>
 
-#include <jelly/core/path.hpp>
+#include <jelly/core/pins.hpp>
 #include <jelly/geometry/mesh_distance.hpp>
 #include <jelly/geometry/pose.hpp>
 #include <jelly/terrain/obstacle_motion.hpp>
 #include <jelly/terrain/terrain.hpp>
-#include <jelly/terrain/terrain_spec.hpp>
+#include <jelly/terrain/terrain_kinds.hpp>
 
 namespace jelly {
 

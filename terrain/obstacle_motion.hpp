@@ -6,7 +6,7 @@
 
 #include <Eigen/Geometry>
 
-#include <jelly/core/path.hpp>
+#include <jelly/core/pins.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {

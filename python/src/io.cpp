@@ -11,7 +11,6 @@
 #include <jelly/io/rollout.hpp>
 #include <jelly/io/run_limits.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/io/xdmf.hpp>
 
 #include "common.hpp"
 

@@ -16,7 +16,7 @@
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/external_force.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/contact/body_contact.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>

@@ -4,7 +4,6 @@
 #include <string>
 
 #include <jelly/core/detail/field_table.hpp>
-#include <jelly/core/enum_names.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
 #include <jelly/solvers/arkode/arkode_dirk.hpp>

@@ -5,7 +5,7 @@
 // Jacobian ("klu"). Each step() integrates adaptively over the Simulator's dt (docs/arkode.md).
 #include <memory>
 
-#include <jelly/solvers/arkode/arkode_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 
 namespace jelly {

@@ -4,7 +4,7 @@
 // over the Simulator's dt, the contact-check interval (docs/arkode.md).
 #include <memory>
 
-#include <jelly/solvers/arkode/arkode_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 
 namespace jelly {

@@ -6,7 +6,7 @@
 #include <arkode/arkode_arkstep.h>
 
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/core/external_force.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/core/forces.hpp>
 #include <jelly/solvers/contact/contact_solver.hpp>
 

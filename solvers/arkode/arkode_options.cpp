@@ -1,4 +1,4 @@
-#include <jelly/solvers/arkode/arkode_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 #include <cmath>
 

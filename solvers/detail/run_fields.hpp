@@ -2,7 +2,6 @@
 // The field tables of a run's limits (core/detail/field_table.hpp): the scene's divergence and
 // crush objects, declared in divergence_guard.cpp and run_report.cpp.
 #include <jelly/core/detail/field_table.hpp>
-#include <jelly/solvers/divergence_guard.hpp>
 #include <jelly/solvers/run_report.hpp>
 
 namespace jelly {

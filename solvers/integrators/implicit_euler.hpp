@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include <jelly/solvers/integrators/implicit_euler_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 
 namespace jelly {

@@ -15,7 +15,7 @@
 
 #include <jelly/core/sparse_matrix.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
-#include <jelly/solvers/integrators/projective_dynamics_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 

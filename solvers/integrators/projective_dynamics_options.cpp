@@ -1,4 +1,4 @@
-#include <jelly/solvers/integrators/projective_dynamics_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>

@@ -12,7 +12,7 @@
 
 #include <jelly/solvers/integrators/detail/vertex_colouring.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
-#include <jelly/solvers/integrators/vbd_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include <jelly/solvers/integrators/integrator.hpp>
-#include <jelly/solvers/integrators/xpbd_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 

@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include <jelly/solvers/linear/cholmod_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/linear/linear_solver.hpp>
 
 namespace jelly {

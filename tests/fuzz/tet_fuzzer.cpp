@@ -8,7 +8,7 @@
 #include <string>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/lattice.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/geometry/tet_mesh_io.hpp>
 #include <jelly/geometry/tetmesh.hpp>
 

@@ -10,7 +10,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/box.hpp>
 #include <jelly/geometry/cloth.hpp>

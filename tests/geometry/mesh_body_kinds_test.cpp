@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/json.hpp>
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/mesh_io.hpp>
 #include <jelly/geometry/tet_mesh_io.hpp>

@@ -56,7 +56,7 @@ TEST(SceneRealtimeOptions, BadOptionsNameTheirPath) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::StartsWith("integrator.options.substeps = 0 is invalid"));
   }
-  // Named choices come from their enum tables (core/enum_names.hpp): the message lists them.
+  // Named choices come from their enum tables (core/errors.hpp): the message lists them.
   try {
     parse_scene(kScene,
                 {"integrator.name=projective_dynamics", "integrator.options.contact=\"implicit\""});

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/core/external_force.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>

@@ -406,7 +406,7 @@ TEST(Arkode, BadOptionsNameTheField) {
   EXPECT_EQ(ArkodeDirk(o).order(), 4);
 }
 
-// The named choices are tables (core/enum_names.hpp): every method of the tables builds its
+// The named choices are tables (core/errors.hpp): every method of the tables builds its
 // integrator with the order its name ends with, an unknown name is refused with the table's
 // names, and the scene's linear_solver is read and written through its table (default "auto").
 TEST(Arkode, MethodsAndLinearSolversAreTables) {

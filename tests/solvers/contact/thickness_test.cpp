@@ -16,7 +16,7 @@
 #include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/contact_params.hpp>
+#include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/obstacle.hpp>
 #include <jelly/terrain/plane.hpp>
 
