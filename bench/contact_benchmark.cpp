@@ -12,9 +12,9 @@
 #include <benchmark/benchmark.h>
 
 #include <jelly/jelly.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
-#include <jelly/solvers/contact/broad_phase.hpp>
-#include <jelly/terrain/mesh_obstacle.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/broad_phase.hpp>
+#include <jelly/terrain/detail/mesh_obstacle.hpp>
 
 namespace {
 

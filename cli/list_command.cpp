@@ -3,7 +3,7 @@
 
 #include <jelly/core/components.hpp>
 #include <jelly/geometry/body_shape.hpp>
-#include <jelly/geometry/tetrahedralize.hpp>
+#include <jelly/geometry/detail/tetrahedralize.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>

@@ -1,7 +1,7 @@
 #pragma once
 // Forces as plugins: a Force adds its forces at (t, x, v) at every force evaluation of every
 // integrator, and may give its Jacobians df/dx and df/dv as 3x3 blocks, which implicit_euler
-// takes into its solve. A user's force and jelly's own (core/builtin_forces.hpp) are peers.
+// takes into its solve. A user's force and jelly's own (core/detail/builtin_forces.hpp) are peers.
 #include <memory>
 #include <string>
 #include <string_view>

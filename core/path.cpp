@@ -4,8 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 
 namespace jelly {
 

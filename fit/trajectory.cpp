@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/fit/detail/implicit_euler_ceres.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/body_shape.hpp>
 
 namespace jelly {

@@ -1,11 +1,11 @@
 #include <jelly/solvers/dynamics.hpp>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/core/forces.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 namespace jelly {
 

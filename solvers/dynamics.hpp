@@ -14,9 +14,9 @@
 
 namespace jelly {
 
-class SpringBands;  // core/detail/spring_bands.hpp: the Simulator's vectorised force loop
-class BodyContact;    // solvers/contact/body_contact.hpp
-class ContactSolver;  // solvers/contact/contact_solver.hpp
+class SpringBands;    // core/detail/spring_bands.hpp: the Simulator's vectorised force loop
+class BodyContact;    // solvers/contact/detail/body_contact.hpp
+class ContactSolver;  // solvers/contact/detail/contact_solver.hpp
 
 class Dynamics {
  public:

@@ -8,8 +8,8 @@
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/detail/team_chooser.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
@@ -436,8 +436,8 @@ StepResult Simulator::step() {
   }
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
-  finish_step(result, *contacts_, bodies ? body_contact_.get() : nullptr, model_, terrains_, before_,
-              state_, options_.dt, threads);
+  finish_step(result, *contacts_, bodies ? body_contact_.get() : nullptr, model_, terrains_,
+              before_, state_, options_.dt, threads);
   ++total_steps_;
   if (team_ && options_.threads == 0)
     team_->record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -482,7 +482,8 @@ void Simulator::note_forces(RunReport& report) {
 RunReport Simulator::run_until(Real t_end) {
   require(std::isfinite(t_end), "t_end", t_end, "a finite time");
   // A step or output interval lost to rounding at the run's largest time (t + h == t) would loop
-  // forever. (io/run_limits.hpp checks a whole run's step and frame counts before it starts.)
+  // forever. (io/detail/run_limits.hpp checks a whole run's step and frame counts before it
+  // starts.)
   const Real largest = std::max(std::abs(state_.t), std::abs(t_end));
   require(state_.t >= t_end - 0.5 * options_.dt || largest + options_.dt > largest, "integrator.dt",
           options_.dt, "a step not lost to rounding at t = " + to_text(largest));

@@ -6,9 +6,9 @@
 #include <utility>
 #include <vector>
 
+#include <jelly/core/detail/sparse_matrix.hpp>
 #include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/core/sparse_matrix.hpp>
 
 namespace jelly {
 

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/fit/detail/implicit_euler_ceres.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {

@@ -4,10 +4,10 @@
 #include <optional>
 #include <vector>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/force.hpp>
-#include <jelly/core/model.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/core/pins.hpp>
 #include <jelly/core/state.hpp>
 

@@ -5,10 +5,10 @@
 
 #include <arkode/arkode_arkstep.h>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/core/forces.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 namespace jelly::arkode {
 

@@ -5,13 +5,13 @@
 #include <string_view>
 #include <vector>
 
-#include <jelly/core/force.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 
-// What CHOLMOD is asked to do (solvers/linear/cholmod_solver.hpp does it): the options of the
-// integrators that factorize with it, apart from the solver, so that naming them does not bring
+// What CHOLMOD is asked to do (solvers/linear/detail/cholmod_solver.hpp does it): the options of
+// the integrators that factorize with it, apart from the solver, so that naming them does not bring
 // in the sparse matrices.
 namespace jelly {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/io/detail/field_reference.hpp>
 #include <jelly/io/scene.hpp>
 

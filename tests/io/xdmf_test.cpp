@@ -19,7 +19,7 @@
 #include <jelly/geometry/triangle_mesh.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/terrain.hpp>
 
 #include "io/io_support.hpp"

@@ -8,7 +8,7 @@
 #include <string_view>
 
 #include <jelly/core/pins.hpp>
-#include <jelly/terrain/obstacle_motion.hpp>
+#include <jelly/terrain/detail/obstacle_motion.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 

@@ -30,7 +30,7 @@
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/body_contact_params.hpp>
-#include <jelly/solvers/contact/broad_phase.hpp>
+#include <jelly/solvers/contact/detail/broad_phase.hpp>
 
 namespace jelly {
 

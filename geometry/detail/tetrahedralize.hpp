@@ -3,7 +3,7 @@
 // `jelly mesh IN.stl -o OUT.msh` does.
 #include <string>
 
-#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 
 namespace jelly {

@@ -13,7 +13,7 @@
 #include <memory>
 #include <vector>
 
-#include <jelly/core/sparse_matrix.hpp>
+#include <jelly/core/detail/sparse_matrix.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 

@@ -4,7 +4,7 @@
 #include <array>
 
 #include <jelly/geometry/body_shape.hpp>
-#include <jelly/geometry/pose.hpp>
+#include <jelly/geometry/detail/pose.hpp>
 
 namespace jelly {
 

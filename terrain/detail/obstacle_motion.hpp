@@ -1,7 +1,7 @@
 #pragma once
-// The rigid motion of an obstacle (terrain/obstacle.hpp, terrain/mesh_obstacle.hpp): its origin
-// at `position` plus a prescribed path's offset at time t, its orientation the initial rotation
-// spun about the origin at a constant angular velocity.
+// The rigid motion of an obstacle (terrain/detail/obstacle.hpp, terrain/detail/mesh_obstacle.hpp):
+// its origin at `position` plus a prescribed path's offset at time t, its orientation the initial
+// rotation spun about the origin at a constant angular velocity.
 #include <string>
 
 #include <Eigen/Geometry>

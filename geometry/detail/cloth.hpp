@@ -4,7 +4,7 @@
 // spring pattern in the plane: structural to the u and v neighbours, shear along both cell
 // diagonals, bending to the neighbours at distance 2.
 #include <jelly/geometry/body_shape.hpp>
-#include <jelly/geometry/pose.hpp>
+#include <jelly/geometry/detail/pose.hpp>
 
 namespace jelly {
 

@@ -3,17 +3,17 @@
 // turned and placed like a voxelized body, as an exact signed distance (geometry/mesh_distance:
 // the nearest point through a tree over the triangles, the sign from the nearest feature's
 // angle-weighted pseudo-normal). Like the other obstacles it may move along a prescribed path
-// and spin about its origin (terrain/obstacle_motion.hpp); the surface velocity at a contact is
-// the rigid motion's at the nearest surface point.
+// and spin about its origin (terrain/detail/obstacle_motion.hpp); the surface velocity at a contact
+// is the rigid motion's at the nearest surface point.
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
 
 #include <jelly/core/pins.hpp>
-#include <jelly/geometry/mesh_distance.hpp>
-#include <jelly/geometry/pose.hpp>
-#include <jelly/terrain/obstacle_motion.hpp>
+#include <jelly/geometry/detail/mesh_distance.hpp>
+#include <jelly/geometry/detail/pose.hpp>
+#include <jelly/terrain/detail/obstacle_motion.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 

@@ -4,8 +4,8 @@
 // over the Simulator's dt, the contact-check interval (docs/arkode.md).
 #include <memory>
 
-#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 

@@ -8,8 +8,8 @@
 #include <memory>
 #include <vector>
 
-#include <jelly/solvers/linear/cholmod_solver.hpp>
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 

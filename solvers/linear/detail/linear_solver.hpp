@@ -5,7 +5,7 @@
 #include <string>
 #include <string_view>
 
-#include <jelly/core/sparse_matrix.hpp>
+#include <jelly/core/detail/sparse_matrix.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {

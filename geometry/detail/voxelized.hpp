@@ -7,8 +7,8 @@
 #include <vector>
 
 #include <jelly/geometry/body_shape.hpp>
-#include <jelly/geometry/mesh_io.hpp>
-#include <jelly/geometry/pose.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
+#include <jelly/geometry/detail/pose.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 
 namespace jelly {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include <jelly/solvers/integrators/integrator_options.hpp>
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 

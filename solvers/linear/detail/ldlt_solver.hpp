@@ -3,7 +3,7 @@
 // reference backend. A non-positive pivot D_ii is reported as kNotPositiveDefinite.
 #include <Eigen/SparseCholesky>
 
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 

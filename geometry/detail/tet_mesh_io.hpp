@@ -3,7 +3,7 @@
 // MSH 2.2 and 4.1, binary 4.1) and TetGen .node/.ele.
 #include <string>
 
-#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
 
 namespace jelly {
 

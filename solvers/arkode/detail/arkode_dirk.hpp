@@ -5,8 +5,8 @@
 // Jacobian ("klu"). Each step() integrates adaptively over the Simulator's dt (docs/arkode.md).
 #include <memory>
 
-#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 
