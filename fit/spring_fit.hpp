@@ -15,6 +15,7 @@
 #include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/contact/body_contact_params.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 // A recorded trajectory of a jelly (frames of positions, optionally velocities) together with
 // everything needed to replay it: the model's structure, the terrains and the integrator and dt.
