@@ -11,6 +11,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <jelly/geometry/detail/mesh_io.hpp>
 #include <jelly/jelly.hpp>
 #include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/contact/detail/broad_phase.hpp>
