@@ -6,7 +6,7 @@
 #include <string>
 
 #include <jelly/jelly.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 int main(int argc, char** argv) {

@@ -34,7 +34,7 @@
 #include <jelly/bench/run_info.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/obstacle.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly::bench {

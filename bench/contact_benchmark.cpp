@@ -12,9 +12,11 @@
 
 #include <benchmark/benchmark.h>
 
+#include <jelly/geometry/detail/mesh_io.hpp>
 #include <jelly/jelly.hpp>
-#include <jelly/solvers/contact/broad_phase.hpp>
-#include <jelly/terrain/mesh_obstacle.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/broad_phase.hpp>
+#include <jelly/terrain/detail/mesh_obstacle.hpp>
 
 namespace {
 

@@ -6,11 +6,12 @@
 #include <vector>
 
 #include <jelly/core/detail/band_system.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/jelly.hpp>
-#include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace {
@@ -229,7 +230,7 @@ BENCHMARK(BM_MatrixFreeAssembly)
     ->UseRealTime();
 
 // A solve of 100 iterations of implicit_euler's matrix-free block-Jacobi CG
-// (solvers/linear/cg_solver.hpp) on the same system from x = 0: 101 products (the starting
+// (solvers/linear/detail/cg_solver.hpp) on the same system from x = 0: 101 products (the starting
 // residual's and one per iteration) plus CG's vector operations, ordered sums and
 // preconditioner; s_per_cg_iteration is the solve's time / 100. Arguments n, the threads, single
 // precision and whole rows (as BM_MatrixFreeProduct).

@@ -8,9 +8,12 @@
 
 #include <benchmark/benchmark.h>
 
-#include <jelly/geometry/tet_mesh_io.hpp>
-#include <jelly/geometry/voxelized.hpp>
-#include <jelly/geometry/winding_number.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
+#include <jelly/geometry/detail/pose.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
+#include <jelly/geometry/detail/voxelized.hpp>
+#include <jelly/geometry/detail/winding_number.hpp>
 #include <jelly/jelly.hpp>
 
 namespace {

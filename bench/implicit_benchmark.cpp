@@ -13,14 +13,14 @@
 #include <random>
 #include <tuple>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/solvers/linear/cg_solver.hpp>
-#include <jelly/solvers/linear/cholmod_solver.hpp>
-#include <jelly/solvers/linear/ldlt_solver.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
+#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/ldlt_solver.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/plane.hpp>
 

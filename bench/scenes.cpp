@@ -2,11 +2,11 @@
 
 #include <cmath>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly::bench {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include <jelly/solvers/simulator.hpp>
-#include <jelly/terrain/contact_params.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 namespace jelly::bench {
 

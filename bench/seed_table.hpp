@@ -12,7 +12,7 @@
 #include <jelly/bench/shard.hpp>
 #include <jelly/bench/table.hpp>
 #include <jelly/core/types.hpp>
-#include <jelly/terrain/contact_params.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 namespace jelly::bench {
 

@@ -7,12 +7,13 @@
 #include <jelly/bench/memory.hpp>
 #include <jelly/bench/scenes.hpp>
 #include <jelly/bench/stability_region.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/detail/team_chooser.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/io/scene.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly::bench {

@@ -4,6 +4,7 @@
 #include <complex>
 #include <vector>
 
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/dynamics.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 

@@ -9,9 +9,9 @@
 #include <cstring>
 
 #include <jelly/core/detail/file_replacement.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
-#include <jelly/fit/recording_trajectory.hpp>
+#include <jelly/fit/detail/recording_trajectory.hpp>
 #include <jelly/fit/spring_fit.hpp>
 #include <jelly/io/recording.hpp>
 

@@ -2,10 +2,10 @@
 #include <string>
 
 #include <jelly/core/components.hpp>
-#include <jelly/geometry/body_kinds.hpp>
-#include <jelly/geometry/tetrahedralize.hpp>
+#include <jelly/geometry/body_shape.hpp>
+#include <jelly/geometry/detail/tetrahedralize.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/contact_params.hpp>
+#include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
 #include "commands.hpp"

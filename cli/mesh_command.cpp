@@ -4,9 +4,9 @@
 #include <filesystem>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/mesh_io.hpp>
-#include <jelly/geometry/tet_mesh_io.hpp>
-#include <jelly/geometry/tetrahedralize.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
+#include <jelly/geometry/detail/tetrahedralize.hpp>
 
 #include "commands.hpp"
 #include "exit_codes.hpp"

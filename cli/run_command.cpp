@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/io/run_limits.hpp>
+#include <jelly/io/detail/run_limits.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 #include "commands.hpp"
 #include "exit_codes.hpp"

@@ -3,7 +3,6 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/io/h5_recorder.hpp>
-#include <jelly/io/xdmf.hpp>
 
 #include "commands.hpp"
 #include "exit_codes.hpp"

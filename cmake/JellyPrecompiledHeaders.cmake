@@ -1,5 +1,5 @@
 # Precompiled headers: the third-party headers nearly every source includes (Eigen, nlohmann's
-# JSON through <jelly/core/json.hpp>, the standard library; GoogleTest in the test programs,
+# JSON through <jelly/core/detail/json.hpp>, the standard library; GoogleTest in the test programs,
 # pybind11 in the Python module) are parsed once per target instead of once per source, which
 # shortens a build from nothing (what CI does; docs/fuzzing.md, "In CI"); most of what is left is
 # template instantiation and code generation.

@@ -1,4 +1,4 @@
-#include <jelly/core/anchor_springs.hpp>
+#include <jelly/core/force.hpp>
 
 #include <cmath>
 

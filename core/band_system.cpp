@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include <jelly/core/detail/band_kernels.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
-#include <jelly/core/forces.hpp>
 
 namespace jelly {
 

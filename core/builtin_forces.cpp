@@ -1,8 +1,8 @@
-#include <jelly/core/builtin_forces.hpp>
+#include <jelly/core/detail/builtin_forces.hpp>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/core/external_force.hpp>
-#include <jelly/core/forces.hpp>
+#include <jelly/core/model.hpp>
 
 namespace jelly {
 

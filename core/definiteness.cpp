@@ -1,4 +1,4 @@
-#include <jelly/core/definiteness.hpp>
+#include <jelly/core/force.hpp>
 
 namespace jelly {
 

@@ -1,10 +1,10 @@
-#include <jelly/core/elevator_motion.hpp>
+#include <jelly/core/pins.hpp>
 
 #include <cmath>
 #include <string>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 
 namespace jelly {
 

@@ -1,11 +1,13 @@
 #pragma once
 // Forces as plugins: a Force adds its forces at (t, x, v) at every force evaluation of every
 // integrator, and may give its Jacobians df/dx and df/dv as 3x3 blocks, which implicit_euler
-// takes into its solve. A user's force and jelly's own (core/builtin_forces.hpp) are peers.
+// takes into its solve. A user's force and jelly's own (core/detail/builtin_forces.hpp) are peers.
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include <jelly/core/errors.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {
@@ -73,5 +75,46 @@ struct JacobianCheck {
 };
 JacobianCheck check_force_jacobian(const Force& force, Real t, const VecX& x, const VecX& v,
                                    Real step = 1e-6);
+
+}  // namespace jelly
+
+// Springs from particles to points in space: pulls from outside the model (the viewer drags a
+// particle with one). Each acts on one particle, so its Jacobian is diagonal and the implicit
+// integrators add it to their matrix (core/detail/anchor_jacobian.hpp; an explicit treatment of
+// a stiff pull at a large step would be unstable).
+namespace jelly {
+
+struct AnchorSpring {
+  int particle = 0;
+  Vec3 target = Vec3::Zero();  // m
+  Real stiffness = 0;          // k, N/m, >= 0
+  Real damping = 0;            // c, N s/m, >= 0, on the particle's own velocity
+};
+using AnchorSprings = std::vector<AnchorSpring>;
+
+// Throws InputError for a particle index outside [0, num_particles), a non-finite target or a
+// negative or non-finite coefficient.
+void validate_anchors(const AnchorSprings& anchors, int num_particles);
+
+// f_p += -k (x_p - target) - c v_p for every anchor. No allocation.
+void add_anchor_forces(const AnchorSprings& anchors, const VecX& x, const VecX& v, VecX& f);
+
+}  // namespace jelly
+
+// How the geometric (transverse) stiffness of a spring is kept from making -K indefinite
+// (docs/implicit.md): an option of the implicit integrators.
+namespace jelly {
+
+// Per spring, the symmetric part of -df_a/dxa is ks u u^T + s P, with P = I - u u^T,
+// s = ks (1 - l0/L) + kd c / L (c = (va - vb).u); it is negative for a compressed (or a closing)
+// spring.
+enum class DefinitenessFix {
+  kClampCompressed,  // Choi & Ko 2002: ks (1 - l0/L) and kd c/L each clamped to >= 0 (default)
+  kProjectPsd,       // the spring's 3x3 block projected to PSD: s clamped to >= 0
+  kNone,             // the exact symmetric Jacobian; M - h D - h^2 K may be indefinite
+};
+// "clamp", "project", "none".
+const std::vector<EnumName<DefinitenessFix>>& definiteness_fixes();
+std::string_view definiteness_name(DefinitenessFix fix);
 
 }  // namespace jelly

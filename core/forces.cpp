@@ -1,4 +1,4 @@
-#include <jelly/core/forces.hpp>
+#include <jelly/core/detail/forces.hpp>
 
 #include <cmath>
 

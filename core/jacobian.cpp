@@ -4,9 +4,9 @@
 #include <cmath>
 #include <utility>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/forces.hpp>
 
 namespace jelly {
 

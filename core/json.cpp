@@ -1,4 +1,4 @@
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 
 #include <algorithm>
 #include <cmath>

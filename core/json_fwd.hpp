@@ -1,8 +1,8 @@
 #pragma once
 // The names of jelly's JSON types without their definitions: all a header needs to declare a
-// function that reads or writes JSON (core/json.hpp says what they are). Keeping nlohmann's
+// function that reads or writes JSON (core/detail/json.hpp says what they are). Keeping nlohmann's
 // definitions out of the headers keeps them cheap to compile; a source that builds or reads
-// JSON includes core/json.hpp.
+// JSON includes core/detail/json.hpp.
 #include <nlohmann/json_fwd.hpp>
 
 namespace jelly {

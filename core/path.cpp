@@ -1,11 +1,11 @@
-#include <jelly/core/path.hpp>
+#include <jelly/core/pins.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 
 namespace jelly {
 

@@ -3,10 +3,144 @@
 // honours them exactly: their accelerations are the path's during a step, their positions and
 // velocities are set to the path's at its end (Integrator::step), and implicit methods make
 // them constraints of their solve.
+#include <string_view>
 #include <vector>
 
-#include <jelly/core/path.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
+
+// The vertical motion of the elevator as a function of time: a cycle of constant-acceleration
+// phases, each optionally ending in a dead stop, repeated forever. The seed cycle is
+// +3 m/s^2 for 2 s, dead stop, -3 m/s^2 for 2 s, dead stop.
+namespace jelly {
+
+struct MotionPhase {
+  Real duration = 2;        // s, > 0
+  Real acceleration = 3;    // m/s^2 along +y
+  bool stop_at_end = true;  // velocity drops to 0 when the phase ends
+};
+
+class ElevatorMotion {
+ public:
+  // No phases: the platform stays still. Throws InputError for a phase of non-positive duration
+  // or a cycle that does not end at rest (it could not repeat); the message names `field`
+  // (a scene passes its JSON path, "terrains[0].motion").
+  explicit ElevatorMotion(std::vector<MotionPhase> phases = {}, std::string_view field = "motion");
+  static ElevatorMotion seed();
+  // Scene JSON: "seed" or a list of phases [{"duration": 2, "acceleration": 3, "stop_at_end":
+  // true}, ...]. Throws InputError naming `path`.
+  static ElevatorMotion read(const Json& j, const std::string& path);
+  // The list of phases.
+  Json to_json() const;
+
+  // Height offset from the start, velocity and acceleration along +y at time t >= 0.
+  Real offset(Real t) const;
+  Real velocity(Real t) const;
+  Real acceleration(Real t) const;
+
+  const std::vector<MotionPhase>& phases() const { return phases_; }
+  Real period() const { return period_; }
+
+ private:
+  struct Sample {
+    Real offset, velocity, acceleration;
+  };
+  Sample sample(Real t) const;
+
+  std::vector<MotionPhase> phases_;
+  Real period_ = 0;
+  Real cycle_offset_ = 0;  // displacement over one cycle
+};
+
+}  // namespace jelly
+
+// A prescribed translation as a function of time, offset(0) = 0: what drives pinned particles
+// and moving obstacles. Fixed; the elevator's cycle of constant-acceleration phases along an
+// axis; keyframes joined by straight segments or by cubic segments with continuous velocity; a
+// sinusoidal oscillation; a circle; or a constant velocity (a controller's target).
+namespace jelly {
+
+enum class PathKind { kFixed, kPhases, kKeyframes, kOscillation, kCircle, kLinear };
+
+struct PathSample {
+  Vec3 offset = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  Vec3 acceleration = Vec3::Zero();
+};
+
+class Path {
+ public:
+  Path() = default;  // fixed
+  // The elevator's cycle along `axis` (a unit vector is not required; its length scales).
+  static Path phases(const Vec3& axis, ElevatorMotion cycle);
+  // Offsets at increasing times (the first time >= 0, offset 0 before it); linear between them,
+  // held after the last. Throws InputError naming `field` for unsorted times or sizes that differ.
+  static Path keyframes(std::vector<Real> times, std::vector<Vec3> offsets,
+                        std::string_view field = "keyframes");
+  // The same keyframes joined by cubic Hermite segments: the velocity at a keyframe is the
+  // slope between its neighbours (Catmull-Rom), 0 at the first and last keyframes and at t = 0
+  // (offset 0), so the velocity is continuous and the path starts and ends at rest.
+  static Path cubic_keyframes(std::vector<Real> times, std::vector<Vec3> offsets,
+                              std::string_view field = "keyframes");
+  // A circle about the point `center` (relative to where the path starts) and `axis`, one turn
+  // per `period` seconds, counter-clockwise about axis (right-hand rule); the radius is the
+  // distance from the start to the axis through center. Throws InputError naming `field` for a
+  // zero axis, a radius of 0, or a period that is not finite and > 0.
+  static Path circle(const Vec3& center, const Vec3& axis, Real period,
+                     std::string_view field = "circle");
+  // offset = velocity t (a target moving at a constant velocity; Simulator::set_pin_target).
+  static Path linear(const Vec3& velocity, std::string_view field = "linear");
+  // amplitude * (sin(2 pi f t + phase) - sin(phase)).
+  static Path oscillation(const Vec3& amplitude, Real frequency, Real phase = 0,
+                          std::string_view field = "oscillation");
+
+  // Scene JSON: "fixed"; {"kind": "phases", "axis": [0, 1, 0], "phases": [{"duration": 2,
+  // "acceleration": 3, "stop_at_end": true}, ...] or "seed"}; {"kind": "keyframes", "times":
+  // [...], "offsets": [[x, y, z], ...], "interpolation": "linear" or "cubic"}; {"kind":
+  // "oscillation", "amplitude": [x, y, z], "frequency": 1, "phase": 0}; {"kind": "circle",
+  // "center": [x, y, z], "axis": [x, y, z], "period": 2}; {"kind": "linear", "velocity": [x, y,
+  // z]}. Throws InputError naming `path`.
+  static Path read(const Json& j, const std::string& path);
+  Json to_json() const;
+
+  PathKind kind() const { return kind_; }
+  bool is_fixed() const { return kind_ == PathKind::kFixed; }
+  PathSample sample(Real t) const;
+
+  const Vec3& axis() const { return axis_; }
+  const ElevatorMotion& cycle() const { return cycle_; }
+  const std::vector<Real>& times() const { return times_; }
+  const std::vector<Vec3>& offsets() const { return offsets_; }
+  const Vec3& amplitude() const { return amplitude_; }
+  Real frequency() const { return frequency_; }
+  bool cubic() const { return cubic_; }
+  const Vec3& center() const { return center_; }
+  Real period() const { return period_; }
+  const Vec3& velocity() const { return velocity_; }
+  Real phase() const { return phase_; }
+
+ private:
+  PathSample sample_cubic(Real t) const;
+
+  PathKind kind_ = PathKind::kFixed;
+  Vec3 axis_ = Vec3::UnitY();
+  ElevatorMotion cycle_;
+  std::vector<Real> times_;
+  std::vector<Vec3> offsets_;
+  Vec3 amplitude_ = Vec3::Zero();
+  Real frequency_ = 0, phase_ = 0;
+  bool cubic_ = false;                          // keyframes: cubic Hermite segments
+  bool added_start_ = false;                    // cubic: (0, 0) was put before the first keyframe
+  std::vector<Vec3> tangents_;                  // cubic keyframes: velocity at each keyframe
+  Vec3 center_ = Vec3::Zero();                  // circle: centre relative to the start
+  Vec3 e1_ = Vec3::Zero(), e2_ = Vec3::Zero();  // circle: -center and axis x (-center)
+  Real period_ = 0;
+  Vec3 velocity_ = Vec3::Zero();  // linear
+};
+
+std::string_view path_kind_name(PathKind kind);
+
+}  // namespace jelly
 
 namespace jelly {
 

@@ -7,8 +7,8 @@
 #include <map>
 
 #include <jelly/core/detail/band_kernels.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
-#include <jelly/core/forces.hpp>
 
 namespace jelly {
 

@@ -1,4 +1,4 @@
-#include <jelly/core/springs.hpp>
+#include <jelly/core/model.hpp>
 
 namespace jelly {
 

@@ -1,4 +1,4 @@
-#include <jelly/core/surface.hpp>
+#include <jelly/core/model.hpp>
 
 #include <cmath>
 #include <string>

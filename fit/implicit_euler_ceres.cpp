@@ -1,4 +1,4 @@
-#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/fit/detail/implicit_euler_ceres.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -6,8 +6,8 @@
 
 #include <ceres/ceres.h>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {

@@ -1,4 +1,4 @@
-#include <jelly/fit/recording_trajectory.hpp>
+#include <jelly/fit/detail/recording_trajectory.hpp>
 
 #include <jelly/core/errors.hpp>
 #include <jelly/fit/spring_fit.hpp>

@@ -20,9 +20,9 @@
 
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/fit/detail/implicit_euler_ceres.hpp>
 #include <jelly/fit/detail/window_adjoint.hpp>
 #include <jelly/fit/detail/window_start.hpp>
-#include <jelly/fit/implicit_euler_ceres.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {

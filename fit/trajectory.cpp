@@ -1,11 +1,11 @@
-#include <jelly/fit/trajectory.hpp>
+#include <jelly/fit/spring_fit.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/fit/detail/implicit_euler_ceres.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {

@@ -1,11 +1,11 @@
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/box.hpp>
-#include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/geometry/tetmesh.hpp>
-#include <jelly/geometry/voxelized.hpp>
+#include <jelly/geometry/detail/box.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
+#include <jelly/geometry/detail/voxelized.hpp>
 
 namespace jelly {
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {

@@ -5,13 +5,11 @@
 #include <string>
 #include <vector>
 
-#include <jelly/core/external_force.hpp>
-#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/core/path.hpp>
+#include <jelly/core/json_fwd.hpp>
+#include <jelly/core/pins.hpp>
 #include <jelly/core/polymorphic_value.hpp>
 #include <jelly/geometry/body_shape.hpp>
-#include <jelly/geometry/lattice.hpp>
 
 namespace jelly {
 

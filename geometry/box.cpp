@@ -1,9 +1,9 @@
-#include <jelly/geometry/box.hpp>
+#include <jelly/geometry/detail/box.hpp>
 
 #include <cmath>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {

@@ -1,10 +1,10 @@
-#include <jelly/geometry/cloth.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
 
 #include <algorithm>
 #include <cmath>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {

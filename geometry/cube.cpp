@@ -2,8 +2,8 @@
 
 #include <cmath>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
 
 namespace jelly {

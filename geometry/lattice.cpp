@@ -1,4 +1,4 @@
-#include <jelly/geometry/lattice.hpp>
+#include <jelly/geometry/body_shape.hpp>
 
 #include <cmath>
 

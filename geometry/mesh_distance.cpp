@@ -1,4 +1,4 @@
-#include <jelly/geometry/mesh_distance.hpp>
+#include <jelly/geometry/detail/mesh_distance.hpp>
 
 #include <algorithm>
 #include <cmath>

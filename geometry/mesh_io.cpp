@@ -1,4 +1,4 @@
-#include <jelly/geometry/mesh_io.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -15,7 +15,7 @@
 #include <jelly/geometry/detail/mesh_file_reader.hpp>
 
 // The meshes component (assimp): the reader of .obj, .stl and .ply files behind read_mesh
-// (geometry/mesh_io.hpp), which does the checks before and after it.
+// (geometry/detail/mesh_io.hpp), which does the checks before and after it.
 namespace jelly {
 
 namespace {

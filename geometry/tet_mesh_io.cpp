@@ -1,4 +1,4 @@
-#include <jelly/geometry/tet_mesh_io.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,15 +1,15 @@
-#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
 #include <jelly/geometry/detail/mesh_file.hpp>
-#include <jelly/geometry/tet_mesh_io.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
 
 namespace jelly {
 

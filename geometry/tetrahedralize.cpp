@@ -1,4 +1,4 @@
-#include <jelly/geometry/tetrahedralize.hpp>
+#include <jelly/geometry/detail/tetrahedralize.hpp>
 
 #include <cmath>
 #include <sstream>
@@ -6,7 +6,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/detail/gmsh_plugin.hpp>
-#include <jelly/geometry/mesh_io.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
 
 namespace jelly {
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include <jelly/core/surface.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/core/types.hpp>
 
 namespace jelly {

@@ -1,4 +1,4 @@
-#include <jelly/geometry/voxelized.hpp>
+#include <jelly/geometry/detail/voxelized.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -6,10 +6,10 @@
 #include <cmath>
 #include <deque>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
-#include <jelly/geometry/winding_number.hpp>
+#include <jelly/geometry/detail/winding_number.hpp>
 
 namespace jelly {
 

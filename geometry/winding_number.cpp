@@ -1,4 +1,4 @@
-#include <jelly/geometry/winding_number.hpp>
+#include <jelly/geometry/detail/winding_number.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -2,11 +2,12 @@
 
 #include <cmath>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/io/detail/checkpoint_h5.hpp>
 #include <jelly/io/detail/h5.hpp>
 #include <jelly/io/detail/json_parse.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 namespace jelly {
 

@@ -14,7 +14,7 @@ struct Checkpoint {
   State state;
   long total_steps = 0;
   Real next_output = 0;  // time of the next observer frame
-  std::vector<ContactSolver::SeedContact> seed_contacts;
+  std::vector<CarriedContact> seed_contacts;
   int contact_count = 0;
   std::vector<Real> integrator_state;  // empty in files written before it was stored
   std::string integrator;              // of the run that wrote it

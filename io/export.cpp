@@ -1,4 +1,4 @@
-#include <jelly/io/export.hpp>
+#include <jelly/io/detail/export.hpp>
 
 #include <cerrno>
 #include <cmath>

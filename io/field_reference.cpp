@@ -1,6 +1,6 @@
 #include <jelly/io/detail/field_reference.hpp>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
 #include <jelly/io/detail/scene_fields.hpp>
 #include <jelly/solvers/contact/detail/body_contact_fields.hpp>

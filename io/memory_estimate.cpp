@@ -1,4 +1,4 @@
-#include <jelly/io/memory_estimate.hpp>
+#include <jelly/io/detail/memory_estimate.hpp>
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include <jelly/io/rollout.hpp>
+#include <jelly/io/detail/rollout.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -12,8 +12,8 @@
 
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/io/memory_estimate.hpp>
-#include <jelly/io/run_limits.hpp>
+#include <jelly/io/detail/memory_estimate.hpp>
+#include <jelly/io/detail/run_limits.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {

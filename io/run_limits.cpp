@@ -1,4 +1,4 @@
-#include <jelly/io/run_limits.hpp>
+#include <jelly/io/detail/run_limits.hpp>
 
 #include <sys/statvfs.h>
 
@@ -9,7 +9,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/io/memory_estimate.hpp>
+#include <jelly/io/detail/memory_estimate.hpp>
 
 namespace jelly {
 

@@ -9,7 +9,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/detail/scene_fields.hpp>
-#include <jelly/io/memory_estimate.hpp>
+#include <jelly/io/detail/memory_estimate.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {

@@ -10,12 +10,11 @@
 #include <jelly/core/polymorphic_value.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/divergence_guard.hpp>
+#include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/simulator.hpp>
-#include <jelly/terrain/contact_params.hpp>
 #include <jelly/terrain/terrain.hpp>
-#include <jelly/terrain/terrain_spec.hpp>
+#include <jelly/terrain/terrain_kinds.hpp>
 
 namespace jelly {
 

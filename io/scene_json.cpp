@@ -2,8 +2,8 @@
 #include <cmath>
 #include <limits>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/detail/scene_fields.hpp>
 #include <jelly/io/detail/scene_override.hpp>

@@ -3,8 +3,8 @@
 #include <cctype>
 #include <vector>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/io/detail/json_parse.hpp>
 #include <jelly/io/scene.hpp>
 

@@ -1,4 +1,4 @@
-#include <jelly/io/xdmf.hpp>
+#include <jelly/io/h5_recorder.hpp>
 
 #include <unistd.h>
 
@@ -20,7 +20,6 @@
 #include <jelly/core/types.hpp>
 #include <jelly/io/detail/h5.hpp>
 #include <jelly/io/detail/xdmf_h5.hpp>
-#include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
 
 namespace jelly {

@@ -1,11 +1,27 @@
 #include <jelly/solvers/dynamics.hpp>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
-#include <jelly/core/external_force.hpp>
-#include <jelly/core/forces.hpp>
+#include <jelly/core/model.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 namespace jelly {
+
+Dynamics::Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains,
+                   const SpringBands* bands, const AnchorSprings* anchors, int threads,
+                   BodyContact* body_contact, const ForceList* extra_forces)
+    : model_(&model),
+      contacts_(&contacts),
+      terrains_(terrains),
+      bands_(bands),
+      anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr),
+      threads_(threads > 1 ? threads : 1),
+      body_contact_(body_contact),
+      forces_(extra_forces != nullptr && !extra_forces->empty() ? extra_forces : nullptr),
+      in_evaluation_contact_(terrains != nullptr &&
+                             ContactSolver::has_in_evaluation_contact(*terrains)) {}
 
 void Dynamics::forces(Real t, const VecX& x, const VecX& v, VecX& f) const {
   ++evaluations_;

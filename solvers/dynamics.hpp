@@ -4,15 +4,19 @@
 // anchor springs (external pulls), and the accelerations M^-1 f, with pinned particles following
 // their paths. With a seed_framework terrain, an evaluation also runs the course framework's
 // collision handler on its own state (stage_acceleration()).
-#include <jelly/core/anchor_springs.hpp>
+// Public as what an integrator of one's own evaluates (docs/extending.md): forces(),
+// acceleration(), stage_acceleration(), added_force_jacobians(), model(), threads(). The
+// Simulator constructs it; the accessors of contact and the force loop's bands return types of
+// internal headers, for jelly's own methods.
 #include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 namespace jelly {
 
-class SpringBands;  // core/detail/spring_bands.hpp: the Simulator's vectorised force loop
-class BodyContact;  // solvers/contact/body_contact.hpp
+class SpringBands;    // core/detail/spring_bands.hpp: the Simulator's vectorised force loop
+class BodyContact;    // solvers/contact/detail/body_contact.hpp
+class ContactSolver;  // solvers/contact/detail/contact_solver.hpp
 
 class Dynamics {
  public:
@@ -26,17 +30,7 @@ class Dynamics {
   Dynamics(const Model& model, const ContactSolver& contacts, const Terrains* terrains = nullptr,
            const SpringBands* bands = nullptr, const AnchorSprings* anchors = nullptr,
            int threads = 1, BodyContact* body_contact = nullptr,
-           const ForceList* extra_forces = nullptr)
-      : model_(&model),
-        contacts_(&contacts),
-        terrains_(terrains),
-        bands_(bands),
-        anchors_(anchors != nullptr && !anchors->empty() ? anchors : nullptr),
-        threads_(threads > 1 ? threads : 1),
-        body_contact_(body_contact),
-        forces_(extra_forces != nullptr && !extra_forces->empty() ? extra_forces : nullptr),
-        in_evaluation_contact_(terrains != nullptr &&
-                               ContactSolver::has_in_evaluation_contact(*terrains)) {}
+           const ForceList* extra_forces = nullptr);
 
   // f(t, x, v): size 3N, no allocation. Pinned particles get the forces as if free (an
   // implicit method constrains them itself).

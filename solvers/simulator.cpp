@@ -8,6 +8,8 @@
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/detail/team_chooser.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
@@ -19,7 +21,9 @@ Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integ
     : model_(std::move(model)),
       state_(std::move(state)),
       integrator_(std::move(integrator)),
-      options_(options) {
+      options_(options),
+      contacts_(std::make_unique<ContactSolver>()),
+      body_contact_(std::make_unique<BodyContact>()) {
   model_.validate();
   options_.validate();
   bands_ = std::make_unique<const SpringBands>(model_);
@@ -33,6 +37,9 @@ Simulator::Simulator(Model model, State state, std::unique_ptr<Integrator> integ
 Simulator::~Simulator() = default;
 Simulator::Simulator(Simulator&&) noexcept = default;
 Simulator& Simulator::operator=(Simulator&&) noexcept = default;
+
+const ContactSolver& Simulator::contacts() const { return *contacts_; }
+const BodyContact& Simulator::body_contact() const { return *body_contact_; }
 
 void Simulator::check_terrain(const Terrain* terrain, size_t index) const {
   require(terrain != nullptr, "terrain", "null", "a terrain");
@@ -181,10 +188,10 @@ void Simulator::model_changed() {
 }
 
 void Simulator::set_body_contact(const BodyContactParams& params) {
-  body_contact_ = BodyContact(params);
+  *body_contact_ = BodyContact(params);
 }
 
-void Simulator::check_no_overlap() { body_contact_.check_no_overlap(model_, state_.x); }
+void Simulator::check_no_overlap() { body_contact_->check_no_overlap(model_, state_.x); }
 
 void Simulator::set_threads(int threads) {
   require(threads >= 0, "threads", threads, "an integer >= 0 (0 = all cores)");
@@ -319,15 +326,15 @@ void Simulator::set_state(State state) {
   require(state.x.size() == model_.num_dofs() && state.v.size() == model_.num_dofs(),
           "state.x.size", state.x.size(), "3 x the number of particles");
   assign_state(state_, state);
-  contacts_.clear();
+  contacts_->clear();
   next_output_ = state_.t;
   frames_ = 0;
 }
 
 SimulatorSnapshot Simulator::snapshot() const {
   SimulatorSnapshot s{state_,
-                      contacts_.seed_contacts(),
-                      contacts_.contact_count(),
+                      contacts_->seed_contacts(),
+                      contacts_->contact_count(),
                       total_steps_,
                       next_output_,
                       integrator_->internal_state(),
@@ -372,7 +379,7 @@ void Simulator::restore(SimulatorSnapshot snapshot) {
   }
   integrator_->restore_internal_state(snapshot.integrator_state);
   assign_state(state_, s);
-  contacts_.restore(std::move(snapshot.seed_contacts), snapshot.contact_count);
+  contacts_->restore(std::move(snapshot.seed_contacts), snapshot.contact_count);
   total_steps_ = snapshot.total_steps;
   next_output_ = snapshot.next_output;
   frames_ = 0;
@@ -404,15 +411,15 @@ int Simulator::step_threads() {
 StepResult Simulator::step() {
   const auto start = std::chrono::steady_clock::now();
   const int threads = step_threads();
-  const bool bodies = body_contact_.active(model_);
-  const Dynamics dynamics(model_, contacts_, &terrains_, bands_.get(), &anchors_, threads,
-                          bodies ? &body_contact_ : nullptr, &forces_);
+  const bool bodies = body_contact_->active(model_);
+  const Dynamics dynamics(model_, *contacts_, &terrains_, bands_.get(), &anchors_, threads,
+                          bodies ? body_contact_.get() : nullptr, &forces_);
   parallel::copy(threads, state_.x, before_.x);
   parallel::copy(threads, state_.v, before_.v);
   before_.t = state_.t;
   // Collision detection apart from integration: the pairs that may touch in this step, which
   // the integrator's solve or finish_step()'s resolve takes.
-  if (bodies) body_contact_.collide(model_, state_, options_.dt);
+  if (bodies) body_contact_->collide(model_, state_, options_.dt);
   StepResult result;
   try {
     result = integrator_->step(dynamics, state_, options_.dt);
@@ -426,8 +433,8 @@ StepResult Simulator::step() {
   }
   force_evaluations_ += dynamics.force_evaluations();
   if (!result.ok) return result;
-  finish_step(result, contacts_, bodies ? &body_contact_ : nullptr, model_, terrains_, before_,
-              state_, options_.dt, threads);
+  finish_step(result, *contacts_, bodies ? body_contact_.get() : nullptr, model_, terrains_,
+              before_, state_, options_.dt, threads);
   ++total_steps_;
   if (team_ && options_.threads == 0)
     team_->record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -469,7 +476,8 @@ void Simulator::note_forces(RunReport& report) {
 RunReport Simulator::run_until(Real t_end) {
   require(std::isfinite(t_end), "t_end", t_end, "a finite time");
   // A step or output interval lost to rounding at the run's largest time (t + h == t) would loop
-  // forever. (io/run_limits.hpp checks a whole run's step and frame counts before it starts.)
+  // forever. (io/detail/run_limits.hpp checks a whole run's step and frame counts before it
+  // starts.)
   const Real largest = std::max(std::abs(state_.t), std::abs(t_end));
   require(state_.t >= t_end - 0.5 * options_.dt || largest + options_.dt > largest, "integrator.dt",
           options_.dt, "a step not lost to rounding at t = " + to_text(largest));
@@ -504,8 +512,8 @@ RunReport Simulator::run_until(Real t_end) {
   note_forces(report);
   report.statistics = integrator_->statistics();
   report_crushed_bodies(model_, state_.x, options_.crush, report);
-  if (body_contact_.active(model_)) {
-    const BodyContact::Stats& b = body_contact_.stats();
+  if (body_contact_->active(model_)) {
+    const BodyContact::Stats& b = body_contact_->stats();
     report.statistics["body_contact_pairs"] = static_cast<double>(b.pairs);
     report.statistics["body_contact_energy_limited"] = static_cast<double>(b.limited);
     report.statistics["body_contact_collided_steps"] = static_cast<double>(b.collided);

@@ -12,14 +12,15 @@
 #include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
-#include <jelly/solvers/divergence_guard.hpp>
-#include <jelly/solvers/integrators/integrator.hpp>
+#include <jelly/solvers/contact/body_contact_params.hpp>
+#include <jelly/solvers/contact/terrain_contact_model.hpp>
 #include <jelly/solvers/run_report.hpp>
+#include <jelly/solvers/integrators/integrator.hpp>
 
 namespace jelly {
 
+class BodyContact;    // solvers/contact/detail/body_contact.hpp (internal)
+class ContactSolver;  // solvers/contact/detail/contact_solver.hpp (internal)
 class Simulator;
 class SpringBands;
 namespace parallel {
@@ -133,7 +134,7 @@ struct SimulatorSnapshot {
   // steps, and counting on from it cannot overflow).
   static constexpr long kMaxTotalSteps = 1L << 53;
   State state;
-  std::vector<ContactSolver::SeedContact> seed_contacts;  // active during the next step
+  std::vector<CarriedContact> seed_contacts;  // active during the next step
   int contact_count = 0;
   long total_steps = 0;  // at most kMaxTotalSteps (the count goes on from there)
   // Time of the next observer frame (taken inside on_frame: that frame's own time, which the
@@ -254,8 +255,9 @@ class Simulator {
   const SimulatorOptions& options() const { return options_; }
   // Sets options().threads (0 = all cores). Throws InputError for a negative count.
   void set_threads(int threads);
-  const ContactSolver& contacts() const { return contacts_; }
-  const BodyContact& body_contact() const { return body_contact_; }
+  // The contact machinery (internal types: for jelly's own programs and tests).
+  const ContactSolver& contacts() const;
+  const BodyContact& body_contact() const;
   long total_steps() const { return total_steps_; }
   // Live edits of the model so far (0: the model as it was built).
   long model_revision() const { return model_revision_; }
@@ -282,8 +284,10 @@ class Simulator {
   std::unique_ptr<parallel::TeamChooser> team_;
   SimulatorOptions options_;
   Terrains terrains_;
-  ContactSolver contacts_;
-  BodyContact body_contact_;
+  // Behind pointers so that this header needs no contact internals; never null (but in a
+  // moved-from simulator).
+  std::unique_ptr<ContactSolver> contacts_;
+  std::unique_ptr<BodyContact> body_contact_;
   State before_;  // the state at the start of the current step
   ObserverList observers_;
   AnchorSprings anchors_;

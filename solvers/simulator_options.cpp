@@ -1,7 +1,7 @@
 // SimulatorOptions' field table and validation (solvers/detail/run_fields.hpp).
 #include <jelly/solvers/simulator.hpp>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/solvers/detail/run_fields.hpp>
 
 namespace jelly {

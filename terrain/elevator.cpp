@@ -1,10 +1,10 @@
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 
 #include <cmath>
 #include <limits>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/terrain/detail/terrain_fields.hpp>
 
 namespace jelly {

@@ -1,13 +1,13 @@
-#include <jelly/terrain/mesh_obstacle.hpp>
+#include <jelly/terrain/detail/mesh_obstacle.hpp>
 
 #include <atomic>
 #include <cmath>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
 #include <jelly/geometry/detail/mesh_file.hpp>
-#include <jelly/geometry/mesh_io.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
 #include <jelly/terrain/detail/terrain_fields.hpp>
 
 namespace jelly {

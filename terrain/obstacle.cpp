@@ -1,10 +1,10 @@
-#include <jelly/terrain/obstacle.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
 
 #include <algorithm>
 #include <cmath>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/terrain/detail/terrain_fields.hpp>
 
 namespace jelly {

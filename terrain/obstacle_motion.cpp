@@ -1,10 +1,10 @@
-#include <jelly/terrain/obstacle_motion.hpp>
+#include <jelly/terrain/detail/obstacle_motion.hpp>
 
 #include <cmath>
 #include <utility>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/pose.hpp>
+#include <jelly/geometry/detail/pose.hpp>
 
 namespace jelly {
 

@@ -1,7 +1,7 @@
 #pragma once
 // A fixed infinite plane (half-space): the floor, or the seed's 20-degree slope.
 #include <jelly/terrain/terrain.hpp>
-#include <jelly/terrain/terrain_spec.hpp>
+#include <jelly/terrain/terrain_kinds.hpp>
 
 namespace jelly {
 

@@ -8,9 +8,56 @@
 #include <utility>
 #include <vector>
 
+#include <jelly/core/errors.hpp>
+#include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
-#include <jelly/terrain/contact_params.hpp>
+
+// How a terrain answers a particle that touches it: the contact model and its coefficients.
+namespace jelly {
+
+enum class ContactModel {
+  // Impulses on the relative velocity: restitution above a resting speed, Coulomb friction
+  // (static and kinetic, bounded by mu times the normal impulse), penetration projected out.
+  kCoulomb,
+  // The seed report's rules (sections 1.2 and 1.3): velocity reflection within epsilon, a contact
+  // force cancelling the inward force, and friction -mu N v_t proportional to the speed.
+  // Reflection once after each step, the forces during the next one (any integrator).
+  kSeed,
+  // The same rules where the course framework applied them: inside every force evaluation, on
+  // that evaluation's own state (each stage of a multi-stage method reflects its own velocity).
+  // The explicit integrators only (docs/contact.md).
+  kSeedFramework,
+};
+// Every contact model with its name and description.
+const std::vector<EnumName<ContactModel>>& contact_models();
+std::string_view contact_model_name(ContactModel model);
+// Throws InputError naming `field` for an unknown name.
+ContactModel contact_model_from_name(std::string_view name, std::string_view field);
+// The seed rules (either placement): reflection within epsilon, no projection.
+inline bool is_seed_model(ContactModel model) {
+  return model == ContactModel::kSeed || model == ContactModel::kSeedFramework;
+}
+
+struct ContactParams {
+  ContactModel model = ContactModel::kCoulomb;
+  Real restitution = 0.8;      // in [0, 1]
+  Real friction = 0.5;         // kinetic mu (coulomb), the report's coefFriction (seed); >= 0
+  Real static_friction = 0.5;  // coulomb: sticking when |v_t| <= mu_s * dv_n; >= friction
+  Real epsilon = 0.01;         // seed: contact distance (m); > 0
+  // coulomb: a particle bounces only if it was already approaching the surface faster than this
+  // at the start of the step; an approach built up within one step (a resting particle pulled
+  // down by gravity and its springs) is absorbed, so that a resting jelly does not jitter.
+  Real resting_speed = 0.05;
+
+  // Throws InputError naming `prefix`field for a value out of range.
+  void validate(const std::string& prefix) const;
+  // Reads the keys of a scene's "contact" object (missing keys keep their defaults), validated.
+  static ContactParams read(JsonFields& fields);
+  Json to_json() const;
+};
+
+}  // namespace jelly
 
 namespace jelly {
 
@@ -45,5 +92,8 @@ class Terrain {
  private:
   ContactParams contact_;
 };
+
+// A scene's terrains, in order (indices name them in messages and snapshots).
+using Terrains = std::vector<std::unique_ptr<Terrain>>;
 
 }  // namespace jelly

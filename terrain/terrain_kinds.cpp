@@ -1,10 +1,10 @@
 #include <jelly/terrain/terrain_kinds.hpp>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
-#include <jelly/terrain/elevator.hpp>
-#include <jelly/terrain/mesh_obstacle.hpp>
-#include <jelly/terrain/obstacle.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
+#include <jelly/terrain/detail/mesh_obstacle.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly {

@@ -8,8 +8,9 @@ layers to its left (a detail/ header counts as its module's):
 
     check_layers.py [--root DIR]             every #include of the layer folders under DIR
     check_layers.py [--root DIR] --umbrella  cmake/jelly.hpp.in includes every public header
-                                             (cmake/public_headers.txt) and no other, and a
-                                             public header includes only public ones
+                                             (cmake/public_headers.txt) and no other, a
+                                             public header includes only public ones, and
+                                             every other header is under a detail/ folder
     check_layers.py --self-test              both checks catch violations in a temporary tree
 
 Exit status 0 when clean, 1 with one line per violation on stderr.
@@ -123,6 +124,15 @@ def check_umbrella(root):
                     violations.append(f"{header[len('jelly/'):]}:{number}: a public header "
                                       f"includes <{m.group(2)}>, which is not public "
                                       f"(cmake/public_headers.txt)")
+    # Every header of the library is either public (listed, installed) or internal under a
+    # detail/ folder: a new header outside detail/ that is not listed is a mistake either way.
+    for module in LIBRARY:
+        for path in sources(root, module):
+            relative = os.path.relpath(path, root).replace(os.sep, "/")
+            if (relative.endswith(".hpp") and "detail" not in relative.split("/")
+                    and "jelly/" + relative not in public):
+                violations.append(f"{relative}: neither a public header (cmake/public_headers.txt) "
+                                  f"nor under a detail/ folder")
     return violations
 
 
@@ -180,9 +190,9 @@ def self_test():
             failures.append(f"{name} ({text.strip()}) is not reported: {found}")
 
     files = dict(clean)
-    files["cmake/public_headers.txt"] += "terrain/elevator.hpp\n"
-    files["terrain/elevator.hpp"] = "#include <jelly/core/model.hpp>\n"
-    if not any("terrain/elevator.hpp" in v for v in check_umbrella(tree(files))):
+    files["cmake/public_headers.txt"] += "terrain/detail/elevator.hpp\n"
+    files["terrain/detail/elevator.hpp"] = "#include <jelly/core/model.hpp>\n"
+    if not any("terrain/detail/elevator.hpp" in v for v in check_umbrella(tree(files))):
         failures.append("a public header missing from the umbrella is not reported")
     files = dict(clean)
     files["cmake/jelly.hpp.in"] += "#include <jelly/core/detail/jacobian.hpp>\n"
@@ -201,6 +211,10 @@ def self_test():
     files["solvers/dynamics.hpp"] = ""
     if not any("solvers/simulator.hpp:2" in v for v in check_umbrella(tree(files))):
         failures.append("a public header including an internal one is not reported")
+    files = dict(clean)
+    files["geometry/box.hpp"] = "#include <jelly/core/model.hpp>\n"
+    if not any("geometry/box.hpp: neither" in v for v in check_umbrella(tree(files))):
+        failures.append("a header outside detail/ left off the public list is not reported")
     for root in made:
         shutil.rmtree(root, ignore_errors=True)
     return failures

@@ -1,20 +1,20 @@
 #pragma once
 // `jelly export`: a recording's render surfaces (scene_adapter.hpp) and terrains as an OBJ per
-// frame, as a PC2 point cache with the rest surface as OBJ beside it (io/export.hpp writes the
-// formats), or as one animated glTF 2.0 binary (.glb).
+// frame, as a PC2 point cache with the rest surface as OBJ beside it (io/detail/export.hpp writes
+// the formats), or as one animated glTF 2.0 binary (.glb).
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
-#include <jelly/io/export.hpp>
+#include <jelly/io/detail/export.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/viewer/scene_adapter.hpp>
 
 namespace jelly::viewer {
 
 // The surfaces of every body at positions x, one OBJ object per body, with area-weighted vertex
-// normals (outward: io/export.hpp vertex_normals).
+// normals (outward: io/detail/export.hpp vertex_normals).
 std::vector<ObjObject> surface_objects(const std::vector<BodySurface>& surfaces, const VecX& x);
 
 // A terrain of a recording as the exports give it: its mesh in its own frame with normals that

@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include <jelly/core/anchor_springs.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/run_report.hpp>
 

@@ -1,6 +1,6 @@
 #pragma once
 // The one place where the viewer (and `jelly export`) reads what a body and a terrain look like:
-// the bodies' render surfaces (Model::bodies, core/surface.hpp) and the terrains' meshes and
+// the bodies' render surfaces (Model::bodies, core/model.hpp) and the terrains' meshes and
 // poses (Terrain::render_mesh(), pose(t)), with the viewer's own choices on top: an infinite
 // plane is drawn as a square large enough for the action, and a recording whose file holds no
 // bodies takes them from the scene it was made from.
@@ -11,10 +11,9 @@
 #include <Eigen/Geometry>
 
 #include <jelly/core/model.hpp>
-#include <jelly/core/surface.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 #include <jelly/io/recording.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/terrain/terrain.hpp>
 
 namespace jelly::viewer {

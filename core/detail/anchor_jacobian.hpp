@@ -1,6 +1,6 @@
 #pragma once
 // The anchor springs' (diagonal) Jacobians in the matrices of the implicit integrators.
-#include <jelly/core/anchor_springs.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 
 namespace jelly {

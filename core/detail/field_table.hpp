@@ -16,7 +16,6 @@
 #include <type_traits>
 #include <vector>
 
-#include <jelly/core/enum_names.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/json_fwd.hpp>
 #include <jelly/core/types.hpp>
@@ -543,7 +542,7 @@ Field<S> omit_default(Field<S> f) {
   return f;
 }
 
-// An enum member named by the table `Names` (core/enum_names.hpp): "one of ...".
+// An enum member named by the table `Names` (core/errors.hpp): "one of ...".
 template <auto M, auto Names>
 Field<field_detail::StructOf<M>> choice_field(std::string_view name, std::string_view help) {
   using S = field_detail::StructOf<M>;

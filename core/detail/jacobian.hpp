@@ -6,9 +6,9 @@
 #include <utility>
 #include <vector>
 
-#include <jelly/core/definiteness.hpp>
+#include <jelly/core/detail/sparse_matrix.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/core/sparse_matrix.hpp>
 
 namespace jelly {
 
@@ -58,7 +58,7 @@ class SpringJacobian {
                        const JacobianOptions& options, Real alpha, Real beta, SparseMatrix& a,
                        const VecX& w, VecX& kw, int threads = 1) const;
   // Adds `value` to entry (dof, dof) of a matrix with this pattern (an external force's
-  // diagonal Jacobian, core/anchor_springs.hpp).
+  // diagonal Jacobian, core/force.hpp).
   void add_to_diagonal(SparseMatrix& m, int dof, Real value) const {
     m.valuePtr()[diagonal_[dof]] += value;
   }

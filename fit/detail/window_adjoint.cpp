@@ -5,6 +5,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/fit/detail/window_start.hpp>
+#include <jelly/fit/detail/implicit_euler_ceres.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {

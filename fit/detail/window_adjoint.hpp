@@ -1,14 +1,14 @@
 #pragma once
 // Internal: the exact-gradient path of fit_recording (docs/fitting.md). One shooting window of a
 // recording replayed with implicit_euler and differentiated by its discrete adjoint
-// (solvers/adjoint/implicit_euler_adjoint.hpp): one forward and one backward pass give the
+// (solvers/adjoint/detail/implicit_euler_adjoint.hpp): one forward and one backward pass give the
 // gradient of any loss on the window's frames.
 #include <functional>
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/fit/trajectory.hpp>
-#include <jelly/solvers/adjoint/implicit_euler_adjoint.hpp>
+#include <jelly/fit/spring_fit.hpp>
+#include <jelly/solvers/adjoint/detail/implicit_euler_adjoint.hpp>
 
 namespace jelly {
 

@@ -3,7 +3,7 @@
 #include <utility>
 #include <vector>
 
-#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/fit/detail/implicit_euler_ceres.hpp>
 
 namespace jelly {
 

@@ -7,7 +7,7 @@
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/fit/trajectory.hpp>
+#include <jelly/fit/spring_fit.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {

@@ -5,11 +5,11 @@
 // pose's, a material's) once.
 #include <jelly/core/detail/field_table.hpp>
 #include <jelly/geometry/body_spec.hpp>
-#include <jelly/geometry/box.hpp>
-#include <jelly/geometry/cloth.hpp>
+#include <jelly/geometry/detail/box.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/geometry/tetmesh.hpp>
-#include <jelly/geometry/voxelized.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
+#include <jelly/geometry/detail/voxelized.hpp>
 
 namespace jelly {
 
@@ -26,7 +26,7 @@ const FieldTable<ClothShape>& cloth_shape_fields();          // geometry/cloth.c
 const FieldTable<VoxelizedShape>& voxelized_shape_fields();  // geometry/voxelized.cpp
 const FieldTable<TetmeshShape>& tetmesh_shape_fields();      // geometry/tetmesh.cpp
 
-// A pose's keys (geometry/pose.hpp), for a member path ending at a Pose's member.
+// A pose's keys (geometry/detail/pose.hpp), for a member path ending at a Pose's member.
 template <auto... Ms>
 Field<field_detail::StructOf<Ms...>> pose_scale_field() {
   return number_field<Ms...>("scale", "", range_above(0), "a finite scale > 0",
@@ -42,7 +42,7 @@ Field<field_detail::StructOf<Ms...>> pose_rotation_field() {
                            "Rotation about x, then y, then z (axes fixed in space)");
 }
 
-// A material's keys (geometry/lattice.hpp).
+// A material's keys (geometry/body_shape.hpp).
 template <auto... Ms>
 Field<field_detail::StructOf<Ms...>> particle_mass_field() {
   return number_field<Ms...>("particle_mass", "kg", range_above(0), "a finite mass > 0",

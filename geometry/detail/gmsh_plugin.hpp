@@ -6,7 +6,7 @@
 // instead. This header is the contract between the two; internal to geometry/.
 #include <string>
 
-#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 
 namespace jelly::detail {

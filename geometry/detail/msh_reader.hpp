@@ -4,7 +4,7 @@
 // geometry/.
 #include <string>
 
-#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
 
 namespace jelly::detail {
 

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include <jelly/core/detail/input_file.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 
 namespace jelly::detail {
 

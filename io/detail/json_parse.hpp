@@ -4,7 +4,7 @@
 // number within a double's range. Internal to io/.
 #include <string>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 
 namespace jelly::detail {
 

@@ -2,7 +2,7 @@
 // Applies "path=value" assignments (jelly run --set) to scene JSON. Internal to io/.
 #include <string>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 
 namespace jelly::detail {
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include <jelly/io/xdmf.hpp>
+#include <jelly/io/h5_recorder.hpp>
 
 namespace jelly {
 

@@ -1,8 +1,7 @@
 // jelly._gradient: the discrete adjoint of implicit_euler (solvers/adjoint/) for
 // jelly.gradient, which maps its arrays to scene paths (python/jelly/__init__.py).
-#include <jelly/core/external_force.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/solvers/adjoint/implicit_euler_adjoint.hpp>
+#include <jelly/solvers/adjoint/detail/implicit_euler_adjoint.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 #include "common.hpp"

@@ -10,7 +10,7 @@
 #include <string>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/core/springs.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/core/types.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/terrain/terrain.hpp>

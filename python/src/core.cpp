@@ -4,16 +4,12 @@
 #include <optional>
 #include <vector>
 
-#include <jelly/core/anchor_springs.hpp>
-#include <jelly/core/body.hpp>
-#include <jelly/core/external_force.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/force.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/core/pins.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/core/surface.hpp>
 #include <jelly/geometry/detail/body_shape_fields.hpp>
 
 #include "common.hpp"

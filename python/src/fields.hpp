@@ -10,7 +10,7 @@
 #include <string>
 
 #include <jelly/core/detail/field_table.hpp>
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 
 #include "common.hpp"
 

@@ -1,6 +1,6 @@
 // fit/: spring and damper coefficients fitted to a recording (docs/fitting.md), with the options
 // and report of `jelly fit`.
-#include <jelly/fit/recording_trajectory.hpp>
+#include <jelly/fit/detail/recording_trajectory.hpp>
 #include <jelly/fit/spring_fit.hpp>
 #include <jelly/io/recording.hpp>
 

@@ -1,6 +1,6 @@
 // geometry/: the body kinds a scene can name (jelly.body_kinds()) and the seed cube built in code
 // (CubeSpec, build_cube). Scenes describe bodies of every kind in their "bodies" list.
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/geometry/cube.hpp>
 
 #include "common.hpp"

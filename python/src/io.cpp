@@ -4,14 +4,13 @@
 #include <chrono>
 #include <future>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/io/checkpoint.hpp>
+#include <jelly/io/detail/rollout.hpp>
+#include <jelly/io/detail/run_limits.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
-#include <jelly/io/rollout.hpp>
-#include <jelly/io/run_limits.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/io/xdmf.hpp>
 
 #include "common.hpp"
 

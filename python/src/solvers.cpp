@@ -4,16 +4,17 @@
 #include <memory>
 #include <optional>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/io/run_limits.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/io/detail/run_limits.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/detail/run_fields.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/simulator.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "common.hpp"

@@ -1,4 +1,4 @@
-#include <jelly/solvers/adjoint/implicit_euler_adjoint.hpp>
+#include <jelly/solvers/adjoint/detail/implicit_euler_adjoint.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -13,17 +13,18 @@
 
 #include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/clock.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/external_force.hpp>
-#include <jelly/core/forces.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/solvers/adjoint/detail/newton_backward.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
-#include <jelly/solvers/linear/cg_solver.hpp>
-#include <jelly/solvers/linear/cholmod_solver.hpp>
-#include <jelly/solvers/linear/ldlt_solver.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
+#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/ldlt_solver.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {

@@ -4,11 +4,10 @@
 #include <string>
 
 #include <jelly/core/detail/field_table.hpp>
-#include <jelly/core/enum_names.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
-#include <jelly/solvers/arkode/arkode_dirk.hpp>
-#include <jelly/solvers/arkode/arkode_erk.hpp>
+#include <jelly/solvers/arkode/detail/arkode_dirk.hpp>
+#include <jelly/solvers/arkode/detail/arkode_erk.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
 #include <jelly/solvers/integrators/detail/options_io.hpp>
 #include <jelly/solvers/integrators/registry.hpp>

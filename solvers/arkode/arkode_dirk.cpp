@@ -1,4 +1,4 @@
-#include <jelly/solvers/arkode/arkode_dirk.hpp>
+#include <jelly/solvers/arkode/detail/arkode_dirk.hpp>
 
 #include <algorithm>
 #include <vector>

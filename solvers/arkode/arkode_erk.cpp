@@ -1,4 +1,4 @@
-#include <jelly/solvers/arkode/arkode_erk.hpp>
+#include <jelly/solvers/arkode/detail/arkode_erk.hpp>
 
 #include <arkode/arkode_butcher_erk.h>
 #include <arkode/arkode_erkstep.h>

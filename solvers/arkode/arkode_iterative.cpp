@@ -5,9 +5,10 @@
 
 #include <arkode/arkode_arkstep.h>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/core/external_force.hpp>
-#include <jelly/core/forces.hpp>
+#include <jelly/core/model.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 namespace jelly::arkode {
 

@@ -1,12 +1,12 @@
-#include <jelly/solvers/arkode/arkode_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 #include <cmath>
 
 #include <arkode/arkode_butcher_dirk.h>
 #include <arkode/arkode_butcher_erk.h>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
 
 namespace jelly {

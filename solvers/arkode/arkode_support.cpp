@@ -9,6 +9,7 @@
 #include <arkode/arkode_erkstep.h>
 
 #include <jelly/core/errors.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 namespace jelly::arkode {
 

@@ -1,4 +1,4 @@
-#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -6,8 +6,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/solvers/contact/detail/body_contact_fields.hpp>
 

@@ -1,4 +1,4 @@
-#include <jelly/solvers/contact/broad_phase.hpp>
+#include <jelly/solvers/contact/detail/broad_phase.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 #include <algorithm>
 #include <cmath>

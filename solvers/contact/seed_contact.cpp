@@ -1,6 +1,7 @@
 // The seed contact model: the seed report's rules once per step, for any integrator. After the
 // step a particle within epsilon and approaching has its normal velocity reflected; during the
 // next step its contact and friction forces act (carried contacts, ContactSolver::add_forces).
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/contact/detail/seed_rules.hpp>
 #include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>

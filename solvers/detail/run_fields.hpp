@@ -4,7 +4,6 @@
 // (simulator_options.cpp). The row factories declare the keys a scene and SimulatorOptions
 // share once (a scene holds dt under integrator, the others at its top).
 #include <jelly/core/detail/field_table.hpp>
-#include <jelly/solvers/divergence_guard.hpp>
 #include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/simulator.hpp>
 

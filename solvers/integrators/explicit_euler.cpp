@@ -1,4 +1,4 @@
-#include <jelly/solvers/integrators/explicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/explicit_euler.hpp>
 
 namespace jelly {
 

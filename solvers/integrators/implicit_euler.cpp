@@ -1,4 +1,4 @@
-#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <jelly/core/detail/clock.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/contact/detail/implicit_body_contact.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
 #include <jelly/solvers/integrators/detail/assembled_system.hpp>

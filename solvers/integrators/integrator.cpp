@@ -4,7 +4,8 @@
 #include <cstdio>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {

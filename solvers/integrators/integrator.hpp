@@ -11,6 +11,9 @@
 
 namespace jelly {
 
+class BodyContact;    // solvers/contact/detail/body_contact.hpp (internal)
+class ContactSolver;  // solvers/contact/detail/contact_solver.hpp (internal)
+
 // Named counters and timings an integrator reports (summary, HDF5 attributes).
 using Statistics = std::map<std::string, double>;
 

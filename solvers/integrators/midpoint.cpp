@@ -1,4 +1,4 @@
-#include <jelly/solvers/integrators/midpoint.hpp>
+#include <jelly/solvers/integrators/detail/midpoint.hpp>
 
 namespace jelly {
 

@@ -1,4 +1,4 @@
-#include <jelly/solvers/integrators/projective_dynamics.hpp>
+#include <jelly/solvers/integrators/detail/projective_dynamics.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <jelly/core/detail/clock.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/solvers/contact/detail/position_contact.hpp>
-#include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
 
 namespace jelly {
 

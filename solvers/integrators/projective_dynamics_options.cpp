@@ -1,7 +1,7 @@
-#include <jelly/solvers/integrators/projective_dynamics_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/solvers/integrators/detail/option_fields.hpp>
 
 namespace jelly {

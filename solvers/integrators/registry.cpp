@@ -4,17 +4,17 @@
 #include <string>
 #include <utility>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
+#include <jelly/solvers/integrators/detail/explicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/midpoint.hpp>
 #include <jelly/solvers/integrators/detail/options_io.hpp>
-#include <jelly/solvers/integrators/explicit_euler.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
-#include <jelly/solvers/integrators/midpoint.hpp>
-#include <jelly/solvers/integrators/projective_dynamics.hpp>
-#include <jelly/solvers/integrators/rk4.hpp>
-#include <jelly/solvers/integrators/symplectic_euler.hpp>
-#include <jelly/solvers/integrators/vbd.hpp>
-#include <jelly/solvers/integrators/xpbd.hpp>
+#include <jelly/solvers/integrators/detail/projective_dynamics.hpp>
+#include <jelly/solvers/integrators/detail/rk4.hpp>
+#include <jelly/solvers/integrators/detail/symplectic_euler.hpp>
+#include <jelly/solvers/integrators/detail/vbd.hpp>
+#include <jelly/solvers/integrators/detail/xpbd.hpp>
 
 namespace jelly {
 

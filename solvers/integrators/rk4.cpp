@@ -1,4 +1,4 @@
-#include <jelly/solvers/integrators/rk4.hpp>
+#include <jelly/solvers/integrators/detail/rk4.hpp>
 
 #include <jelly/core/detail/parallel.hpp>
 

@@ -1,4 +1,4 @@
-#include <jelly/solvers/integrators/symplectic_euler.hpp>
+#include <jelly/solvers/integrators/detail/symplectic_euler.hpp>
 
 namespace jelly {
 

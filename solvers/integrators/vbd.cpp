@@ -1,10 +1,11 @@
-#include <jelly/solvers/integrators/vbd.hpp>
+#include <jelly/solvers/integrators/detail/vbd.hpp>
 
 #include <algorithm>
 #include <cmath>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
-#include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/contact/detail/thickness.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 #include <jelly/terrain/terrain.hpp>

@@ -1,4 +1,4 @@
-#include <jelly/solvers/integrators/xpbd.hpp>
+#include <jelly/solvers/integrators/detail/xpbd.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,9 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
-#include <jelly/core/forces.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/contact/detail/position_contact.hpp>
 
 namespace jelly {

@@ -1,4 +1,4 @@
-#include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
 
 #include <time.h>
 

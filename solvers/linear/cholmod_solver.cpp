@@ -1,4 +1,4 @@
-#include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
 
 #include <cholmod.h>
 

@@ -1,4 +1,4 @@
-#include <jelly/solvers/linear/ldlt_solver.hpp>
+#include <jelly/solvers/linear/detail/ldlt_solver.hpp>
 
 namespace jelly {
 

@@ -1,4 +1,4 @@
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 

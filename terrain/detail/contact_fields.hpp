@@ -2,7 +2,7 @@
 // The field table of a terrain's contact parameters (core/detail/field_table.hpp), declared in
 // terrain/contact_params.cpp.
 #include <jelly/core/detail/field_table.hpp>
-#include <jelly/terrain/contact_params.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 namespace jelly {
 

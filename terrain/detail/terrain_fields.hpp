@@ -3,10 +3,10 @@
 // .cpp files. Each table holds the kind's own keys; `kind` and `contact` are read by
 // terrain_kinds.cpp. The row factories below declare keys several kinds share once.
 #include <jelly/core/detail/field_table.hpp>
-#include <jelly/terrain/elevator.hpp>
-#include <jelly/terrain/mesh_obstacle.hpp>
-#include <jelly/terrain/obstacle.hpp>
-#include <jelly/terrain/obstacle_motion.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
+#include <jelly/terrain/detail/mesh_obstacle.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
+#include <jelly/terrain/detail/obstacle_motion.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly {
@@ -18,7 +18,7 @@ const FieldTable<ElevatorSpec>& elevator_fields();  // terrain/elevator.cpp
 const FieldTable<ObstacleSpec>& obstacle_fields(ObstacleShape shape);  // terrain/obstacle.cpp
 const FieldTable<MeshObstacleSpec>& mesh_obstacle_fields();            // terrain/mesh_obstacle.cpp
 
-// An obstacle's path (core/path.hpp) and its spin.
+// An obstacle's path (core/pins.hpp) and its spin.
 template <auto... Ms>
 Field<field_detail::StructOf<Ms...>> obstacle_motion_field() {
   return json_value_field<Ms...>(

@@ -17,8 +17,8 @@
 #include <jelly/bench/spectral.hpp>
 #include <jelly/bench/stability.hpp>
 #include <jelly/bench/stability_region.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/core/measures.hpp>
 #include "support/systems.hpp"
 

@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/components.hpp>
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/io/detail/field_reference.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/integrators/registry.hpp>

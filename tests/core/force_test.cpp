@@ -5,9 +5,9 @@
 #include <memory>
 #include <random>
 
-#include <jelly/core/builtin_forces.hpp>
+#include <jelly/core/detail/builtin_forces.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/geometry/cube.hpp>
 
 #include "support/systems.hpp"

@@ -2,9 +2,9 @@
 
 #include <random>
 
-#include <jelly/geometry/cube.hpp>
-#include <jelly/core/forces.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/measures.hpp>
+#include <jelly/geometry/cube.hpp>
 
 #include "support/systems.hpp"
 

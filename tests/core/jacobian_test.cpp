@@ -5,9 +5,9 @@
 #include <Eigen/Dense>
 
 #include <jelly/core/detail/band_system.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/geometry/cube.hpp>
 
 namespace jelly {

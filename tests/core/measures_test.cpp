@@ -8,7 +8,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/core/surface.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/geometry/cube.hpp>
 
 #include "support/systems.hpp"

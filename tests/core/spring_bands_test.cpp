@@ -5,9 +5,9 @@
 #include <random>
 #include <vector>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/geometry/cube.hpp>
 
 #include "support/systems.hpp"

@@ -10,9 +10,8 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/fit/spring_fit.hpp>
-#include <jelly/fit/trajectory.hpp>
 #include <jelly/geometry/body_spec.hpp>
-#include <jelly/solvers/integrators/implicit_euler_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "fit/fit_scenes.hpp"

@@ -6,7 +6,7 @@
 #include <random>
 
 #include <jelly/geometry/cube.hpp>
-#include <jelly/fit/trajectory.hpp>
+#include <jelly/fit/spring_fit.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "support/systems.hpp"

@@ -1,6 +1,6 @@
 // implicit_euler_ceres: backward Euler as nonlinear least squares, checked against analytic
 // answers and against Newton's method on the same equations.
-#include <jelly/fit/implicit_euler_ceres.hpp>
+#include <jelly/fit/detail/implicit_euler_ceres.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 #include "support/systems.hpp"
@@ -164,7 +164,8 @@ TEST(ImplicitEulerCeres, AgreesWithNewtonImplicitEuler) {
   IntegratorOptions newton;
   newton.implicit.newton_iterations = 50;
   newton.implicit.newton_tolerance = 1e-13;
-  newton.implicit.linear_solver = ImplicitLinearSolver::kCholmod;  // direct solves: no CG tolerance in the way
+  newton.implicit.linear_solver =
+      ImplicitLinearSolver::kCholmod;  // direct solves: no CG tolerance in the way
   SimulatorOptions options;
   options.dt = h;
   Simulator reference(model, deformed_state(model), make_integrator("implicit_euler", newton),

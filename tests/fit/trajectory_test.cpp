@@ -1,5 +1,5 @@
 // Trajectory: validation with clear messages, restart states, and the replay cost.
-#include <jelly/fit/trajectory.hpp>
+#include <jelly/fit/spring_fit.hpp>
 
 #include <cmath>
 #include <string>
@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/fit/spring_fit.hpp>
 
 #include "fit/fit_scenes.hpp"
 

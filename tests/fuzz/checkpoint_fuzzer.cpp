@@ -8,7 +8,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/io/checkpoint.hpp>
-#include <jelly/io/run_limits.hpp>
+#include <jelly/io/detail/run_limits.hpp>
 
 #include "fuzz/h5_mutation.hpp"
 

@@ -11,8 +11,8 @@
 #include <sstream>
 #include <vector>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/io/h5_recorder.hpp>
 
 namespace jelly::fuzz {

@@ -9,9 +9,9 @@
 #include <string>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/mesh_distance.hpp>
-#include <jelly/geometry/mesh_io.hpp>
-#include <jelly/geometry/voxelized.hpp>
+#include <jelly/geometry/detail/mesh_distance.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
+#include <jelly/geometry/detail/voxelized.hpp>
 
 #include "fuzz/fuzz_file.hpp"
 #include "fuzz/fuzz_target.hpp"

@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/fit/recording_trajectory.hpp>
+#include <jelly/fit/detail/recording_trajectory.hpp>
 #include <jelly/io/recording.hpp>
 
 #include "fuzz/h5_mutation.hpp"

@@ -7,9 +7,9 @@
 #include <cstdlib>
 #include <string>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
-#include <jelly/io/run_limits.hpp>
+#include <jelly/io/detail/run_limits.hpp>
 #include <jelly/io/scene.hpp>
 
 #include "fuzz/fuzz_target.hpp"

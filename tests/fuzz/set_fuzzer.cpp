@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/io/scene.hpp>
 
 #include "fuzz/fuzz_target.hpp"

@@ -8,9 +8,9 @@
 #include <string>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/lattice.hpp>
-#include <jelly/geometry/tet_mesh_io.hpp>
-#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/body_shape.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
 
 #include "fuzz/fuzz_file.hpp"
 #include "fuzz/fuzz_target.hpp"

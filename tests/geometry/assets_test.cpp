@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/geometry/body_spec.hpp>
-#include <jelly/geometry/voxelized.hpp>
+#include <jelly/geometry/detail/voxelized.hpp>
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/simulator.hpp>
 

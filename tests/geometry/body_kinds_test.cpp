@@ -7,14 +7,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/geometry/body_spec.hpp>
-#include <jelly/geometry/box.hpp>
-#include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/geometry/detail/box.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 

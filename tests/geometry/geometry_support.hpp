@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/geometry/lattice.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 
 #include "support/temp_dir.hpp"

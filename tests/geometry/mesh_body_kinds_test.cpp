@@ -4,11 +4,11 @@
 
 #include <gtest/gtest.h>
 
-#include <jelly/core/json.hpp>
-#include <jelly/geometry/body_kinds.hpp>
+#include <jelly/core/detail/json.hpp>
+#include <jelly/geometry/body_shape.hpp>
 #include <jelly/geometry/body_spec.hpp>
-#include <jelly/geometry/mesh_io.hpp>
-#include <jelly/geometry/tet_mesh_io.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 

@@ -7,8 +7,8 @@
 #include <limits>
 #include <random>
 
-#include <jelly/geometry/mesh_distance.hpp>
-#include <jelly/geometry/winding_number.hpp>
+#include <jelly/geometry/detail/mesh_distance.hpp>
+#include <jelly/geometry/detail/winding_number.hpp>
 
 #include "support/meshes.hpp"
 

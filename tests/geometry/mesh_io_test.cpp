@@ -6,7 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <jelly/geometry/mesh_io.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
 
 #include "geometry_support.hpp"
 

@@ -9,7 +9,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <jelly/geometry/tet_mesh_io.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
 
 #include "geometry_support.hpp"
 

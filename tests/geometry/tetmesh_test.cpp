@@ -5,10 +5,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <jelly/core/json.hpp>
-#include <jelly/geometry/tet_mesh_io.hpp>
-#include <jelly/geometry/tetmesh.hpp>
-#include <jelly/geometry/tetrahedralize.hpp>
+#include <jelly/core/detail/json.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
+#include <jelly/geometry/detail/tetrahedralize.hpp>
 #include <jelly/io/scene.hpp>
 
 #include "geometry_support.hpp"

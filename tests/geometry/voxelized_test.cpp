@@ -5,9 +5,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <jelly/core/json.hpp>
-#include <jelly/geometry/box.hpp>
-#include <jelly/geometry/voxelized.hpp>
+#include <jelly/core/detail/json.hpp>
+#include <jelly/geometry/detail/box.hpp>
+#include <jelly/geometry/detail/voxelized.hpp>
 #include <jelly/io/scene.hpp>
 
 #include "geometry_support.hpp"

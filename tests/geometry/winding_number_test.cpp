@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include <jelly/geometry/winding_number.hpp>
+#include <jelly/geometry/detail/winding_number.hpp>
 
 namespace jelly {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/io/checkpoint.hpp>
 #include <jelly/io/detail/h5.hpp>
 #include <jelly/io/h5_recorder.hpp>

@@ -6,6 +6,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/io/checkpoint.hpp>
 #include <jelly/io/h5_recorder.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 
 #include "io/io_support.hpp"
 

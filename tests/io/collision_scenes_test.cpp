@@ -11,8 +11,8 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/solvers/contact/broad_phase.hpp>
-#include <jelly/terrain/mesh_obstacle.hpp>
+#include <jelly/solvers/contact/detail/broad_phase.hpp>
+#include <jelly/terrain/detail/mesh_obstacle.hpp>
 
 #include "scene_files.hpp"
 #include "support/systems.hpp"

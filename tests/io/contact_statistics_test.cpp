@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/io/scene.hpp>

@@ -13,8 +13,8 @@
 #include <map>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
-#include <jelly/geometry/tet_mesh_io.hpp>
+#include <jelly/core/detail/json.hpp>
+#include <jelly/geometry/detail/tet_mesh_io.hpp>
 #include <jelly/io/detail/field_reference.hpp>
 #include <jelly/io/scene.hpp>
 

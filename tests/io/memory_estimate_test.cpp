@@ -3,7 +3,7 @@
 // resident size (VmHWM) over its resident size before the body was built; the estimate's growth
 // over an empty scene must be within a factor of 2 of it, at two sizes, and so must the growth
 // from the smaller size to the larger (the estimate's slope, what decides at large sizes).
-#include <jelly/io/memory_estimate.hpp>
+#include <jelly/io/detail/memory_estimate.hpp>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,7 +15,7 @@
 
 #include <gtest/gtest.h>
 
-#include <jelly/io/run_limits.hpp>
+#include <jelly/io/detail/run_limits.hpp>
 #include <jelly/io/scene.hpp>
 
 namespace jelly {

@@ -2,8 +2,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/io/scene.hpp>
 
 namespace jelly {
@@ -56,7 +56,7 @@ TEST(SceneRealtimeOptions, BadOptionsNameTheirPath) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::StartsWith("integrator.options.substeps = 0 is invalid"));
   }
-  // Named choices come from their enum tables (core/enum_names.hpp): the message lists them.
+  // Named choices come from their enum tables (core/errors.hpp): the message lists them.
   try {
     parse_scene(kScene,
                 {"integrator.name=projective_dynamics", "integrator.options.contact=\"implicit\""});

@@ -6,11 +6,11 @@
 #include <memory>
 #include <string>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/core/errors.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 int main(int argc, char** argv) {

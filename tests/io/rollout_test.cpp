@@ -1,7 +1,7 @@
 // Batched rollouts: the frame times a rollout plans are those a Simulator emits, each run equals
 // its scene run alone bit for bit for any thread count, a diverged run stops alone, and runs of
 // other particle counts or bad overrides are refused by name.
-#include <jelly/io/rollout.hpp>
+#include <jelly/io/detail/rollout.hpp>
 
 #include <atomic>
 #include <cmath>

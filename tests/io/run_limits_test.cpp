@@ -1,6 +1,6 @@
 // What a run takes, checked before it starts: no step, absurd step or frame counts, steps lost to
 // rounding, cubes beyond memory and recordings beyond the disk are InputErrors naming the field.
-#include <jelly/io/run_limits.hpp>
+#include <jelly/io/detail/run_limits.hpp>
 
 #include <cmath>
 #include <string>
@@ -10,7 +10,7 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/io/memory_estimate.hpp>
+#include <jelly/io/detail/memory_estimate.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {

@@ -1,6 +1,6 @@
 // Scene files: the seed scenes load to the seed facts, scenes round-trip through JSON, and every
 // kind of bad scene or --set override is an InputError with a precise message.
-#include <jelly/core/json.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/io/scene.hpp>
 
 #include <algorithm>
@@ -18,8 +18,9 @@
 #include <jelly/core/measures.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "scene_files.hpp"

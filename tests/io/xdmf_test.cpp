@@ -1,4 +1,4 @@
-// The XDMF sidecar (io/xdmf.hpp): every DataItem names a whole dataset of the recording, the
+// The XDMF sidecar (io/h5_recorder.hpp): every DataItem names a whole dataset of the recording, the
 // per-frame views read as the recorded frames, the derived arrays are what they claim, and the
 // sidecar is the same whether written at the end of a run, in several runs or from the file
 // alone. (That ParaView's readers open it: the ctest jelly_paraview, tests/io/paraview_test.py.)
@@ -19,8 +19,7 @@
 #include <jelly/geometry/triangle_mesh.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/io/xdmf.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/terrain.hpp>
 
 #include "io/io_support.hpp"

@@ -1,4 +1,4 @@
-#include <jelly/solvers/divergence_guard.hpp>
+#include <jelly/solvers/run_report.hpp>
 
 #include <gtest/gtest.h>
 

@@ -9,8 +9,8 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/arkode/arkode_options.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/plane.hpp>

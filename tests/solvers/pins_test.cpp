@@ -9,8 +9,8 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/body_spec.hpp>
-#include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>
 

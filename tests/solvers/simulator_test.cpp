@@ -8,9 +8,9 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 #include "support/systems.hpp"

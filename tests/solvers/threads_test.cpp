@@ -5,11 +5,12 @@
 #include <cmath>
 #include <vector>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/plane.hpp>

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include <jelly/geometry/mesh_io.hpp>
+#include <jelly/geometry/detail/mesh_io.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 
 #include "support/temp_dir.hpp"

@@ -8,10 +8,10 @@
 #include <limits>
 #include <random>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
-#include <jelly/terrain/mesh_obstacle.hpp>
-#include <jelly/terrain/obstacle.hpp>
+#include <jelly/terrain/detail/mesh_obstacle.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
 #include "support/errors.hpp"

@@ -6,9 +6,9 @@
 #include <limits>
 #include <random>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
-#include <jelly/terrain/obstacle.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
 #include "support/errors.hpp"

@@ -4,8 +4,8 @@
 #include <memory>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/terrain/elevator.hpp>
-#include <jelly/terrain/obstacle.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
 #include <jelly/terrain/plane.hpp>
 
 namespace jelly {

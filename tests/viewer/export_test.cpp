@@ -12,7 +12,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/geometry/cube.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
-#include <jelly/io/export.hpp>
+#include <jelly/io/detail/export.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/io/scene.hpp>

@@ -9,11 +9,11 @@
 #include <map>
 #include <thread>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/io/export.hpp>
+#include <jelly/io/detail/export.hpp>
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/io/scene.hpp>

@@ -6,7 +6,7 @@
 #include <mutex>
 #include <string>
 
-#include <jelly/geometry/tetmesh.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
 
 namespace jelly::detail {
 

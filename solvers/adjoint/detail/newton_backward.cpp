@@ -7,7 +7,7 @@
 
 #include <Eigen/Dense>
 
-#include <jelly/core/forces.hpp>
+#include <jelly/core/detail/forces.hpp>
 
 namespace jelly {
 

@@ -12,7 +12,7 @@
 #include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 

@@ -13,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include <jelly/core/anchor_springs.hpp>
 #include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/arkode/detail/arkode_support.hpp>

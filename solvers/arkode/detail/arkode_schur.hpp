@@ -11,7 +11,7 @@
 #include <jelly/core/detail/jacobian.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/arkode/detail/arkode_support.hpp>
-#include <jelly/solvers/linear/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
 
 namespace jelly::arkode {
 

@@ -12,7 +12,7 @@
 #include <sundials/sundials_linearsolver.h>
 #include <sundials/sundials_matrix.h>
 
-#include <jelly/solvers/arkode/arkode_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 
 namespace jelly::arkode {

@@ -38,10 +38,10 @@
 #include <utility>
 #include <vector>
 
+#include <jelly/core/detail/sparse_matrix.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/core/sparse_matrix.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
 
 namespace jelly {
 

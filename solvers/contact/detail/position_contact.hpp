@@ -18,7 +18,7 @@
 
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/contact/detail/restitution.hpp>
 
 namespace jelly {

@@ -4,10 +4,11 @@
 
 #include <jelly/core/detail/anchor_jacobian.hpp>
 #include <jelly/core/detail/clock.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
-#include <jelly/solvers/linear/cg_solver.hpp>
-#include <jelly/solvers/linear/cholmod_solver.hpp>
-#include <jelly/solvers/linear/ldlt_solver.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
+#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/ldlt_solver.hpp>
 
 namespace jelly {
 

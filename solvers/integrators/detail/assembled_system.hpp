@@ -11,8 +11,8 @@
 #include <jelly/core/force.hpp>
 #include <jelly/solvers/contact/detail/implicit_body_contact.hpp>
 #include <jelly/solvers/integrators/detail/backward_euler_system.hpp>
-#include <jelly/solvers/integrators/implicit_euler_options.hpp>
-#include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
 
 namespace jelly {
 

@@ -10,7 +10,7 @@
 #include <jelly/core/types.hpp>
 #include <jelly/solvers/dynamics.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 

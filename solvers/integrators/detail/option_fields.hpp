@@ -3,11 +3,7 @@
 // options .cpp: scene I/O, validation, the Python properties and the scene-key reference read
 // them.
 #include <jelly/core/detail/field_table.hpp>
-#include <jelly/solvers/arkode/arkode_options.hpp>
-#include <jelly/solvers/integrators/implicit_euler_options.hpp>
-#include <jelly/solvers/integrators/projective_dynamics_options.hpp>
-#include <jelly/solvers/integrators/vbd_options.hpp>
-#include <jelly/solvers/integrators/xpbd_options.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly {
 

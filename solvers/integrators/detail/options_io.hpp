@@ -1,7 +1,7 @@
 #pragma once
 // The registry entry's options of an integrator whose options are one member of
 // IntegratorOptions with read/to_json/validate of their own: for the table in registry.cpp and
-// the components' registrations. Include <jelly/core/json.hpp> before it.
+// the components' registrations. Include <jelly/core/detail/json.hpp> before it.
 #include <string>
 #include <type_traits>
 #include <utility>

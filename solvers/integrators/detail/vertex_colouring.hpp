@@ -5,7 +5,7 @@
 // the particles can be updated in any order, on any number of threads, with the same result.
 #include <vector>
 
-#include <jelly/core/springs.hpp>
+#include <jelly/core/model.hpp>
 
 namespace jelly {
 

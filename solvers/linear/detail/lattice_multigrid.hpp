@@ -32,7 +32,7 @@
 
 #include <jelly/core/detail/band_system.hpp>
 #include <jelly/core/model.hpp>
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 

@@ -30,9 +30,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/SparseCore>
 
-#include <jelly/core/sparse_matrix.hpp>
+#include <jelly/core/detail/sparse_matrix.hpp>
 #include <jelly/core/types.hpp>
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 

@@ -9,13 +9,13 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/core/external_force.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/geometry/body_spec.hpp>
-#include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/adjoint/implicit_euler_adjoint.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
+#include <jelly/solvers/adjoint/detail/implicit_euler_adjoint.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>
 

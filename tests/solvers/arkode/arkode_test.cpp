@@ -8,15 +8,15 @@
 #include <Eigen/Dense>
 
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/arkode/arkode_dirk.hpp>
-#include <jelly/solvers/arkode/arkode_erk.hpp>
+#include <jelly/solvers/arkode/detail/arkode_dirk.hpp>
+#include <jelly/solvers/arkode/detail/arkode_erk.hpp>
 #include <jelly/solvers/arkode/detail/arkode_iterative.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "support/systems.hpp"
@@ -406,7 +406,7 @@ TEST(Arkode, BadOptionsNameTheField) {
   EXPECT_EQ(ArkodeDirk(o).order(), 4);
 }
 
-// The named choices are tables (core/enum_names.hpp): every method of the tables builds its
+// The named choices are tables (core/errors.hpp): every method of the tables builds its
 // integrator with the order its name ends with, an unknown name is refused with the table's
 // names, and the scene's linear_solver is read and written through its table (default "auto").
 TEST(Arkode, MethodsAndLinearSolversAreTables) {

@@ -14,8 +14,8 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/contact/body_contact.hpp>
-#include <jelly/solvers/contact/broad_phase.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/broad_phase.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/terrain/plane.hpp>

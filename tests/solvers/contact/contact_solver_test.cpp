@@ -4,10 +4,10 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "support/systems.hpp"

@@ -5,16 +5,17 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/forces.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/contact/detail/implicit_contact.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "support/systems.hpp"

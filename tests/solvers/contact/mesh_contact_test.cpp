@@ -7,9 +7,9 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/contact/contact_solver.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/mesh_obstacle.hpp>
+#include <jelly/terrain/detail/mesh_obstacle.hpp>
 
 #include "support/meshes.hpp"
 #include "support/systems.hpp"

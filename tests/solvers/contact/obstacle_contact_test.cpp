@@ -7,8 +7,9 @@
 
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/obstacle.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
 
 #include "support/systems.hpp"
 

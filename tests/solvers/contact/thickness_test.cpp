@@ -9,16 +9,16 @@
 #include <optional>
 #include <string>
 
+#include <jelly/core/detail/json.hpp>
 #include <jelly/core/errors.hpp>
-#include <jelly/core/json.hpp>
 #include <jelly/geometry/body_spec.hpp>
-#include <jelly/geometry/cloth.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/terrain/contact_params.hpp>
-#include <jelly/terrain/obstacle.hpp>
+#include <jelly/terrain/detail/obstacle.hpp>
 #include <jelly/terrain/plane.hpp>
+#include <jelly/terrain/terrain.hpp>
 
 #include "support/systems.hpp"
 

@@ -11,11 +11,13 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
-#include <jelly/solvers/integrators/projective_dynamics.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/projective_dynamics.hpp>
+#include <jelly/solvers/integrators/detail/xpbd.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/solvers/integrators/xpbd.hpp>
-#include <jelly/terrain/elevator.hpp>
+#include <jelly/terrain/detail/elevator.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "support/systems.hpp"

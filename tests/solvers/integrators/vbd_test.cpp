@@ -1,5 +1,5 @@
-// Vertex block descent (solvers/integrators/vbd.hpp): its colouring, its conservation laws, its
-// rest state against backward Euler's static solution, the impact that crushes xpbd's jelly,
+// Vertex block descent (solvers/integrators/detail/vbd.hpp): its colouring, its conservation laws,
+// its rest state against backward Euler's static solution, the impact that crushes xpbd's jelly,
 // and its independence of the thread count (docs/realtime.md).
 #include <gtest/gtest.h>
 
@@ -10,10 +10,11 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/detail/contact_solver.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
+#include <jelly/solvers/integrators/detail/vbd.hpp>
 #include <jelly/solvers/integrators/detail/vertex_colouring.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/solvers/integrators/vbd.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "support/systems.hpp"

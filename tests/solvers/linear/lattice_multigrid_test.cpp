@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <jelly/core/detail/band_system.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
 
 namespace jelly {
 namespace {

@@ -1,9 +1,9 @@
 // Every backend of the LinearSolver interface on the same systems.
 #include <gtest/gtest.h>
 
-#include <jelly/solvers/linear/cg_solver.hpp>
-#include <jelly/solvers/linear/cholmod_solver.hpp>
-#include <jelly/solvers/linear/ldlt_solver.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
+#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
+#include <jelly/solvers/linear/detail/ldlt_solver.hpp>
 
 #include "solvers/linear/linear_systems.hpp"
 

@@ -6,11 +6,11 @@
 #include <gtest/gtest.h>
 #include <Eigen/Cholesky>
 
-#include <jelly/geometry/cube.hpp>
+#include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/core/forces.hpp>
 #include <jelly/core/measures.hpp>
-#include <jelly/solvers/linear/linear_solver.hpp>
+#include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 #include "support/systems.hpp"
 

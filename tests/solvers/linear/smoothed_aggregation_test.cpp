@@ -5,11 +5,11 @@
 #include <random>
 
 #include <jelly/core/detail/jacobian.hpp>
-#include <jelly/geometry/cloth.hpp>
-#include <jelly/geometry/tetmesh.hpp>
-#include <jelly/solvers/integrators/implicit_euler.hpp>
+#include <jelly/geometry/detail/cloth.hpp>
+#include <jelly/geometry/detail/tetmesh.hpp>
+#include <jelly/solvers/integrators/detail/implicit_euler.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
-#include <jelly/solvers/linear/cg_solver.hpp>
+#include <jelly/solvers/linear/detail/cg_solver.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/plane.hpp>
 
