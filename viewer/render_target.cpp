@@ -6,6 +6,7 @@
 #include <string>
 
 #include <jelly/viewer/detail/gl.hpp>
+#include <jelly/viewer/detail/gl_program.hpp>
 
 namespace jelly::viewer {
 
@@ -62,36 +63,9 @@ void main() {
 }
 )";
 
-GLuint compile_fxaa_shader(GLenum type, const char* source) {
-  const GLuint shader = glCreateShader(type);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    glDeleteShader(shader);
-    throw std::runtime_error(std::string("RenderTarget: the FXAA shader does not compile: ") + log);
-  }
-  return shader;
-}
-
 GLuint link_fxaa_program() {
-  const GLuint vs = compile_fxaa_shader(GL_VERTEX_SHADER, kFxaaVertex);
-  const GLuint fs = compile_fxaa_shader(GL_FRAGMENT_SHADER, kFxaaFragment);
-  const GLuint program = glCreateProgram();
-  glAttachShader(program, vs);
-  glAttachShader(program, fs);
-  glLinkProgram(program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    glDeleteProgram(program);
-    throw std::runtime_error("RenderTarget: the FXAA program does not link");
-  }
+  const GLuint program =
+      detail::link_gl_program(kFxaaVertex, kFxaaFragment, "RenderTarget: the FXAA");
   glUseProgram(program);
   glUniform1i(glGetUniformLocation(program, "u_image"), 0);
   glUseProgram(0);

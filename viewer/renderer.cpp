@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <jelly/viewer/detail/gl.hpp>
+#include <jelly/viewer/detail/gl_program.hpp>
 
 namespace jelly::viewer {
 
@@ -214,44 +215,6 @@ out vec4 o_color;
 void main() { o_color = vec4(mix(u_bottom, u_top, clamp(v_height, 0.0, 1.0)), 1.0); }
 )";
 
-GLuint compile(GLenum type, const std::string& text, const char* name) {
-  const GLuint shader = glCreateShader(type);
-  const char* source = text.c_str();
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    glDeleteShader(shader);
-    throw std::runtime_error(std::string("renderer: the ") + name +
-                             " shader does not compile: " + log);
-  }
-  return shader;
-}
-
-GLuint link(const std::string& vertex, const std::string& fragment, const char* name) {
-  const GLuint vs = compile(GL_VERTEX_SHADER, vertex, name);
-  const GLuint fs = compile(GL_FRAGMENT_SHADER, fragment, name);
-  const GLuint program = glCreateProgram();
-  glAttachShader(program, vs);
-  glAttachShader(program, fs);
-  glLinkProgram(program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {};
-    glGetProgramInfoLog(program, sizeof log, nullptr, log);
-    glDeleteProgram(program);
-    throw std::runtime_error(std::string("renderer: the ") + name +
-                             " program does not link: " + log);
-  }
-  return program;
-}
-
 // A program with its uniform locations looked up once.
 struct Program {
   GLuint id = 0;
@@ -261,7 +224,8 @@ struct Program {
         top = -1, bottom = -1, horizon = -1, focus = -1, extent = -1;
 
   void make(const std::string& vertex, const std::string& fragment, const char* name) {
-    id = link(vertex, fragment, name);
+    id = detail::link_gl_program(vertex.c_str(), fragment.c_str(),
+                                 std::string("renderer: the ") + name);
     const auto at = [this](const char* u) { return glGetUniformLocation(id, u); };
     model = at("u_model");
     view_proj = at("u_view_proj");

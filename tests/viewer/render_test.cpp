@@ -462,7 +462,7 @@ TEST(RenderCli, FxaaRendersAndRefusesMultisampling) {
   long red = 0;
   for (size_t i = 0; i + 2 < image.rgb.size(); i += 3) red += testing::is_jelly(&image.rgb[i]);
   EXPECT_GT(red, 200);
-  for (const std::string command :
+  for (const std::string& command :
        {"render '" + dir.file("r.h5") + "' -o '" + dir.file("g%03d.png") + "' --fxaa --samples 4",
         "view '" + dir.file("r.h5") + "' --fxaa --samples 2"}) {
     r = testing::run(jelly + command, dir);
