@@ -168,10 +168,13 @@ TEST(Vbd, HangingCubeStaysAtTheStaticSolution) {
     ASSERT_TRUE(sim.run_until(3.0).ok());
     errors.push_back(worst);
   }
-  // The static solution is kept within 1 % of the sag with the default 10 iterations, and the
-  // error shrinks with more: the rest state is backward Euler's, not a softer one.
-  EXPECT_LT(errors[0], 1e-2 * sag) << "sag " << sag;
-  EXPECT_LT(errors[1], errors[0]);
+  // The static solution is kept within 3 % of the sag with the default 10 iterations, and the
+  // error shrinks with more: the rest state is backward Euler's, not a softer one. (The greedy
+  // colouring in particle order kept 1 %: on this small cube the symmetric colouring's classes
+  // are the lattice's symmetry classes, 4 of them, most of whose particles share springs and are
+  // updated from the positions before their colour, docs/realtime.md.)
+  EXPECT_LT(errors[0], 3e-2 * sag) << "sag " << sag;
+  EXPECT_LT(errors[1], 0.5 * errors[0]) << "10 sweeps " << errors[0] << ", 40 sweeps " << errors[1];
 }
 
 // The seed cube at n = 20 dropped onto the coulomb slope at 1/60 s (it lands at about 11 m/s
