@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
   PeerBudgetOptions o;
   o.scenes_dir = JELLY_PEER_SCENES_DIR;
   o.reference = "bullet";
-  int threads = 0, iterations = 10;
+  int threads = 0, iterations = 10, converged_steps = 16, symplectic_steps = 32;
   IntegratorOptions jelly_options;
   std::vector<std::string> labels;
   std::string out = "out/bullet";
@@ -196,6 +196,10 @@ int main(int argc, char** argv) {
   app.add_option("--vbd-contact_hardness", jelly_options.vbd.contact_hardness,
                  "vbd's contact hardness (0 = contact after the step)");
   app.add_option("--xpbd-substeps", jelly_options.xpbd.substeps, "xpbd's substeps per step");
+  app.add_option("--converged-steps", converged_steps,
+                 "rk4's steps per frame for the converged stretch (0 = no such setup)");
+  app.add_option("--symplectic-steps", symplectic_steps,
+                 "symplectic_euler's steps per frame (0 = no such setup)");
   app.add_option("--setups", labels, "only these setups (labels, comma-separated)")->delimiter(',');
   app.add_option("--out", out, "output folder (CSV, HDF5)");
   CLI11_PARSE(app, argc, argv);
@@ -205,7 +209,22 @@ int main(int argc, char** argv) {
     require(threads >= 0, "--threads", threads, "an integer >= 0 (0 = all cores)");
     jelly_options.vbd.validate("--vbd-");
     jelly_options.xpbd.validate("--xpbd-");
+    require(converged_steps >= 0 && converged_steps <= 10000, "--converged-steps", converged_steps,
+            "an integer in [0, 10000] (0 = none)");
+    require(symplectic_steps >= 0 && symplectic_steps <= 10000, "--symplectic-steps",
+            symplectic_steps, "an integer in [0, 10000] (0 = none)");
     std::vector<PeerSetup> setups = default_jelly_peer_setups(threads, jelly_options);
+    if (converged_steps > 0) {
+      // The material's own stretch: rk4 at a small step (converged: docs/performance.md).
+      o.converged = "rk4 x" + std::to_string(converged_steps);
+      setups.push_back(
+          jelly_peer_setup(o.converged, "rk4", jelly_options, threads, converged_steps));
+    }
+    if (symplectic_steps > 0) {
+      setups.push_back(jelly_peer_setup("symplectic_euler x" + std::to_string(symplectic_steps),
+                                        "symplectic_euler", jelly_options, threads,
+                                        symplectic_steps));
+    }
     PeerSetup bullet;
     bullet.label = "bullet";
     bullet.engine = "bullet 3.24 btSoftBody, " + std::to_string(iterations) + " iterations";

@@ -21,12 +21,15 @@ Real median_of(std::vector<Real> v) {
 
 class JellyRun final : public PeerRun {
  public:
-  explicit JellyRun(Simulator sim) : sim_(std::move(sim)) {}
+  JellyRun(Simulator sim, int steps_per_frame)
+      : sim_(std::move(sim)), steps_per_frame_(steps_per_frame) {}
   bool frame() override {
-    const StepResult r = sim_.step();
-    if (!r.ok) {
-      why_ = r.message;
-      return false;
+    for (int k = 0; k < steps_per_frame_; ++k) {
+      const StepResult r = sim_.step();
+      if (!r.ok) {
+        why_ = r.message;
+        return false;
+      }
     }
     if (auto why = sim_.options().divergence.check(sim_.model(), sim_.state())) {
       why_ = *why;
@@ -39,6 +42,7 @@ class JellyRun final : public PeerRun {
 
  private:
   Simulator sim_;
+  int steps_per_frame_;
   std::string why_;
 };
 
@@ -75,17 +79,17 @@ Scene peer_scene(const std::string& name, const std::string& scenes_dir) {
 int peer_lattice_n(const std::string& name) { return name == "cube20" ? 20 : 0; }
 
 PeerSetup jelly_peer_setup(const std::string& label, const std::string& integrator,
-                           const IntegratorOptions& options, int threads) {
+                           const IntegratorOptions& options, int threads, int steps_per_frame) {
   PeerSetup s;
   s.label = label;
   s.engine = "jelly";
-  s.make = [integrator, options, threads](const Scene& scene, Real frame) {
+  s.make = [integrator, options, threads, steps_per_frame](const Scene& scene, Real frame) {
     Scene copy = scene;
     copy.integrator.name = integrator;
     copy.integrator.options = options;
-    copy.integrator.dt = frame;
+    copy.integrator.dt = frame / steps_per_frame;
     copy.threads = threads;
-    return std::unique_ptr<PeerRun>(new JellyRun(make_simulator(copy)));
+    return std::unique_ptr<PeerRun>(new JellyRun(make_simulator(copy), steps_per_frame));
   };
   return s;
 }
@@ -119,11 +123,29 @@ Table run_peer_budget(const PeerBudgetOptions& o, const std::vector<PeerSetup>& 
               "time_ratio = median over rounds of mean frame time / the reference's; "
               "penetration_max (m), stretch_max ((L - l0) / l0 over all springs and frames), "
               "stretch_end (last frame), volume_ratio_min/_end and inverted_cells_max/_end "
-              "(cube: worst frame, last frame)",
-              {"scene:s", "setup:s", "engine:s", "particles", "springs", "status:s", "frames",
-               "frame_ms_median", "frame_ms_mean", "frame_ms_max", "time_ratio", "penetration_max",
-               "stretch_max", "stretch_end", "volume_ratio_min", "volume_ratio_end",
-               "inverted_cells_max", "inverted_cells_end", "reason:s"});
+              "(cube: worst frame, last frame), stretch_beyond_max/_end (stretch_max/_end less "
+              "the converged setup's)",
+              {"scene:s",
+               "setup:s",
+               "engine:s",
+               "particles",
+               "springs",
+               "status:s",
+               "frames",
+               "frame_ms_median",
+               "frame_ms_mean",
+               "frame_ms_max",
+               "time_ratio",
+               "penetration_max",
+               "stretch_max",
+               "stretch_end",
+               "volume_ratio_min",
+               "volume_ratio_end",
+               "inverted_cells_max",
+               "inverted_cells_end",
+               "stretch_beyond_max",
+               "stretch_beyond_end",
+               "reason:s"});
   const int frames = static_cast<int>(std::lround(o.duration / o.frame));
   for (const std::string& name : o.scenes) {
     const Scene scene = peer_scene(name, o.scenes_dir);
@@ -178,9 +200,12 @@ Table run_peer_budget(const PeerBudgetOptions& o, const std::vector<PeerSetup>& 
         }
       }
     }
-    int reference = -1;
-    for (size_t k = 0; k < setups.size(); ++k)
+    int reference = -1, converged = -1;
+    for (size_t k = 0; k < setups.size(); ++k) {
       if (setups[k].label == o.reference) reference = static_cast<int>(k);
+      if (setups[k].label == o.converged && results[k].status == "completed")
+        converged = static_cast<int>(k);
+    }
     for (size_t k = 0; k < setups.size(); ++k) {
       const Result& r = results[k];
       Real ratio = NAN;
@@ -196,14 +221,27 @@ Table run_peer_budget(const PeerBudgetOptions& o, const std::vector<PeerSetup>& 
         mean += t / r.times.size();
         worst = std::max(worst, t);
       }
-      table.add_row({name, setups[k].label, setups[k].engine,
+      table.add_row({name,
+                     setups[k].label,
+                     setups[k].engine,
                      static_cast<double>(model.num_particles()),
-                     static_cast<double>(model.springs.size()), r.status,
-                     static_cast<double>(r.done), 1e3 * median_of(r.times), 1e3 * mean, 1e3 * worst,
-                     ratio, r.worst.penetration, r.worst.stretch, r.stretch_end,
-                     lattice ? r.worst.volume_ratio : NAN, lattice ? r.volume_end : NAN,
+                     static_cast<double>(model.springs.size()),
+                     r.status,
+                     static_cast<double>(r.done),
+                     1e3 * median_of(r.times),
+                     1e3 * mean,
+                     1e3 * worst,
+                     ratio,
+                     r.worst.penetration,
+                     r.worst.stretch,
+                     r.stretch_end,
+                     lattice ? r.worst.volume_ratio : NAN,
+                     lattice ? r.volume_end : NAN,
                      lattice ? static_cast<double>(r.worst.inverted_cells) : NAN,
-                     lattice ? static_cast<double>(r.inverted_end) : NAN, r.reason});
+                     lattice ? static_cast<double>(r.inverted_end) : NAN,
+                     converged >= 0 ? r.worst.stretch - results[converged].worst.stretch : NAN,
+                     converged >= 0 ? r.stretch_end - results[converged].stretch_end : NAN,
+                     r.reason});
     }
   }
   return table;

@@ -51,9 +51,10 @@ struct PeerSetup {
   std::function<std::unique_ptr<PeerRun>(const Scene&, Real frame)> make;
 };
 
-// jelly with `integrator` and its options, one step per frame, on `threads` threads (0 = all).
+// jelly with `integrator` and its options, `steps_per_frame` steps of frame / steps_per_frame
+// per frame, on `threads` threads (0 = all).
 PeerSetup jelly_peer_setup(const std::string& label, const std::string& integrator,
-                           const IntegratorOptions& options, int threads);
+                           const IntegratorOptions& options, int threads, int steps_per_frame = 1);
 // vbd, xpbd and implicit_euler with the given options (labels "vbd i<iterations>",
 // "xpbd s<substeps>", "implicit_euler"), one step per frame each.
 std::vector<PeerSetup> default_jelly_peer_setups(int threads, const IntegratorOptions& options);
@@ -65,13 +66,17 @@ struct PeerBudgetOptions {
   Real duration = 3;       // s simulated per run
   int rounds = 3;          // runs of every setup, in alternation
   std::string reference;   // label the time ratios are taken against (empty: none)
+  // Label of the setup whose stretch is the material's (a converged solution: rk4 at a small
+  // step): the others' stretch is also given beyond it (empty: none).
+  std::string converged;
   std::ostream* progress = nullptr;
   void validate() const;
 };
 
 // Rows per scene and setup: frame time (median, mean, max over every frame of every round),
 // time_ratio (median over rounds of the setup's mean frame time over the reference's in the
-// same round), and the worst measures over the runs' frames.
+// same round), the worst measures over the runs' frames, and the largest and last stretch less
+// the converged setup's.
 Table run_peer_budget(const PeerBudgetOptions& options, const std::vector<PeerSetup>& setups);
 
 }  // namespace jelly::bench

@@ -349,10 +349,13 @@ def render_bullet(data):
                      f"{sig(r['volume_ratio_min'], 2)} / {sig(r['volume_ratio_end'], 2)}"
                      if cube else "",
                      f"{int(r['inverted_cells_max']):,} / {int(r['inverted_cells_end']):,}"
-                     if cube else "", r["status"].replace("_", " ")])
+                     if cube else "",
+                     f"{signed(r['stretch_beyond_max'])} / {signed(r['stretch_beyond_end'])}"
+                     if finite(r.get("stretch_beyond_max", "")) else "",
+                     r["status"].replace("_", " ")])
     header = ["scene", "setup", "frame ms: median / mean / max", "time / Bullet's",
               "penetration (m)", "stretch: max / end", "volume ratio: min / end",
-              "inverted cells: max / end", "status"]
+              "inverted cells: max / end", "stretch beyond the converged: max / end", "status"]
     return "\n\n".join([table(header, body), measured(meta)])
 
 

@@ -55,8 +55,8 @@ void Vbd::prepare(const Model& model) {
   for (int i : model.pins.particles) pinned_[i] = 1;
 }
 
-void Vbd::update_particle(const Model& model, const AnchorSprings* anchors, Real h, Real t1, int i,
-                          VecX& x) const {
+Vec3 Vbd::update_particle(const Model& model, const AnchorSprings* anchors, Real h, Real t1, int i,
+                          const VecX& x) const {
   const Springs& s = model.springs;
   const Real inv_h = 1.0 / h;
   const Vec3 xi(particle(x, i));
@@ -161,21 +161,36 @@ void Vbd::update_particle(const Model& model, const AnchorSprings* anchors, Real
   }
   // H is symmetric positive definite (inertia + clamped, positive semidefinite terms).
   const Eigen::LLT<Eigen::Matrix3d> llt(hess);
-  particle(x, i) = xi + llt.solve(f);
+  return xi + llt.solve(f);
 }
 
 void Vbd::sweep(const Model& model, const AnchorSprings* anchors, Real h, Real t1, VecX& x,
                 int threads) {
   const int team = parallel::team_size(threads, graph_.largest_colour(), kMinVbdParticlesPerThread);
-  // One team for the sweep, colour after colour, a barrier between colours: within a colour
-  // each particle reads only particles of other colours, so the result is that of any order.
+  // One team for the sweep, colour after colour, a barrier between colours. Within a colour each
+  // particle reads only particles of other colours, or, in a coupled colour, the positions from
+  // before the colour (its new positions go to next_ first): the result is that of any order.
   parallel::run(team, [&](int part, int parts) {
     for (int c = 0; c < graph_.colours(); ++c) {
       const long begin = graph_.colour_start[c], count = graph_.colour_start[c + 1] - begin;
       const parallel::Range r = parallel::split(count, part, parts);
-      for (long p = begin + r.begin; p < begin + r.end; ++p) {
-        const int i = graph_.particles[p];
-        if (!pinned_[i]) update_particle(model, anchors, h, t1, i, x);
+      if (!graph_.coupled[c]) {
+        for (long p = begin + r.begin; p < begin + r.end; ++p) {
+          const int i = graph_.particles[p];
+          if (!pinned_[i]) particle(x, i) = update_particle(model, anchors, h, t1, i, x);
+        }
+      } else {
+        for (long p = begin + r.begin; p < begin + r.end; ++p) {
+          const int i = graph_.particles[p];
+          if (!pinned_[i]) particle(next_, i) = update_particle(model, anchors, h, t1, i, x);
+        }
+        if (parts > 1) {
+#pragma omp barrier
+        }
+        for (long p = begin + r.begin; p < begin + r.end; ++p) {
+          const int i = graph_.particles[p];
+          if (!pinned_[i]) particle(x, i) = particle(next_, i);
+        }
       }
       if (parts > 1) {
 #pragma omp barrier
@@ -191,6 +206,7 @@ StepResult Vbd::do_step(const Dynamics& dynamics, State& s, Real h) {
   const int n = model.num_particles();
   const int threads = dynamics.threads();
   ensure_size(f_, 3 * n);
+  ensure_size(next_, 3 * n);
   // The inertial target y = x + h v + h^2 M^-1 f_ext: gravity, the model's external and added
   // forces and the seed model's contact forces, explicit over the step.
   for (int i = 0; i < n; ++i) particle(f_, i) = model.mass[i] * model.gravity;

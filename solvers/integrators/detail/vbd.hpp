@@ -2,7 +2,8 @@
 // Vertex block descent (Chen et al., SIGGRAPH 2024): backward Euler's incremental potential
 //   G(x) = sum_i m_i / (2 h^2) |x_i - y_i|^2 + E_springs(x),   y = x^t + h v^t + h^2 a_ext,
 // minimised by `iterations` sweeps of block coordinate descent: colour by colour of the springs'
-// vertex graph (detail/vertex_colouring.hpp), each particle takes one Newton step on its own
+// vertex graph (detail/vertex_colouring.hpp: a colouring every symmetry of the graph keeps, so
+// that mirror images stay mirror images), each particle takes one Newton step on its own
 // 3x3 block (its inertia, springs, dampers and anchor springs; the springs' Hessians made
 // definite as implicit_euler's clamp does), with the particles of one colour in parallel;
 // optionally Chebyshev-accelerated; v = (x - x^t) / h. Contact with terrains and between bodies
@@ -42,9 +43,9 @@ class Vbd final : public Integrator {
   // One sweep over every colour on up to `threads` threads.
   void sweep(const Model& model, const AnchorSprings* anchors, Real h, Real t1, VecX& x,
              int threads);
-  // One particle's Newton step on its block of G.
-  void update_particle(const Model& model, const AnchorSprings* anchors, Real h, Real t1, int i,
-                       VecX& x) const;
+  // One particle's Newton step on its block of G at x: its new position.
+  Vec3 update_particle(const Model& model, const AnchorSprings* anchors, Real h, Real t1, int i,
+                       const VecX& x) const;
 
   VbdOptions options_;
   VertexColouring graph_;
@@ -56,6 +57,7 @@ class Vbd final : public Integrator {
   std::vector<const Terrain*> penalty_terrains_;  // the coulomb terrains of this step
   VecX gap_;  // [N]: each particle's thickness against them (contact/detail/thickness.hpp)
   VecX x0_, y_, previous_, before_previous_, f_;
+  VecX next_;  // [3N]: a coupled colour's new positions before they replace x
   long sweeps_ = 0;
 };
 

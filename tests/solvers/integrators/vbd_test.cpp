@@ -10,6 +10,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/core/measures.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/contact/detail/contact_solver.hpp>
 #include <jelly/solvers/integrators/detail/implicit_euler.hpp>
 #include <jelly/solvers/integrators/detail/vbd.hpp>
@@ -32,25 +33,56 @@ Simulator vbd_sim(const Model& model, const State& s, Real dt, const VbdOptions&
   return Simulator(model, s, make_integrator("vbd", o), so);
 }
 
-// No two particles of one colour share a spring, and every particle has one colour.
-TEST(Vbd, ColouringSeparatesEverySpring) {
-  const Model m = build_cube(testing::small_cube(5));
-  const VertexColouring g = colour_vertices(m.num_particles(), m.springs);
-  ASSERT_GT(g.colours(), 1);
-  std::vector<int> colour(m.num_particles(), -1);
-  for (int c = 0; c < g.colours(); ++c)
-    for (int p = g.colour_start[c]; p < g.colour_start[c + 1]; ++p) {
-      ASSERT_EQ(colour[g.particles[p]], -1);
-      colour[g.particles[p]] = c;
+// Every particle has one colour; two particles of one colour share a spring only when they are
+// in one class; the classes are the lattice's symmetry classes: mirror images across each
+// mid-plane, and the axes' permutations, share a class.
+TEST(Vbd, ColouringSeparatesEverySpringOutsideAClass) {
+  for (const int n : {4, 5}) {
+    SCOPED_TRACE(n);
+    const Model m = build_cube(testing::small_cube(n));
+    const VertexColouring g = colour_vertices(m.num_particles(), m.springs);
+    ASSERT_GT(g.colours(), 1);
+    std::vector<int> colour(m.num_particles(), -1);
+    for (int c = 0; c < g.colours(); ++c)
+      for (int p = g.colour_start[c]; p < g.colour_start[c + 1]; ++p) {
+        ASSERT_EQ(colour[g.particles[p]], -1);
+        colour[g.particles[p]] = c;
+      }
+    for (int i = 0; i < m.num_particles(); ++i) ASSERT_GE(colour[i], 0);
+    std::vector<char> coupled(g.colours(), 0);
+    for (int k = 0; k < m.springs.size(); ++k) {
+      const int a = m.springs.a[k], b = m.springs.b[k];
+      if (colour[a] != colour[b]) continue;
+      EXPECT_EQ(g.particle_class[a], g.particle_class[b]) << "spring " << k;
+      coupled[colour[a]] = 1;
     }
-  for (int i = 0; i < m.num_particles(); ++i) ASSERT_GE(colour[i], 0);
-  for (int k = 0; k < m.springs.size(); ++k)
-    EXPECT_NE(colour[m.springs.a[k]], colour[m.springs.b[k]]) << "spring " << k;
-  // Greedy: at most the largest degree + 1.
-  int degree = 0;
-  for (int i = 0; i < m.num_particles(); ++i)
-    degree = std::max(degree, g.spring_start[i + 1] - g.spring_start[i]);
-  EXPECT_LE(g.colours(), degree + 1);
+    for (int c = 0; c < g.colours(); ++c) EXPECT_EQ(coupled[c], g.coupled[c]) << "colour " << c;
+    const int last = n - 1;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        for (int k = 0; k < n; ++k) {
+          const int p = g.particle_class[cube_index(n, i, j, k)];
+          EXPECT_EQ(p, g.particle_class[cube_index(n, last - i, j, k)]);
+          EXPECT_EQ(p, g.particle_class[cube_index(n, i, last - j, k)]);
+          EXPECT_EQ(p, g.particle_class[cube_index(n, i, j, last - k)]);
+          EXPECT_EQ(p, g.particle_class[cube_index(n, j, k, i)]);
+        }
+    // The corners, the edges' inner particles, ... : the orbits of the cube's 48 symmetries.
+    EXPECT_EQ(g.classes(), n == 4 ? 4 : 10);
+    // Renumbering the particles renumbers the colouring: the same colours, particle for particle.
+    Springs reversed = m.springs;
+    const int last_particle = m.num_particles() - 1;
+    for (int k = 0; k < reversed.size(); ++k) {
+      reversed.a[k] = last_particle - m.springs.a[k];
+      reversed.b[k] = last_particle - m.springs.b[k];
+    }
+    const VertexColouring r = colour_vertices(m.num_particles(), reversed);
+    std::vector<int> colour_r(m.num_particles(), -1);
+    for (int c = 0; c < r.colours(); ++c)
+      for (int p = r.colour_start[c]; p < r.colour_start[c + 1]; ++p) colour_r[r.particles[p]] = c;
+    for (int i = 0; i < m.num_particles(); ++i)
+      EXPECT_EQ(colour[i], colour_r[last_particle - i]) << "particle " << i;
+  }
 }
 
 State spinning(const Model& model, unsigned seed) {
@@ -136,10 +168,13 @@ TEST(Vbd, HangingCubeStaysAtTheStaticSolution) {
     ASSERT_TRUE(sim.run_until(3.0).ok());
     errors.push_back(worst);
   }
-  // The static solution is kept within 1 % of the sag with the default 10 iterations, and the
-  // error shrinks with more: the rest state is backward Euler's, not a softer one.
-  EXPECT_LT(errors[0], 1e-2 * sag) << "sag " << sag;
-  EXPECT_LT(errors[1], errors[0]);
+  // The static solution is kept within 3 % of the sag with the default 10 iterations, and the
+  // error shrinks with more: the rest state is backward Euler's, not a softer one. (The greedy
+  // colouring in particle order kept 1 %: on this small cube the symmetric colouring's classes
+  // are the lattice's symmetry classes, 4 of them, most of whose particles share springs and are
+  // updated from the positions before their colour, docs/realtime.md.)
+  EXPECT_LT(errors[0], 3e-2 * sag) << "sag " << sag;
+  EXPECT_LT(errors[1], 0.5 * errors[0]) << "10 sweeps " << errors[0] << ", 40 sweeps " << errors[1];
 }
 
 // The seed cube at n = 20 dropped onto the coulomb slope at 1/60 s (it lands at about 11 m/s
@@ -282,6 +317,121 @@ TEST(Vbd, InvalidOptionsNameTheField) {
   o.chebyshev_rho = NAN;
   EXPECT_NE(message(o).find("integrator.options.chebyshev_rho"), std::string::npos);
   EXPECT_NO_THROW(make_integrator("vbd"));
+}
+
+// A cube stretched symmetrically about its centre and let go (no gravity, no terrain): the
+// sweeps keep it symmetric under the three mirrors to round-off, so that its linear and angular
+// momentum stay zero to 1e-12 (the greedy colouring in particle order lost the symmetry by
+// millimetres), for few and many sweeps, with and without Chebyshev acceleration.
+TEST(Vbd, StretchedCubeStaysSymmetric) {
+  for (const auto& [iterations, rho] :
+       {std::pair{2, 0.0}, std::pair{10, 0.0}, std::pair{10, 0.6}}) {
+    SCOPED_TRACE(std::to_string(iterations) + " sweeps, rho " + std::to_string(rho));
+    const int n = 5;
+    const CubeSpec spec = testing::small_cube(n, 1.0, Vec3(-0.5, -0.5, -0.5));
+    Model model = build_cube(spec);
+    model.gravity.setZero();
+    State s = rest_state(model);
+    for (int i = 0; i < model.num_particles(); ++i) {
+      const Vec3 p = particle(s.x, i);
+      particle(s.x, i) = Vec3(1.4 * p.x(), 0.8 * p.y(), 1.1 * p.z());
+    }
+    VbdOptions o;
+    o.iterations = iterations;
+    o.chebyshev_rho = rho;
+    Simulator sim = vbd_sim(model, s, 1.0 / 60, o);
+    Real spin = 0, momentum = 0, asymmetry = 0;
+    testing::Probe probe([&](const Simulator& sm) {
+      spin = std::max(spin, angular_momentum(model, sm.state()).norm());
+      momentum = std::max(momentum, linear_momentum(model, sm.state()).norm());
+      const VecX& x = sm.state().x;
+      const int l = n - 1;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          for (int k = 0; k < n; ++k) {
+            const Vec3 p = particle(x, cube_index(n, i, j, k));
+            const Vec3 mx = particle(x, cube_index(n, l - i, j, k));
+            const Vec3 my = particle(x, cube_index(n, i, l - j, k));
+            const Vec3 mz = particle(x, cube_index(n, i, j, l - k));
+            asymmetry = std::max({asymmetry, (p - Vec3(-mx.x(), mx.y(), mx.z())).norm(),
+                                  (p - Vec3(my.x(), -my.y(), my.z())).norm(),
+                                  (p - Vec3(mz.x(), mz.y(), -mz.z())).norm()});
+          }
+    });
+    sim.add_observer(probe);
+    ASSERT_TRUE(sim.run_until(1.0).ok());
+    // It moved: the stretch springs back.
+    EXPECT_GT(kinetic_energy(model, sim.state()) + elastic_energy(model, sim.state()), 0);
+    EXPECT_GT((sim.state().x - s.x).norm(), 0.1);
+    const Real scale = model.mass.sum();  // kg m/s: the total mass at 1 m/s
+    EXPECT_LT(spin, 1e-12 * scale);
+    EXPECT_LT(momentum, 1e-12 * scale);
+    EXPECT_LT(asymmetry, 1e-12);
+    EXPECT_LT(center_of_mass(model, sim.state()).norm(), 1e-12);
+  }
+}
+
+// Two n = 4 cubes, mirror images of each other across x = 0 (0.1 m apart), thrown head on at
+// 2 m/s each without gravity; the contact between them is the Simulator's after each step
+// (frictionless, inelastic).
+Simulator vbd_head_on(Real dt, int threads) {
+  Model model;
+  const CubeSpec a = testing::small_cube(4, 0.3, Vec3(-0.35, 0, 0));
+  const CubeSpec b = testing::small_cube(4, 0.3, Vec3(0.05, 0, 0));
+  model.add_body("left", a.shape().build(a.material(), "a."));
+  model.add_body("right", b.shape().build(b.material(), "b."));
+  model.gravity.setZero();
+  State s = rest_state(model);
+  for (int i = 0; i < model.num_particles(); ++i)
+    particle(s.v, i) = Vec3(i < 64 ? 2.0 : -2.0, 0, 0);
+  Simulator sim = vbd_sim(model, s, dt, {}, threads);
+  BodyContactParams params;
+  params.friction = params.static_friction = 0;
+  params.restitution = 0;
+  sim.set_body_contact(params);
+  return sim;
+}
+
+// The symmetric head-on collision stays symmetric at 1/240 and 1/60 s: particle (i, j, k) of the
+// left cube is the mirror image of (3 - i, j, k) of the right one, positions and velocities to
+// 1e-12; no sideways velocity, no spin, no net momentum. The colouring's classes span both
+// cubes (an automorphism of the springs' graph swaps them), and at 1/60 s 1 and 2 threads give
+// the same bits.
+TEST(Vbd, MirroredCollisionStaysSymmetric) {
+  for (const Real dt : {1.0 / 240, 1.0 / 60}) {
+    SCOPED_TRACE(dt);
+    Simulator sim = vbd_head_on(dt, 1);
+    const Model& model = sim.model();
+    long touching = 0;
+    Real spin = 0, momentum = 0, asymmetry = 0;
+    testing::Probe probe([&](const Simulator& sm) {
+      touching += sm.body_contact().pairs().empty() ? 0 : 1;
+      spin = std::max(spin, angular_momentum(model, sm.state()).norm());
+      momentum = std::max(momentum, linear_momentum(model, sm.state()).norm());
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+          for (int k = 0; k < 4; ++k) {
+            const int l = (i * 4 + j) * 4 + k, r = 64 + ((3 - i) * 4 + j) * 4 + k;
+            const Vec3 xl = particle(sm.state().x, l), xr = particle(sm.state().x, r);
+            const Vec3 vl = particle(sm.state().v, l), vr = particle(sm.state().v, r);
+            asymmetry = std::max({asymmetry, std::abs(xl.x() + xr.x()), std::abs(xl.y() - xr.y()),
+                                  std::abs(xl.z() - xr.z()), std::abs(vl.x() + vr.x()),
+                                  std::abs(vl.y() - vr.y()), std::abs(vl.z() - vr.z())});
+          }
+    });
+    sim.add_observer(probe);
+    ASSERT_TRUE(sim.run_until(0.5).ok());
+    EXPECT_GT(touching, 0);
+    const Real scale = model.mass.sum() * 2;  // kg m/s: total mass x approach speed
+    EXPECT_LT(spin, 1e-12 * scale);
+    EXPECT_LT(momentum, 1e-12 * scale);
+    EXPECT_LT(asymmetry, 1e-12);
+  }
+  Simulator one = vbd_head_on(1.0 / 60, 1), two = vbd_head_on(1.0 / 60, 2);
+  ASSERT_TRUE(one.run_until(0.3).ok());
+  ASSERT_TRUE(two.run_until(0.3).ok());
+  EXPECT_EQ(one.state().x, two.state().x);
+  EXPECT_EQ(one.state().v, two.state().v);
 }
 
 }  // namespace
