@@ -5,11 +5,11 @@ with the comments that document a declaration marked as documentation:
 
   - the comment at the top of a header (after `#pragma once`) documents the file (`/// \\file`);
   - a run of `//` lines directly above a declaration (no blank line between) documents it;
-  - a `//` comment at the end of a member's or an enumerator's line (`int n = 0;  // ...`), and
-    the comment lines aligned under it, document that member (`///<`).
+  - a `//` comment at the end of a member's, an enumerator's or a one-line function's line
+    (`int n = 0;  // ...`), and the comment lines aligned under it, document it (`///<`).
 
 Comments inside function bodies and initializers, comments followed by a blank line, a
-preprocessor line, a closing brace or an access label stay plain comments. Line numbers are
+preprocessor line, a closing brace, an access label or a namespace stay plain comments. Line numbers are
 kept (one output line per input line), so Doxygen's warnings point at the header's own lines.
 
 Usage: doxygen_filter.py HEADER  (prints the filtered text on stdout, as Doxygen expects)
@@ -83,7 +83,8 @@ def documents_next(line):
     s = line.strip()
     if not s or s.startswith("#") or s.startswith("}") or s.startswith("//"):
         return False
-    return not re.match(r"^(public|private|protected)\s*:", s)
+    # a section's comment above `namespace jelly {` stays plain: the namespace has its own page
+    return not re.match(r"^((public|private|protected)\s*:|namespace\b)", s)
 
 
 def filter_header(lines, name):
@@ -134,6 +135,10 @@ def filter_header(lines, name):
         if comment and not in_body and not comment.startswith("///") \
                 and not PLAIN.match(comment):
             ends_member = stripped.endswith(";") or stripped.endswith(",")
+            # a function defined on its line: `int size() const { return n_; }  // ...`
+            marks = [b for _, b in braces(code)]
+            ends_member |= stripped.endswith("}") and bool(marks) and marks[0] == "{" \
+                and marks.count("{") == marks.count("}")
             if ends_member or (stack and ENUMERATOR.match(stripped)):
                 out[i] = code + "///<" + doc(comment[2:])
                 trailing_column = len(code)
