@@ -124,7 +124,7 @@ enum class DefinitenessFix {
 };
 // "clamp", "project", "none".
 const std::vector<EnumName<DefinitenessFix>>& definiteness_fixes();
-std::string_view definiteness_name(
-    DefinitenessFix fix);  // the name of `fix` in definiteness_fixes()
+// The name of `fix` in definiteness_fixes().
+std::string_view definiteness_name(DefinitenessFix fix);
 
 }  // namespace jelly

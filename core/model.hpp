@@ -56,8 +56,8 @@ struct Springs {
 namespace jelly {
 
 using Triangle = std::array<int, 3>;  // three vertex indices
-using RowMatrixX3 =
-    Eigen::Matrix<Real, Eigen::Dynamic, 3, Eigen::RowMajor>;  // vertex positions, one row each
+// Vertex positions, one row each.
+using RowMatrixX3 = Eigen::Matrix<Real, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 // The triangle surface a person sees of a body: vertices that are weighted sums of particles.
 struct Surface {

@@ -145,8 +145,8 @@ class Path {
   Vec3 velocity_ = Vec3::Zero();  // linear
 };
 
-std::string_view path_kind_name(
-    PathKind kind);  // "fixed", "phases", "keyframes", "oscillation", "circle", "linear"
+// "fixed", "phases", "keyframes", "oscillation", "circle", "linear".
+std::string_view path_kind_name(PathKind kind);
 
 }  // namespace jelly
 

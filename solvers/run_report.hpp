@@ -46,8 +46,8 @@ enum class RunStatus {
   kDiverged,               // NaN, Inf or runaway speed: the divergence guard stopped the run
   kSolverFailed,  // the integrator returned a failure (e.g. a matrix not positive definite)
 };
-std::string_view run_status_name(
-    RunStatus status);  // "completed", "completed_with_warnings", "diverged", "solver_failed"
+// "completed", "completed_with_warnings", "diverged", "solver_failed".
+std::string_view run_status_name(RunStatus status);
 
 // What a run did: how it ended, the time reached, steps, wall time, the integrator's counters and
 // notes.
