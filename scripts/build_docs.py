@@ -301,6 +301,18 @@ def doxygen_reference(source, output, work, headers):
             problems.append(f"{len(warnings)} Doxygen warnings on the public headers (each"
                             " public class, function, member, enum and typedef needs its"
                             " comment):\n  " + "\n  ".join(warnings))
+    # Doxygen writes `#include <solvers/simulator.hpp>`; users write <jelly/solvers/...>.
+    for name in os.listdir(output) if os.path.isdir(output) else []:
+        if name.endswith(".html"):
+            path = os.path.join(output, name)
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+            fixed = re.sub(r'(#include &lt;(?:<a class="el" href="[^"]*">)?)(?=(?:core|geometry|terrain|solvers|io|fit)/)',
+                           r"\1jelly/",
+                           text)
+            if fixed != text:
+                with open(path, "w", encoding="utf-8") as f:
+                    f.write(fixed)
     pages = {}
     # Doxygen names a file's page by its base name, or by its path where two share one
     mangle = lambda name: name.replace("_", "__").replace("/", "_2").replace(".", "_8")
