@@ -367,7 +367,11 @@ def header_summary(path):
             if not line.startswith("//"):
                 break
             text.append(line[2:].strip())
-    sentence = re.split(r"(?<=[.:;])\s", " ".join(text) + " ", maxsplit=1)[0].strip()
+    sentence = re.split(r"(?<=\.)\s", " ".join(text) + " ", maxsplit=1)[0].strip()
+    if len(sentence) > 160:  # a long sentence: up to its first colon or semicolon
+        short = re.split(r"(?<=[:;])\s", sentence, maxsplit=1)[0]
+        if short.count("(") == short.count(")"):
+            sentence = short
     return sentence.rstrip(".:;").replace("|", "\\|")
 
 
