@@ -17,7 +17,9 @@ command: that line comes from the CSV's own metadata, never from prose. The plot
 (scripts/plot_bench.py) are drawn into --img from the same files.
 
 A folder of --data holding a table.csv (written by a script through scripts/bench_csv.py:
-scripts/bench_python.py --out docs/bench) is a table of that folder's name, rendered as written.
+scripts/bench_python.py --out docs/bench, scripts/bench_commands.py) is a table of that
+folder's name, rendered as written; one holding a core.json (Google Benchmark's JSON output) is
+rendered as the table core is.
 
 Tables: stability, speed, budget, bullet, core (performance.md; core from Google Benchmark's
 JSON output), integrators (integrators.md: the decision table), implicit_growth,
@@ -539,10 +541,12 @@ def render_page(text, data, path):
         render = RENDERERS.get(name)
         if render is None and os.path.isfile(os.path.join(data, name, "table.csv")):
             render = lambda folder, name=name: render_measured(folder, name)
+        if render is None and os.path.isfile(os.path.join(data, name, "core.json")):
+            render = lambda folder, name=name: render_core(folder, name)
         if render is None:
             raise InputProblem(f"{path}:{i + 1}: no table '{name}' (known: "
                                + ", ".join(sorted(RENDERERS)) + ", and every folder of "
-                               + data + " that holds a table.csv)")
+                               + data + " that holds a table.csv or a core.json)")
         end = END % name
         try:
             j = lines.index(end, i + 1)
