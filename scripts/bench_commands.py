@@ -48,7 +48,8 @@ def main():
     rounds = args.rounds or spec.get("rounds", 3)
     scale, divide = SCALE[spec.get("unit", "s")], spec.get("divide", 1)
     folder = os.path.dirname(os.path.abspath(args.spec))
-    version = None
+    result = subprocess.run([jelly, "--version"], stdout=subprocess.PIPE, text=True)
+    version = result.stdout.split()[-1] if result.returncode == 0 and result.stdout else None
     table = MeasuredTable(os.path.basename(folder), spec["description"], version)
     times = {(r, c): [] for r in range(len(spec["rows"])) for c in range(len(spec["columns"]))}
     for _ in range(rounds):
