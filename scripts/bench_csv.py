@@ -35,6 +35,16 @@ def _cpu():
     return platform.processor() or "unknown CPU"
 
 
+def command_line():
+    """The command as a reader runs it from the source tree: the module's PYTHONPATH, Debian's
+    python3 and the script's path relative to the current folder."""
+    script = os.path.relpath(os.path.abspath(sys.argv[0]))
+    words = ["/usr/bin/python3", script] + sys.argv[1:]
+    if os.environ.get("PYTHONPATH"):
+        words.insert(0, "PYTHONPATH=" + os.environ["PYTHONPATH"])
+    return " ".join(words)
+
+
 class MeasuredTable:
     """One table: its start (date, load) is taken when it is made, its end when written."""
 
@@ -45,7 +55,7 @@ class MeasuredTable:
     def write(self, folder, header, rows):
         """Writes FOLDER/NAME/table.csv; returns its path."""
         meta = {
-            "command_line": " ".join(["/usr/bin/python3"] + sys.argv),
+            "command_line": command_line(),
             "cores": str(len(os.sched_getaffinity(0))),
             "cpu": _cpu(),
             "date_utc": self.start,

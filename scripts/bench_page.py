@@ -162,7 +162,8 @@ def measured(meta):
     """The line under a table: when, where, under what load and by what command."""
     command = meta.get("command_line", "")
     words = command.split(" ")
-    if words and words[0]:
+    # build/bench/jelly-bench: on the PATH; a Python script's command stays as it ran
+    if words and words[0] and not words[0].endswith("python3") and "=" not in words[0]:
         words[0] = os.path.basename(words[0])
     load = meta.get("load_average_start")
     load_text = (f"load average (1, 5, 15 min) {load} at the start and "
