@@ -33,8 +33,8 @@ endif()
 
 # jelly_fuzz_coverage(target): with JELLY_FUZZ, `target`'s objects carry the coverage the fuzzer
 # is guided by. The library and the fuzz programs call it: they are the code the fuzzers run.
-# The test programs, jelly and jelly-bench do not (the instrumentation made a test source 15 %
-# slower to compile); only the fuzz programs link libFuzzer's main.
+# The test programs, jelly and jelly-bench do not (the instrumentation makes their sources
+# slower to compile and they need no guidance); only the fuzz programs link libFuzzer's main.
 function(jelly_fuzz_coverage target)
   if(JELLY_FUZZ)
     target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)

@@ -8,6 +8,7 @@
 
 namespace jelly {
 
+// A component of this program: its name and what it brings.
 struct ComponentInfo {
   std::string_view name;         // "core", "io", "meshes", "arkode", "fit", "viewer"
   std::string_view description;  // what it brings, one line
@@ -27,9 +28,9 @@ void register_component(const ComponentInfo& info);
 // CMake targets jelly::io, jelly::meshes, jelly::arkode and jelly::fit add a source to the
 // program that calls theirs before main; a program linked without CMake calls them itself.
 void register_io_component();
-void register_meshes_component();
-void register_arkode_component();
-void register_fit_component();
+void register_meshes_component();  // the component meshes' (assimp's mesh files)
+void register_arkode_component();  // the component arkode's (its two integrators)
+void register_fit_component();     // the component fit's
 void register_viewer_component();  // the viewer layer's (viewer/), when the program links it
 
 }  // namespace jelly

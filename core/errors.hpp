@@ -8,13 +8,17 @@
 
 namespace jelly {
 
+// Bad user input (a scene, an option, an argument): the message names the field, the value and
+// what is allowed. The CLI prints it and exits 2.
 class InputError : public std::invalid_argument {
  public:
+  // Any message.
   explicit InputError(const std::string& message) : std::invalid_argument(message) {}
   // "<field> = <value> is invalid: <allowed>".
   InputError(std::string_view field, std::string_view value, std::string_view allowed);
 };
 
+// A value as message text (doubles with 17 digits: the value read back is the value).
 template <typename T>
 std::string to_text(const T& value) {
   std::ostringstream out;
@@ -36,10 +40,11 @@ void require(bool ok, std::string_view field, const T& value, std::string_view a
 namespace jelly {
 
 template <typename E>
+// One row of an enum's table: a value, its name and what it means.
 struct EnumName {
-  E value;
-  std::string_view name;
-  std::string_view description;
+  E value;                       // the enum's value
+  std::string_view name;         // its name in files, options and messages
+  std::string_view description;  // one line of help
 };
 
 // The names of a table as `"a", "b", "c"` (for messages).
@@ -51,6 +56,7 @@ std::string quoted_names(const std::vector<EnumName<E>>& table) {
   return out;
 }
 
+// The name of `value` in `table`, or "unknown".
 template <typename E>
 std::string_view name_of(const std::vector<EnumName<E>>& table, E value) {
   for (const EnumName<E>& e : table) {

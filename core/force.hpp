@@ -12,23 +12,28 @@
 
 namespace jelly {
 
-using Mat3 = Eigen::Matrix3d;
+using Mat3 = Eigen::Matrix3d;  // a 3x3 block of a Jacobian
 
 // The Jacobians of a force as 3x3 blocks: block (i, j) holds d f_i / d x_j and d f_i / d v_j
 // (i, j particle indices). Blocks may repeat; repeated blocks add up.
 class ForceJacobian {
  public:
+  // One 3x3 block (i, j) of df/dx and df/dv.
   struct Block {
-    int i = 0, j = 0;
-    Mat3 dfdx = Mat3::Zero();
-    Mat3 dfdv = Mat3::Zero();
+    int i = 0;                 // the particle whose force it is
+    int j = 0;                 // the particle whose position or velocity it is
+    Mat3 dfdx = Mat3::Zero();  // d f_i / d x_j
+    Mat3 dfdv = Mat3::Zero();  // d f_i / d v_j
   };
+  // Adds block (i, j); no allocation once the list has grown to its steady size.
   void add(int i, int j, const Mat3& dfdx, const Mat3& dfdv) {
     blocks_.push_back({i, j, dfdx, dfdv});
   }
   // Forgets the blocks, keeping the memory (no allocation in steady state).
   void clear() { blocks_.clear(); }
+  // True when no block was added since the last clear().
   bool empty() const { return blocks_.empty(); }
+  // The blocks in the order they were added.
   const std::vector<Block>& blocks() const { return blocks_; }
   // y += (df/dx) p and z += (df/dv) p (dense 3N vectors).
   void multiply(const VecX& p, VecX& dfdx_p, VecX& dfdv_p) const;
@@ -40,6 +45,8 @@ class ForceJacobian {
   std::vector<Block> blocks_;
 };
 
+// A force of the user's or of jelly's own, added at every force evaluation of every integrator; it
+// may give its Jacobians for the implicit solvers.
 class Force {
  public:
   virtual ~Force() = default;
@@ -68,11 +75,12 @@ using ForceList = std::vector<std::shared_ptr<Force>>;
 // largest entry of |J - J_fd| over the largest entry of |J_fd| (or of |J|; 1 when both are 0),
 // for df/dx and df/dv. Dense: meant for tests on small models.
 struct JacobianCheck {
-  Real dfdx_error = 0;
-  Real dfdv_error = 0;
+  Real dfdx_error = 0;  // relative error of df/dx
+  Real dfdv_error = 0;  // relative error of df/dv
   Real dfdx_scale = 0;  // largest entry of |df/dx|, for stating an absolute tolerance
-  Real dfdv_scale = 0;
+  Real dfdv_scale = 0;  // largest entry of |df/dv|
 };
+// The JacobianCheck of `force` at (t, x, v), with central differences of step `step`.
 JacobianCheck check_force_jacobian(const Force& force, Real t, const VecX& x, const VecX& v,
                                    Real step = 1e-6);
 
@@ -84,13 +92,14 @@ JacobianCheck check_force_jacobian(const Force& force, Real t, const VecX& x, co
 // a stiff pull at a large step would be unstable).
 namespace jelly {
 
+// A spring from particle `particle` to a point in space (the viewer's drag).
 struct AnchorSpring {
-  int particle = 0;
+  int particle = 0;            // the particle pulled
   Vec3 target = Vec3::Zero();  // m
   Real stiffness = 0;          // k, N/m, >= 0
   Real damping = 0;            // c, N s/m, >= 0, on the particle's own velocity
 };
-using AnchorSprings = std::vector<AnchorSpring>;
+using AnchorSprings = std::vector<AnchorSpring>;  // the anchor springs of a simulator
 
 // Throws InputError for a particle index outside [0, num_particles), a non-finite target or a
 // negative or non-finite coefficient.
@@ -115,6 +124,7 @@ enum class DefinitenessFix {
 };
 // "clamp", "project", "none".
 const std::vector<EnumName<DefinitenessFix>>& definiteness_fixes();
+// The name of `fix` in definiteness_fixes().
 std::string_view definiteness_name(DefinitenessFix fix);
 
 }  // namespace jelly

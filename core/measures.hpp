@@ -12,13 +12,19 @@ Vec3 center_of_mass(const Model& model, const VecX& x);        // sum m x / sum 
 Vec3 linear_momentum(const Model& model, const VecX& v);       // sum m v
 Vec3 angular_momentum(const Model& model, const VecX& x, const VecX& v);  // sum m x cross v
 
+// kinetic_energy of a state.
 inline Real kinetic_energy(const Model& m, const State& s) { return kinetic_energy(m, s.v); }
+// elastic_energy of a state.
 inline Real elastic_energy(const Model& m, const State& s) { return elastic_energy(m, s.x); }
+// gravitational_energy of a state.
 inline Real gravitational_energy(const Model& m, const State& s) {
   return gravitational_energy(m, s.x);
 }
+// center_of_mass of a state.
 inline Vec3 center_of_mass(const Model& m, const State& s) { return center_of_mass(m, s.x); }
+// linear_momentum of a state.
 inline Vec3 linear_momentum(const Model& m, const State& s) { return linear_momentum(m, s.v); }
+// angular_momentum of a state.
 inline Vec3 angular_momentum(const Model& m, const State& s) {
   return angular_momentum(m, s.x, s.v);
 }
@@ -33,11 +39,15 @@ inline Real total_energy(const Model& m, const State& s) {
 // lost the sign it has at rest, or is 0.
 struct BodyVolume {
   long elements = 0;  // cells or tetrahedra; 0: a body without volume (a cloth)
-  long inverted = 0;
-  Real rest = 0, current = 0;  // m^3, the sums of the elements' signed volumes
+  long inverted = 0;  // elements whose signed volume lost its rest sign, or is 0
+  Real rest = 0;      // m^3, the sum of the elements' signed volumes at rest
+  Real current = 0;   // m^3, the same at x
 
+  // False for a body without volume (a cloth).
   bool has_volume() const { return elements > 0 && rest != 0; }
+  // Current over rest volume; 1 without volume.
   Real ratio() const { return has_volume() ? current / rest : 1; }
+  // The share of inverted elements.
   Real inverted_fraction() const { return elements > 0 ? Real(inverted) / elements : 0; }
 };
 // No allocation; O(elements).

@@ -18,25 +18,30 @@
 // (struct-of-arrays) for the force loop, with their type and coefficients.
 namespace jelly {
 
+// The three types of springs of the seed's lattice.
 enum class SpringType : std::uint8_t { kStructural = 0, kShear = 1, kBending = 2 };
-inline constexpr int kSpringTypeCount = 3;
-std::string_view spring_type_name(SpringType type);
+inline constexpr int kSpringTypeCount = 3;           // the number of SpringType values
+std::string_view spring_type_name(SpringType type);  // "structural", "shear", "bending"
 
 // Stiffness ks (N/m) and damping kd (N s/m) of one spring type.
 struct SpringCoefficients {
-  Real ks = 1400;
-  Real kd = 50;
+  Real ks = 1400;  // N/m
+  Real kd = 50;    // N s/m
 };
 
 // Springs stored once each, as parallel arrays (struct-of-arrays) for the force loop.
 struct Springs {
-  std::vector<int> a, b;
-  std::vector<Real> rest_length, ks, kd;
-  std::vector<SpringType> type;
+  std::vector<int> a;             // first particle of each spring
+  std::vector<int> b;             // second particle
+  std::vector<Real> rest_length;  // m
+  std::vector<Real> ks;           // N/m
+  std::vector<Real> kd;           // N s/m
+  std::vector<SpringType> type;   // structural, shear or bending
 
-  int size() const { return static_cast<int>(a.size()); }
-  void add(int a_index, int b_index, Real rest, SpringCoefficients c, SpringType t);
-  int count(SpringType t) const;
+  int size() const { return static_cast<int>(a.size()); }  // the number of springs
+  void add(int a_index, int b_index, Real rest, SpringCoefficients c,
+           SpringType t);         // appends one spring
+  int count(SpringType t) const;  // the number of springs of type t
   // Sets ks and kd of every spring of type t.
   void set_coefficients(SpringType t, SpringCoefficients c);
   // Appends `other` with its particle indices offset by `shift`.
@@ -50,19 +55,23 @@ struct Springs {
 // embedded in a lattice cell with trilinear weights).
 namespace jelly {
 
-using Triangle = std::array<int, 3>;
+using Triangle = std::array<int, 3>;  // three vertex indices
+// Vertex positions, one row each.
 using RowMatrixX3 = Eigen::Matrix<Real, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
+// The triangle surface a person sees of a body: vertices that are weighted sums of particles.
 struct Surface {
   std::vector<Triangle> triangles;  // vertex indices, counter-clockwise seen from outside
   // Vertex v = sum over k in [offsets[v], offsets[v + 1]) of weights[k] * x[particles[k]].
   std::vector<int> offsets{0};
-  std::vector<int> particles;
-  std::vector<Real> weights;
+  std::vector<int> particles;  // the particles of each vertex's sum
+  std::vector<Real> weights;   // their weights
 
+  // The number of vertices.
   int num_vertices() const { return static_cast<int>(offsets.size()) - 1; }
+  // The number of triangles.
   int num_triangles() const { return static_cast<int>(triangles.size()); }
-  bool empty() const { return triangles.empty(); }
+  bool empty() const { return triangles.empty(); }  // true for a body without a surface
   // A vertex that is particle p itself.
   void add_particle_vertex(int p);
   // A vertex that is a weighted sum of particles (weights sum to 1).
@@ -70,6 +79,7 @@ struct Surface {
   // Adds `shift` to every particle index (a body appended after others).
   void shift_particles(int shift);
 
+  // Vertex v's position at x.
   Vec3 vertex(const VecX& x, int v) const;
   // All vertex positions, one row each.
   void vertices(const VecX& x, RowMatrixX3& out) const;
@@ -85,46 +95,51 @@ namespace jelly {
 
 // Particles of a body chosen by name (a mesh's vertex group, a lattice corner), body-local.
 struct ParticleGroup {
-  std::string name;
-  std::vector<int> particles;
+  std::string name;            // the group's name
+  std::vector<int> particles;  // body-local particle indices
 };
 
 // The volume a body fills, for measuring how much it is crushed (core/body_volume.hpp): the
 // lattice's cells (corner c at grid offset (c & 1, (c >> 1) & 1, (c >> 2) & 1)) or a mesh's
 // tetrahedra (positively oriented at rest). Both empty: a body without volume (cloth).
 struct VolumeElements {
-  std::vector<std::array<int, 8>> cells;
-  std::vector<std::array<int, 4>> tets;
+  std::vector<std::array<int, 8>> cells;  // the lattice's cells, 8 corners each
+  std::vector<std::array<int, 4>> tets;   // the tetrahedra, 4 corners each
 
-  bool empty() const { return cells.empty() && tets.empty(); }
+  bool empty() const { return cells.empty() && tets.empty(); }  // true for a body without volume
+  // The number of elements.
   long size() const { return static_cast<long>(cells.size() + tets.size()); }
-  void shift_particles(int offset);
+  void shift_particles(int offset);  // adds `offset` to every particle index
 };
 
 // What a body builder makes: particles, springs and surface with indices local to the part.
 struct BodyPart {
-  std::string kind;  // the body kind that built it ("cube", "box", "cloth", ...)
-  VecX mass;         // [n] kg
-  VecX position;     // [3n] rest positions (m)
-  Springs springs;   // local particle indices
-  Surface surface;   // local particle indices
-  Real spacing = 0;  // typical distance between neighbouring particles (m)
-  std::vector<ParticleGroup> groups;
-  VolumeElements volume;  // local particle indices
+  std::string kind;                   // the body kind that built it ("cube", "box", "cloth", ...)
+  VecX mass;                          // [n] kg
+  VecX position;                      // [3n] rest positions (m)
+  Springs springs;                    // local particle indices
+  Surface surface;                    // local particle indices
+  Real spacing = 0;                   // typical distance between neighbouring particles (m)
+  std::vector<ParticleGroup> groups;  // named groups (local particle indices)
+  VolumeElements volume;              // local particle indices
   // A sheet without volume (cloth): its particles keep their contact radius from terrains and
   // obstacles by default (Body::thickness), so the surface they span stays outside them.
   bool sheet = false;
 
-  int num_particles() const { return static_cast<int>(mass.size()); }
+  int num_particles() const { return static_cast<int>(mass.size()); }  // the number of particles
 };
 
+// A body of the model: a named range of particles and springs with its material, surface and
+// motion.
 struct Body {
-  std::string name;  // unique in the model; the HDF5 group /particles/<name>
-  std::string kind;
-  int first_particle = 0, num_particles = 0;
-  int first_spring = 0, num_springs = 0;
-  Real spacing = 0;  // typical distance between neighbouring particles (m)
-  Real radius = 0;   // contact radius of its particles (m)
+  std::string name;        // unique in the model; the HDF5 group /particles/<name>
+  std::string kind;        // the body kind that built it ("cube", "cloth", ...)
+  int first_particle = 0;  // its particles are [first_particle, end_particle())
+  int num_particles = 0;   // how many
+  int first_spring = 0;    // its springs are [first_spring, end_spring())
+  int num_springs = 0;     // how many
+  Real spacing = 0;        // typical distance between neighbouring particles (m)
+  Real radius = 0;         // contact radius of its particles (m)
   // The distance its particles keep from terrains and obstacles (m), in every contact model and
   // integrator: a sheet's contact radius by default, 0 for a body with volume.
   Real thickness = 0;
@@ -139,8 +154,9 @@ struct Body {
   // palette by body index.
   std::optional<Vec3> color;
 
-  int end_particle() const { return first_particle + num_particles; }
-  int end_spring() const { return first_spring + num_springs; }
+  int end_particle() const { return first_particle + num_particles; }  // one past its last particle
+  int end_spring() const { return first_spring + num_springs; }        // one past its last spring
+  // True when `particle` (a global index) belongs to this body.
   bool contains(int particle) const {
     return particle >= first_particle && particle < end_particle();
   }
@@ -154,6 +170,7 @@ struct Body {
 // limited to a time window.
 namespace jelly {
 
+// The kinds of ExternalForce.
 enum class ExternalForceKind {
   kConstant,  // `vector` (N, the total) spread over the particles in proportion to their masses
   kWind,      // drag (w(t) - v) on each particle, w(t) the air's velocity (`vector`, m/s)
@@ -161,21 +178,23 @@ enum class ExternalForceKind {
 };
 // Every kind with its scene name and description.
 const std::vector<EnumName<ExternalForceKind>>& external_force_kinds();
-std::string_view external_force_kind_name(ExternalForceKind kind);
+std::string_view external_force_kind_name(ExternalForceKind kind);  // the scene name of `kind`
 // Throws InputError naming `field` for an unknown name.
 ExternalForceKind external_force_kind_from_name(std::string_view name, std::string_view field);
 
+// A force from outside the bodies on some particles: constant, wind or point, with an optional
+// gust and time window.
 struct ExternalForce {
-  ExternalForceKind kind = ExternalForceKind::kConstant;
-  std::vector<int> particles;  // global particle indices it acts on
+  ExternalForceKind kind = ExternalForceKind::kConstant;  // constant, wind or point
+  std::vector<int> particles;                             // global particle indices it acts on
   Vec3 vector = Vec3::Zero();  // force (N) or, for wind, air velocity (m/s)
   Real drag = 0;               // wind: N s/m per particle, >= 0
   Real gust = 0;               // vector(t) = vector (1 + gust sin(2 pi gust_frequency t))
   Real gust_frequency = 0;     // Hz, >= 0
   Real start = 0;              // acts for start <= t < end
-  Real end = std::numeric_limits<Real>::infinity();
+  Real end = std::numeric_limits<Real>::infinity();  // s
 
-  Vec3 vector_at(Real t) const;
+  Vec3 vector_at(Real t) const;  // `vector` with the gust factor at time t
   // Throws InputError naming `prefix`field for a value out of range.
   void validate(int num_particles, const std::string& prefix) const;
 };
@@ -191,19 +210,20 @@ void add_external_damping(const std::vector<ExternalForce>& forces, Real t, VecX
 
 namespace jelly {
 
+// The simulated system: particles, springs, bodies, gravity, pins and external forces.
 struct Model {
-  VecX mass;           // [N] particle masses (kg)
-  VecX rest_position;  // [3N] the positions the rest lengths were measured in
-  Springs springs;
-  Vec3 gravity{0, -9.8, 0};
+  VecX mass;                 // [N] particle masses (kg)
+  VecX rest_position;        // [3N] the positions the rest lengths were measured in
+  Springs springs;           // every spring of every body, and those between bodies
+  Vec3 gravity{0, -9.8, 0};  // m/s^2
   // Named ranges of particles and springs, in order; together they cover all of them.
   std::vector<Body> bodies;
-  Pins pins;
-  std::vector<ExternalForce> external_forces;
+  Pins pins;                                   // pinned particles and the paths they follow
+  std::vector<ExternalForce> external_forces;  // forces from outside, besides gravity and springs
 
-  int num_particles() const { return static_cast<int>(mass.size()); }
-  int num_dofs() const { return 3 * num_particles(); }
-  int num_bodies() const { return static_cast<int>(bodies.size()); }
+  int num_particles() const { return static_cast<int>(mass.size()); }  // N
+  int num_dofs() const { return 3 * num_particles(); }  // 3N: the size of the state's vectors
+  int num_bodies() const { return static_cast<int>(bodies.size()); }  // the number of bodies
 
   // Appends a body built by a builder: its particles and springs after the existing ones.
   // `radius` <= 0 takes half the part's spacing; the body's thickness is its radius for a sheet

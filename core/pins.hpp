@@ -14,18 +14,21 @@
 // +3 m/s^2 for 2 s, dead stop, -3 m/s^2 for 2 s, dead stop.
 namespace jelly {
 
+// One phase of the elevator's cycle.
 struct MotionPhase {
   Real duration = 2;        // s, > 0
   Real acceleration = 3;    // m/s^2 along +y
   bool stop_at_end = true;  // velocity drops to 0 when the phase ends
 };
 
+// The elevator's vertical motion: a cycle of MotionPhase, repeated forever.
 class ElevatorMotion {
  public:
   // No phases: the platform stays still. Throws InputError for a phase of non-positive duration
   // or a cycle that does not end at rest (it could not repeat); the message names `field`
   // (a scene passes its JSON path, "terrains[0].motion").
   explicit ElevatorMotion(std::vector<MotionPhase> phases = {}, std::string_view field = "motion");
+  // The seed's cycle: +3 m/s^2 for 2 s, dead stop, -3 m/s^2 for 2 s, dead stop.
   static ElevatorMotion seed();
   // Scene JSON: "seed" or a list of phases [{"duration": 2, "acceleration": 3, "stop_at_end":
   // true}, ...]. Throws InputError naming `path`.
@@ -35,11 +38,11 @@ class ElevatorMotion {
 
   // Height offset from the start, velocity and acceleration along +y at time t >= 0.
   Real offset(Real t) const;
-  Real velocity(Real t) const;
-  Real acceleration(Real t) const;
+  Real velocity(Real t) const;      // m/s along +y at time t
+  Real acceleration(Real t) const;  // m/s^2 along +y at time t
 
-  const std::vector<MotionPhase>& phases() const { return phases_; }
-  Real period() const { return period_; }
+  const std::vector<MotionPhase>& phases() const { return phases_; }  // the cycle
+  Real period() const { return period_; }                             // s, the cycle's duration
 
  private:
   struct Sample {
@@ -60,14 +63,17 @@ class ElevatorMotion {
 // sinusoidal oscillation; a circle; or a constant velocity (a controller's target).
 namespace jelly {
 
+// The kinds of Path.
 enum class PathKind { kFixed, kPhases, kKeyframes, kOscillation, kCircle, kLinear };
 
+// A path's offset, velocity and acceleration at one time.
 struct PathSample {
-  Vec3 offset = Vec3::Zero();
-  Vec3 velocity = Vec3::Zero();
-  Vec3 acceleration = Vec3::Zero();
+  Vec3 offset = Vec3::Zero();        // m, from where the path starts
+  Vec3 velocity = Vec3::Zero();      // m/s
+  Vec3 acceleration = Vec3::Zero();  // m/s^2
 };
 
+// A prescribed translation as a function of time, offset(0) = 0: drives pins and moving obstacles.
 class Path {
  public:
   Path() = default;  // fixed
@@ -101,23 +107,24 @@ class Path {
   // "center": [x, y, z], "axis": [x, y, z], "period": 2}; {"kind": "linear", "velocity": [x, y,
   // z]}. Throws InputError naming `path`.
   static Path read(const Json& j, const std::string& path);
-  Json to_json() const;
+  Json to_json() const;  // the scene JSON that read() reads back
 
-  PathKind kind() const { return kind_; }
+  PathKind kind() const { return kind_; }  // which kind of path
+  // True for a fixed path (offset 0 at all times).
   bool is_fixed() const { return kind_ == PathKind::kFixed; }
-  PathSample sample(Real t) const;
+  PathSample sample(Real t) const;  // offset, velocity and acceleration at time t
 
-  const Vec3& axis() const { return axis_; }
-  const ElevatorMotion& cycle() const { return cycle_; }
-  const std::vector<Real>& times() const { return times_; }
-  const std::vector<Vec3>& offsets() const { return offsets_; }
-  const Vec3& amplitude() const { return amplitude_; }
-  Real frequency() const { return frequency_; }
-  bool cubic() const { return cubic_; }
-  const Vec3& center() const { return center_; }
-  Real period() const { return period_; }
-  const Vec3& velocity() const { return velocity_; }
-  Real phase() const { return phase_; }
+  const Vec3& axis() const { return axis_; }                     // phases: the axis
+  const ElevatorMotion& cycle() const { return cycle_; }         // phases: the cycle
+  const std::vector<Real>& times() const { return times_; }      // keyframes: their times (s)
+  const std::vector<Vec3>& offsets() const { return offsets_; }  // keyframes: their offsets (m)
+  const Vec3& amplitude() const { return amplitude_; }           // oscillation: the amplitude (m)
+  Real frequency() const { return frequency_; }                  // oscillation: Hz
+  bool cubic() const { return cubic_; }           // keyframes: true when joined by cubic segments
+  const Vec3& center() const { return center_; }  // circle: its centre relative to the start (m)
+  Real period() const { return period_; }         // circle: one turn's duration (s)
+  const Vec3& velocity() const { return velocity_; }  // linear: m/s
+  Real phase() const { return phase_; }               // oscillation: the phase (rad)
 
  private:
   PathSample sample_cubic(Real t) const;
@@ -138,27 +145,30 @@ class Path {
   Vec3 velocity_ = Vec3::Zero();  // linear
 };
 
+// "fixed", "phases", "keyframes", "oscillation", "circle", "linear".
 std::string_view path_kind_name(PathKind kind);
 
 }  // namespace jelly
 
 namespace jelly {
 
+// The pinned particles of a model: each follows its Path from its anchor.
 struct Pins {
   std::vector<int> particles;  // global particle indices, each at most once
   std::vector<Vec3> anchors;   // position at t = 0 (where the path's offset is 0)
   std::vector<int> path;       // index into paths, per pin
-  std::vector<Path> paths;
+  std::vector<Path> paths;     // the paths pins follow
 
-  int size() const { return static_cast<int>(particles.size()); }
-  bool empty() const { return particles.empty(); }
+  int size() const { return static_cast<int>(particles.size()); }  // the number of pins
+  bool empty() const { return particles.empty(); }  // true when no particle is pinned
   // Adds a path and returns its index.
   int add_path(Path p);
   // Pins `particle` at `anchor` (t = 0) moving along paths[path_index]; a particle pinned
   // twice keeps its first pin. Linear in the number of pins (it looks for the particle): many
   // new particles go through add_new.
   void add(int particle, const Vec3& anchor, int path_index);
-  void add_fixed(int particle, const Vec3& anchor);
+  void add_fixed(int particle,
+                 const Vec3& anchor);  // pins `particle` at `anchor` for ever (a fixed path)
   // The pin of `particle` (its index k), or -1 when it is not pinned.
   int find(int particle) const;
   // Pins `particle` at `anchor` moving along `p`, or gives its pin that anchor and path when it
@@ -172,9 +182,10 @@ struct Pins {
   void add_new(const std::vector<int>& particles, const std::vector<Vec3>& anchors, int path_index);
   // The index of a fixed path, added if there is none.
   int fixed_path();
-  bool all_fixed() const;
+  bool all_fixed() const;  // true when every pin's path is fixed
 
-  Vec3 position(int k, Real t) const;
+  Vec3 position(int k, Real t) const;  // the position of pin k at time t
+  // Offset, velocity and acceleration of pin k's path at time t.
   PathSample sample(int k, Real t) const { return paths[path[k]].sample(t); }
   // Sets the positions and velocities of the pinned particles to their paths' at time t.
   void apply(Real t, VecX& x, VecX& v) const;

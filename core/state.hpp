@@ -5,10 +5,11 @@
 
 namespace jelly {
 
+// The dynamic state: time, positions and velocities of every particle.
 struct State {
-  Real t = 0;
-  VecX x;  // [3N] positions (m)
-  VecX v;  // [3N] velocities (m/s)
+  Real t = 0;  // time (s)
+  VecX x;      // [3N] positions (m)
+  VecX v;      // [3N] velocities (m/s)
 };
 
 }  // namespace jelly

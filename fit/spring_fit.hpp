@@ -25,6 +25,8 @@ namespace jelly {
 // called from several threads at once, so it must not share mutable state.
 using TerrainFactory = std::function<Terrains()>;
 
+// A recorded motion to fit coefficients to: the model, frame times, positions (and velocities),
+// terrains, contact and the integrator it was recorded with.
 struct Trajectory {
   // Masses, springs (a, b, rest length, type) and gravity. The coefficients ks and kd are the
   // starting guess of a fit unless FitOptions::initial names other values.
@@ -40,11 +42,13 @@ struct Trajectory {
   TerrainFactory terrains;  // empty = no terrain
   // Contact between bodies (and within one) as the recording ran it; every replay uses it.
   BodyContactParams body_contact;
-  std::string integrator = "rk4";  // the integrator the recording was made with
-  IntegratorOptions integrator_options;
-  Real dt = 0.001;  // s; every frame interval is a whole number of steps
+  std::string integrator = "rk4";        // the integrator the recording was made with
+  IntegratorOptions integrator_options;  // the options of that integrator
+  Real dt = 0.001;                       // s; every frame interval is a whole number of steps
 
+  // The number of frames.
   int frames() const { return static_cast<int>(times.size()); }
+  // True when velocities were recorded.
   bool has_velocities() const { return !velocities.empty(); }
   // Throws InputError naming the first problem: fewer than 3 frames, sizes, times that are not
   // increasing or not a whole number of steps apart, non-finite values, a recording in which
@@ -73,14 +77,16 @@ namespace jelly {
 // One free coefficient: ks or kd, of one spring type or of all types together, of one body or
 // of every body.
 struct FitParameter {
+  // Which coefficient: stiffness or damping.
   enum class Quantity { kKs, kKd };
-  Quantity quantity = Quantity::kKs;
-  std::optional<SpringType> type;  // none = every spring type shares the value
-  std::string body;                // "" = every body shares the value
+  Quantity quantity = Quantity::kKs;  // ks or kd
+  std::optional<SpringType> type;     // none = every spring type shares the value
+  std::string body;                   // "" = every body shares the value
 
   // "ks", "kd", "ks.structural", "kd.bending", ..., prefixed "<body>." for one body's:
   // "soft.ks", "stiff.kd.shear".
   std::string name() const;
+  // True when it applies to springs of type t.
   bool applies_to(SpringType t) const { return !type || *type == t; }
   // The springs [first, end) of the model it applies to (every spring when `body` is empty);
   // throws InputError (field "free") naming the model's bodies when it has no body `body`.
@@ -101,21 +107,22 @@ enum class FitGradients {
 };
 // "auto", "adjoint", "numeric"; throws InputError naming `field` for another name.
 FitGradients fit_gradients_from_name(std::string_view name, std::string_view field);
-std::string_view fit_gradients_name(FitGradients gradients);
+std::string_view fit_gradients_name(FitGradients gradients);  // "auto", "adjoint", "numeric"
 
+// How fit_recording fits: the free parameters, their starts, windows, Ceres' tolerances, threads.
 struct FitOptions {
-  FitGradients gradients = FitGradients::kAuto;
-  std::vector<FitParameter> free = parse_free_parameters("ks,kd");
+  FitGradients gradients = FitGradients::kAuto;  // how the residuals are differentiated
+  std::vector<FitParameter> free = parse_free_parameters("ks,kd");  // the coefficients fitted
   // Starting values by parameter name; a parameter not named starts at the mean of its springs'
   // current coefficient in the trajectory's model. Every start must be > 0.
   std::map<std::string, Real> initial;
   // Multiple shooting: windows of this length (s), each replayed from its recorded first frame;
   // 0 = one window over the whole recording.
   Real window = 0.1;
-  int max_iterations = 50;
-  Real function_tolerance = 1e-10;
-  Real gradient_tolerance = 1e-12;
-  Real parameter_tolerance = 1e-10;
+  int max_iterations = 50;           // Ceres' iteration limit
+  Real function_tolerance = 1e-10;   // Ceres' relative cost tolerance
+  Real gradient_tolerance = 1e-12;   // Ceres' gradient tolerance
+  Real parameter_tolerance = 1e-10;  // Ceres' relative step tolerance
   // Full multiple shooting on the velocities: each window's initial velocity becomes 3N extra
   // unknowns, started from the recorded (or finite-difference) velocity. Removes the bias of
   // finite-difference restarts for recordings without velocities, at 2 x 3N more replays of
@@ -123,46 +130,49 @@ struct FitOptions {
   bool fit_restart_velocities = false;
   // Relative step of the central differences, on the log of the coefficients.
   Real relative_step = 1e-6;
-  int num_threads = 1;
-  bool compute_covariance = true;
-  bool progress_to_stdout = false;
+  int num_threads = 1;              // replays run in parallel
+  bool compute_covariance = true;   // standard deviations from the covariance
+  bool progress_to_stdout = false;  // Ceres' progress lines on stdout
 
   // Throws InputError naming the first invalid option.
   void validate() const;
 };
 
+// One fitted coefficient: its start, value and standard deviations.
 struct FittedParameter {
-  FitParameter parameter;
-  std::string name;
-  Real initial = 0;
-  Real value = 0;
+  FitParameter parameter;  // what was fitted
+  std::string name;        // its name ("ks", "kd.shear", ...)
+  Real initial = 0;        // its starting value
+  Real value = 0;          // the fitted value
   // Standard deviation by the delta method, sd(k) = k sd(log k), from the covariance of the
   // log-coefficients; NaN when the covariance could not be computed. `stddev` accounts for the
   // noise of the restart states (docs/fitting.md); `stddev_independent` is the textbook
   // s^2 (J^T J)^-1, which treats every residual as independent and is too small when the
   // recorded positions are noisy.
   Real stddev = 0;
-  Real stddev_independent = 0;
+  Real stddev_independent = 0;  // s^2 (J^T J)^-1's, which ignores the restart noise
 };
 
+// What fit_recording found: every parameter's estimate, the costs, Ceres' report and the
+// covariance.
 struct FitResult {
-  std::vector<FittedParameter> parameters;
-  Real initial_cost = 0;  // 1/2 sum of squared position residuals (m^2)
-  Real final_cost = 0;
-  int iterations = 0;
-  bool converged = false;   // Ceres terminated with CONVERGENCE
-  std::string termination;  // Ceres' message
-  std::string brief_report;
-  bool covariance_ok = false;
-  std::string covariance_message;
-  Real residual_rms = 0;  // sqrt(2 final_cost / residuals) (m)
-  int windows = 0;
-  int residuals = 0;
+  std::vector<FittedParameter> parameters;  // the estimates, in the order of FitOptions::free
+  Real initial_cost = 0;                    // 1/2 sum of squared position residuals (m^2)
+  Real final_cost = 0;                      // the same at the end (m^2)
+  int iterations = 0;                       // Ceres' iterations
+  bool converged = false;                   // Ceres terminated with CONVERGENCE
+  std::string termination;                  // Ceres' message
+  std::string brief_report;                 // Ceres' brief report
+  bool covariance_ok = false;               // true when the standard deviations could be computed
+  std::string covariance_message;           // why they could not, or empty
+  Real residual_rms = 0;                    // sqrt(2 final_cost / residuals) (m)
+  int windows = 0;                          // windows of multiple shooting
+  int residuals = 0;                        // position residuals (3 per particle per frame)
   // "adjoint" (exact gradients, Ceres' line search with BFGS) or "numeric" (central differences,
   // Levenberg-Marquardt), and why the numeric path was taken when the adjoint was not.
   std::string gradient_path;
-  std::string gradient_reason;
-  long adjoint_passes = 0;  // window replays differentiated by the adjoint (forward + backward)
+  std::string gradient_reason;  // why the numeric path was taken, or empty
+  long adjoint_passes = 0;      // window replays differentiated by the adjoint (forward + backward)
   // The fitted initial velocity of each window (fit_restart_velocities), else empty.
   std::vector<VecX> restart_velocities;
   long replays = 0;             // window replays (each one simulation of a window)

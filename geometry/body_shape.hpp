@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include <jelly/core/model.hpp>
 #include <jelly/core/json_fwd.hpp>
+#include <jelly/core/model.hpp>
 
 // A lattice body: particles at the occupied points of a regular grid, joined by the seed's
 // springs (structural to the axis neighbours, shear along the face and body diagonals of each
@@ -20,6 +20,7 @@ namespace jelly {
 
 // Spring coefficients per type (structural, shear, bending) and how particle masses are set.
 struct Material {
+  // Indexed by SpringType: structural, shear, bending.
   std::array<SpringCoefficients, kSpringTypeCount> springs{
       SpringCoefficients{1400, 50}, SpringCoefficients{1400, 50}, SpringCoefficients{1400, 50}};
   Real particle_mass = 1;  // kg per particle, used when density is 0
@@ -31,6 +32,7 @@ struct Material {
   void validate(const std::string& prefix) const;
 };
 
+// A regular grid of points, some occupied: the lattice a cube, box or voxelized body is built on.
 struct LatticeGrid {
   std::array<int, 3> n{2, 2, 2};  // points along the grid's x, y, z
   Vec3 spacing = Vec3::Ones();    // m between neighbouring points along each axis
@@ -39,10 +41,12 @@ struct LatticeGrid {
   // One flag per point, index (i n_y + j) n_z + k; empty = every point occupied.
   std::vector<char> occupied;
 
+  // The number of grid points.
   int points() const { return n[0] * n[1] * n[2]; }
+  // The index of point (i, j, k).
   int index(int i, int j, int k) const { return (i * n[1] + j) * n[2] + k; }
-  bool is_occupied(int i, int j, int k) const;
-  Vec3 position(int i, int j, int k) const;
+  bool is_occupied(int i, int j, int k) const;  // true when point (i, j, k) holds a particle
+  Vec3 position(int i, int j, int k) const;     // the world position of point (i, j, k)
 };
 
 // Particles in grid-index order, springs grouped by their first particle (the seed cube's order:
@@ -57,10 +61,14 @@ std::vector<int> lattice_particle_indices(const LatticeGrid& grid);
 
 namespace jelly {
 
+// The shape of a body of one kind (cube, box, cloth, ...): its parameters, validated, written and
+// built into a BodyPart.
 class BodyShape {
  public:
   virtual ~BodyShape() = default;
+  // The body kind's name in scenes ("cube", "cloth", ...).
   virtual std::string_view kind() const = 0;
+  // A copy of the same class.
   virtual std::unique_ptr<BodyShape> clone() const = 0;
   // Throws InputError naming `prefix`field (a scene passes its JSON path, "bodies[0].").
   virtual void validate(const std::string& prefix) const = 0;
@@ -81,6 +89,7 @@ class BodyShape {
 template <typename Derived>
 class BodyShapeOf : public BodyShape {
  public:
+  // A copy of the same class.
   std::unique_ptr<BodyShape> clone() const override {
     return std::make_unique<Derived>(static_cast<const Derived&>(*this));
   }
@@ -92,8 +101,9 @@ class BodyShapeOf : public BodyShape {
 // BodyShape subclass and its builder) and one line there.
 namespace jelly {
 
+// One body kind of the registry: its name, description and how its keys are read.
 struct BodyKindInfo {
-  std::string_view name;
+  std::string_view name;         // the kind's name in scenes
   std::string_view description;  // one line, with the kind's keys
   // Reads the kind's keys from `fields` (which names the JSON path), validates them and returns
   // the shape; the keys every body has (name, kind, material, pins, ...) are the caller's.

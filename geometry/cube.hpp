@@ -15,7 +15,7 @@ namespace jelly {
 // diagonals, bending; 12,876 for n = 10).
 // Throw InputError naming n for n < 0 or n > 500000 (whose counts would overflow).
 std::int64_t cube_particle_count(std::int64_t n);
-std::int64_t cube_spring_count(std::int64_t n);
+std::int64_t cube_spring_count(std::int64_t n);  // the springs of a cube of n^3 particles
 
 // Body kind "cube": n particles per edge, edge_length, origin = position of particle (0, 0, 0).
 struct CubeShape final : BodyShapeOf<CubeShape> {
@@ -23,12 +23,14 @@ struct CubeShape final : BodyShapeOf<CubeShape> {
   Real edge_length = 4;                         // m, > 0
   Vec3 origin{-20.0 / 9, 61.0 / 9, -20.0 / 9};  // position of particle (0, 0, 0)
 
+  // "cube".
   std::string_view kind() const override { return "cube"; }
   void validate(const std::string& prefix) const override;
   BodyPart build(const Material& material, const std::string& prefix) const override;
   long estimated_particles() const override { return cube_particle_count(n); }
   long estimated_springs() const override { return cube_spring_count(n); }
   void write(Json& object) const override;
+  // Reads the kind's keys from `fields`.
   static std::unique_ptr<BodyShape> read(JsonFields& fields);
 };
 
@@ -42,10 +44,10 @@ struct CubeSpec {
   // Indexed by SpringType: structural, shear, bending.
   std::array<SpringCoefficients, kSpringTypeCount> springs{
       SpringCoefficients{1400, 50}, SpringCoefficients{1400, 50}, SpringCoefficients{1400, 50}};
-  Vec3 gravity{0, -9.8, 0};
+  Vec3 gravity{0, -9.8, 0};  // m/s^2
 
-  CubeShape shape() const;
-  Material material() const;
+  CubeShape shape() const;    // the cube's shape (n, edge_length, origin)
+  Material material() const;  // springs and particle mass
   // Throws InputError naming the first invalid field (cube.n, springs.shear.kd, gravity).
   void validate() const;
 };
@@ -56,6 +58,7 @@ struct CubeSpec {
 // at distance 2. For n = 10: 2700 + 7776 + 2400 = 12,876 springs. One body, named "jelly".
 Model build_cube(const CubeSpec& spec);
 
+// The index of lattice particle (i, j, k) of a cube of n per edge.
 inline int cube_index(int n, int i, int j, int k) { return (i * n + j) * n + k; }
 
 }  // namespace jelly

@@ -9,17 +9,20 @@
 
 namespace jelly {
 
+// A triangle mesh: vertices and triangles over them (counter-clockwise seen from outside).
 struct TriangleMesh {
-  std::vector<Vec3> vertices;
-  std::vector<Triangle> triangles;
+  std::vector<Vec3> vertices;       // m
+  std::vector<Triangle> triangles;  // vertex indices
 
+  // The number of vertices.
   int num_vertices() const { return static_cast<int>(vertices.size()); }
+  // The number of triangles.
   int num_triangles() const { return static_cast<int>(triangles.size()); }
-  Eigen::AlignedBox3d bounds() const;
+  Eigen::AlignedBox3d bounds() const;  // the box around the vertices
   // The surface's area, and the volume it encloses (divergence theorem: the sum of
   // a . (b x c) / 6 over the triangles; negative when they face inwards).
   Real area() const;
-  Real enclosed_volume() const;
+  Real enclosed_volume() const;  // m^3
   // Adds a quad as two triangles a-b-c, a-c-d.
   void add_quad(int a, int b, int c, int d);
   // Appends `other`.
@@ -30,6 +33,7 @@ struct TriangleMesh {
 TriangleMesh box_mesh(const Vec3& size);
 // A square of side `size` in the plane through the origin with the given unit normal.
 TriangleMesh square_mesh(const Vec3& normal, Real size);
+// A sphere of `rings` x `segments` quads (the poles' as triangles).
 TriangleMesh sphere_mesh(Real radius, int rings = 16, int segments = 32);
 // Along y, from -height/2 to +height/2, capped.
 TriangleMesh cylinder_mesh(Real radius, Real height, int segments = 32);

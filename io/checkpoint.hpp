@@ -10,21 +10,23 @@
 
 namespace jelly {
 
+// What a simulator needs to continue a run bit for bit: its state, counters, carried contacts,
+// integrator state and the model's edited values.
 struct Checkpoint {
-  State state;
-  long total_steps = 0;
-  Real next_output = 0;  // time of the next observer frame
-  std::vector<CarriedContact> seed_contacts;
-  int contact_count = 0;
-  std::vector<Real> integrator_state;  // empty in files written before it was stored
-  std::string integrator;              // of the run that wrote it
-  Real dt = 0;                         // of the run that wrote it
-  Real output_interval = 0;            // of the run that wrote it
+  State state;                                // time, positions, velocities
+  long total_steps = 0;                       // steps taken since the run began
+  Real next_output = 0;                       // time of the next observer frame
+  std::vector<CarriedContact> seed_contacts;  // contacts the seed rules carry into the next step
+  int contact_count = 0;                      // contacts resolved so far
+  std::vector<Real> integrator_state;         // empty in files written before it was stored
+  std::string integrator;                     // of the run that wrote it
+  Real dt = 0;                                // of the run that wrote it
+  Real output_interval = 0;                   // of the run that wrote it
   std::string scene_json;  // the scene of the run that wrote it (empty when none was stored)
   // The model's values after live edits of the run that wrote it (none without edits).
   std::optional<ModelValues> model_values;
 
-  SimulatorSnapshot snapshot() const;
+  SimulatorSnapshot snapshot() const;  // the simulator's snapshot to restore
 };
 
 // The checkpoint a recording holds (written at its last flush or at the end of its run). Throws

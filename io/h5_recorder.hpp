@@ -23,6 +23,7 @@
 // docs/output.md describes the sidecar and the /xdmf group.
 namespace jelly {
 
+// What the XDMF sidecar of a recording shows.
 struct XdmfOptions {
   // Strain of every spring at every frame (|xa - xb| / rest length - 1) as a cell array: float32
   // [T][M], the largest part of /xdmf.
@@ -54,6 +55,7 @@ std::string write_paraview_state(const std::string& h5_path);
 
 namespace jelly {
 
+// How an H5Recorder writes: compression, blocks of frames, sidecar, overwriting.
 struct RecorderOptions {
   std::string scene_json;  // the whole scene as JSON text (stored as an attribute), may be empty
   std::string integrator_name;  // attribute; defaults to sim.integrator().name()
@@ -77,6 +79,8 @@ struct RecorderOptions {
   void validate() const;
 };
 
+// An observer that records a run into an HDF5 file (H5MD layout, docs/output.md) with its XDMF
+// sidecar and a checkpoint that restarts it.
 class H5Recorder final : public Observer {
  public:
   // Creates the file and writes the static parts (model, terrains, parameters). Throws
@@ -90,6 +94,7 @@ class H5Recorder final : public Observer {
   H5Recorder(const H5Recorder&) = delete;
   H5Recorder& operator=(const H5Recorder&) = delete;
 
+  // Records the frame (positions, velocities, observables, terrain positions).
   void on_frame(const Simulator& sim) override;
   // Writes the pending frames, the run report and the integrator statistics as attributes of
   // /parameters, the final checkpoint, flushes, and writes the XDMF sidecar (under a temporary
@@ -108,8 +113,8 @@ class H5Recorder final : public Observer {
   // the checkpoint's integrator and dt as they are then.)
   void set_scene(const std::string& scene_json, const std::string& integrator_name);
 
-  const std::string& path() const;
-  long frames() const;  // frames received so far
+  const std::string& path() const;  // the file it writes
+  long frames() const;              // frames received so far
 
  private:
   struct Impl;

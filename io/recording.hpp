@@ -11,23 +11,27 @@ namespace jelly {
 
 // A terrain's recorded motion: /terrain/<name>/position and the group's attributes.
 struct TerrainTrack {
-  std::string name;  // "<index>_<kind>"
-  std::string kind;
-  std::vector<Vec3> position;  // per frame
-  std::map<std::string, std::string> attributes;
+  std::string name;                               // "<index>_<kind>"
+  std::string kind;                               // the terrain kind
+  std::vector<Vec3> position;                     // per frame
+  std::map<std::string, std::string> attributes;  // the group's attributes, as text
 };
 
+// A recording read back (read_recording): the model, the frames' times, positions and velocities,
+// observables and terrain tracks.
 struct Recording {
-  Model model;
-  std::vector<Real> time;                // per frame
-  std::vector<long> step;                // per frame: the simulator's total step count
-  std::vector<VecX> position, velocity;  // per frame, [3N] each
-  std::string scene_json;
+  Model model;                                    // the model the run simulated
+  std::vector<Real> time;                         // per frame
+  std::vector<long> step;                         // per frame: the simulator's total step count
+  std::vector<VecX> position;                     // per frame, [3N] each (m)
+  std::vector<VecX> velocity;                     // per frame, [3N] each (m/s)
+  std::string scene_json;                         // the scene of the run, JSON text (may be empty)
   std::map<std::string, std::string> attributes;  // of /parameters, as text
   // /observables/<name>/value: one row per frame, 1 or 3 columns.
   std::map<std::string, Eigen::MatrixXd> observables;
-  std::vector<TerrainTrack> terrains;
+  std::vector<TerrainTrack> terrains;  // each terrain's recorded motion
 
+  // The number of frames.
   int frames() const { return static_cast<int>(time.size()); }
 };
 

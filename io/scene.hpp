@@ -10,33 +10,36 @@
 #include <jelly/core/polymorphic_value.hpp>
 #include <jelly/geometry/body_spec.hpp>
 #include <jelly/geometry/cube.hpp>
-#include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
+#include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/simulator.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
 
 namespace jelly {
 
+// The integrator of a scene: its name, step and options.
 struct IntegratorSpec {
-  std::string name;  // a name from integrator_names(); required in a scene file
-  Real dt = 0.001;   // s
-  IntegratorOptions options;
+  std::string name;           // a name from integrator_names(); required in a scene file
+  Real dt = 0.001;            // s
+  IntegratorOptions options;  // the options of every method (only the named one's are used)
 };
 
+// A scene: bodies, terrains, gravity, contact, integrator, duration and output, as a scene file
+// holds them (docs/scenes.md).
 struct Scene {
   std::string description;  // free text, not used by the solver
   // The bodies, in order (their particles follow each other in the model). A scene file
   // without "bodies" holds one cube named "jelly" described by its "cube" and "springs" keys.
   std::vector<BodySpec> bodies{seed_cube_body()};
-  Vec3 gravity{0, -9.8, 0};
-  std::vector<PolymorphicValue<TerrainSpec>> terrains;
+  Vec3 gravity{0, -9.8, 0};                             // m/s^2
+  std::vector<PolymorphicValue<TerrainSpec>> terrains;  // terrains and obstacles, in order
   // Contact between bodies (and, with self_contact, within a body): docs/contact.md.
   BodyContactParams body_contact;
-  IntegratorSpec integrator;
+  IntegratorSpec integrator;        // the integrator, its step and options
   Real duration = 5;                // s simulated by `jelly run`; required in a scene file
   Real output_interval = 1.0 / 60;  // s between recorded frames; 0 = every step
-  DivergenceGuard divergence;
+  DivergenceGuard divergence;       // when a run counts as diverged
   // When a run reports a body crushed (solvers/run_report.hpp; key "crush"; written only when
   // not the defaults).
   CrushLimits crush{};
@@ -56,6 +59,7 @@ struct Scene {
   // A scene's cube body as a CubeSpec with the scene's gravity (one-cube scenes, tests); throws
   // InputError when body `index` is not a cube.
   CubeSpec cube(int index = 0) const;
+  // Replaces body `index` by `cube` and sets the scene's gravity to the cube's.
   void set_cube(const CubeSpec& cube, int index = 0);
 };
 

@@ -16,6 +16,11 @@ by a line saying where, when and under what load the figures were measured and b
 command: that line comes from the CSV's own metadata, never from prose. The plots
 (scripts/plot_bench.py) are drawn into --img from the same files.
 
+A folder of --data holding a table.csv (written by a script through scripts/bench_csv.py:
+scripts/bench_python.py --out docs/bench, scripts/bench_commands.py) is a table of that
+folder's name, rendered as written; one holding a core.json (Google Benchmark's JSON output) is
+rendered as the table core is.
+
 Tables: stability, speed, budget, bullet, core (performance.md; core from Google Benchmark's
 JSON output), integrators (integrators.md: the decision table), implicit_growth,
 implicit_scenes and matrix_free (implicit.md: implicit_euler's cost against size, its
@@ -157,16 +162,22 @@ def measured(meta):
     """The line under a table: when, where, under what load and by what command."""
     command = meta.get("command_line", "")
     words = command.split(" ")
-    if words and words[0]:
+    # build/bench/jelly-bench: on the PATH; a Python script's command stays as it ran
+    if words and words[0] and not words[0].endswith("python3") and "=" not in words[0]:
         words[0] = os.path.basename(words[0])
     load = meta.get("load_average_start")
     load_text = (f"load average (1, 5, 15 min) {load} at the start and "
                  f"{meta.get('load_average_end', 'unrecorded')} at the end"
                  if load else "load not recorded")
+    if "compiler" in meta or "build_type" not in meta and "python" not in meta:
+        build = (f"jelly {meta.get('jelly_version', '?')} {meta.get('build_type', '')} build "
+                 f"({meta.get('compiler', '?')})")
+    else:  # a table a Python script measured (scripts/bench_csv.py)
+        build = (f"jelly {meta.get('jelly_version', '?')}, Python "
+                 f"{meta.get('python', '?')}")
     return (f"*Measured {date_range(meta)} on {meta.get('cpu', 'an unrecorded CPU')} "
             f"({meta.get('cores', '?')} of {meta.get('hardware_cores', '?')} cores), "
-            f"jelly {meta.get('jelly_version', '?')} {meta.get('build_type', '')} build "
-            f"({meta.get('compiler', '?')}); {load_text}. Command: `{' '.join(words)}`.*")
+            f"{build}; {load_text}. Command: `{' '.join(words)}`.*")
 
 
 def ordered(names):
@@ -186,6 +197,16 @@ def table(header, rows):
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(row) + " |" for row in rows]
     return "\n".join(lines)
+
+
+def render_measured(data, name):
+    """A table written by a script through scripts/bench_csv.py (data/NAME/table.csv): its
+    cells as written, then the line of its metadata."""
+    rows, meta = read_table(os.path.join(data, name, "table.csv"))
+    header = list(rows[0].keys()) if rows else []
+    if not header:
+        raise InputProblem(f"{os.path.join(data, name, 'table.csv')}: no rows")
+    return table(header, [[r[h] for h in header] for r in rows]) + "\n\n" + measured(meta)
 
 
 # --- the tables ---------------------------------------------------------------------------------
@@ -521,15 +542,21 @@ def render_page(text, data, path):
             i += 1
             continue
         name = match.group(1)
-        if name not in RENDERERS:
+        render = RENDERERS.get(name)
+        if render is None and os.path.isfile(os.path.join(data, name, "table.csv")):
+            render = lambda folder, name=name: render_measured(folder, name)
+        if render is None and os.path.isfile(os.path.join(data, name, "core.json")):
+            render = lambda folder, name=name: render_core(folder, name)
+        if render is None:
             raise InputProblem(f"{path}:{i + 1}: no table '{name}' (known: "
-                               + ", ".join(sorted(RENDERERS)) + ")")
+                               + ", ".join(sorted(RENDERERS)) + ", and every folder of "
+                               + data + " that holds a table.csv or a core.json)")
         end = END % name
         try:
             j = lines.index(end, i + 1)
         except ValueError:
             raise InputProblem(f"{path}:{i + 1}: '{lines[i]}' has no '{end}'") from None
-        out += [lines[i], "", RENDERERS[name](data), "", end]
+        out += [lines[i], "", render(data), "", end]
         names.append(name)
         i = j + 1
     return "\n".join(out), names

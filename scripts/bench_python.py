@@ -18,7 +18,11 @@
    alternating, with the CPU time (user + system) each took; the arrays are checked equal.
 
     PYTHONPATH=build/python /usr/bin/python3 scripts/bench_python.py \
-        [step|view|sweep|threads|rollout ...]
+        [--out docs/bench] [step|view|sweep|threads|rollout ...]
+
+With --out DIR each benchmark but sweep also writes its table, DIR/python_<name>/table.csv, with
+the date, machine and load (scripts/bench_csv.py); scripts/bench_page.py renders it into
+docs/python.md.
 """
 
 import os
@@ -31,7 +35,24 @@ import numpy as np
 
 import jelly
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_csv import MeasuredTable  # noqa: E402
+
 SCENES = pathlib.Path(__file__).resolve().parents[1] / "scenes"
+OUT = None  # --out: the folder of the tables' CSV files
+
+
+def table(name, description):
+    return MeasuredTable(name, description, getattr(jelly, "__version__", None))
+
+
+def us(seconds):
+    return f"{seconds * 1e6:.2f} us"
+
+
+def save(measured, header, rows):
+    if OUT:
+        print("  wrote " + measured.write(OUT, header, rows))
 
 
 def seed_simulator(n=10):
@@ -62,6 +83,9 @@ def per_step_cpp(sim, steps):
 
 
 def bench_step(repeats=15, steps=400):
+    measured = table("python_step", f"sim.step() from Python against the C++ loop of run_until,"
+                     f" interleaved in one process, {repeats} repeats; rk4, dt 1 ms")
+    rows = []
     for label, n, count in (("seed cube n = 10 (1000 particles, 12,876 springs)", 10, steps),
                             ("2 x 2 x 2 cube (call overhead)", 2, 20000)):
         sim = seed_simulator(n)
@@ -77,9 +101,18 @@ def bench_step(repeats=15, steps=400):
         print(f"  Python / C++: best {min(py) / min(cpp):.3f}, median "
               f"{statistics.median(py) / statistics.median(cpp):.3f}, difference of the bests "
               f"{(min(py) - min(cpp)) * 1e6:+.2f} us per step")
+        short = "seed cube" if n == 10 else "2 x 2 x 2 cube"
+        rows += [[f"{short}, `sim.step()` from Python", us(min(py)), us(statistics.median(py))],
+                 [f"{short}, C++ loop (`run_until`)", us(min(cpp)), us(statistics.median(cpp))],
+                 [f"{short}, Python / C++", f"{min(py) / min(cpp):.2f}",
+                  f"{statistics.median(py) / statistics.median(cpp):.2f}"]]
+    save(measured, ["case", "best per step", "median per step"], rows)
 
 
 def bench_view():
+    measured = table("python_view", "reading the positions of a 64,000-particle cube (n = 40)"
+                     " and of an 8-particle one: best of 7 x 200 reads")
+    rows = []
     scene = jelly.load_scene(SCENES / "seed_slope.json", {"cube.n": 40})
     sim = jelly.Simulator(scene)
     x = sim.state.x
@@ -103,6 +136,7 @@ def bench_view():
                 read()
             times.append((time.perf_counter() - start) / 200)
         print(f"  {label:32s} best {min(times) * 1e6:9.2f} us")
+        rows.append([f"{label}, 64,000 particles", us(min(times))])
     small = jelly.Simulator(jelly.load_scene(SCENES / "seed_slope.json", {"cube.n": 2}))
     times = []
     for _ in range(7):
@@ -111,6 +145,8 @@ def bench_view():
             small.state.x
         times.append((time.perf_counter() - start) / 2000)
     print(f"  {'read sim.state.x, 8 particles':32s} best {min(times) * 1e6:9.2f} us")
+    rows.append(["read sim.state.x (view), 8 particles", us(min(times))])
+    save(measured, ["read", "best"], rows)
 
 
 def bench_sweep(workers=2):
@@ -151,6 +187,9 @@ def bench_threads(repeats=7, seconds=1.0):
     def run(sim):
         sim.run_until(sim.t + seconds)
 
+    measured = table("python_threads", f"2 seed cubes x {seconds:g} s (rk4, dt 1 ms, 1 solver"
+                     f" thread each), {repeats} repeats: one after the other against 2 Python"
+                     " threads")
     serial, threaded = [], []
     for _ in range(repeats):
         a, b = fresh(), fresh()
@@ -173,6 +212,11 @@ def bench_threads(repeats=7, seconds=1.0):
           f"median {statistics.median(threaded):.3f} s")
     print(f"  speed-up: best {min(serial) / min(threaded):.2f}, median "
           f"{statistics.median(serial) / statistics.median(threaded):.2f}")
+    save(measured, ["", "best", "median"],
+         [["one after the other", f"{min(serial):.3f} s", f"{statistics.median(serial):.3f} s"],
+          ["2 Python threads", f"{min(threaded):.3f} s", f"{statistics.median(threaded):.3f} s"],
+          ["speed-up", f"{min(serial) / min(threaded):.2f}",
+           f"{statistics.median(serial) / statistics.median(threaded):.2f}"]])
 
 
 def bench_rollout(repeats=3, runs=64, steps=500):
@@ -204,6 +248,10 @@ def bench_rollout(repeats=3, runs=64, steps=500):
                                                           threads=1),
         "Python loop of step()": python_loop,
     }
+    measured = table("python_rollout", f"{runs} launches of a 5 x 5 x 5 cube onto the slope,"
+                     f" {steps} steps each (rk4, dt 1 ms), positions at every step; the cases"
+                     f" alternate, {repeats} repeats, best wall time with the CPU time of the"
+                     " same repeat; the arrays equal bit for bit")
     times = {name: [] for name in cases}
     loads = []
     for _ in range(repeats):  # alternating, so that load changes hit every case alike
@@ -219,6 +267,15 @@ def bench_rollout(repeats=3, runs=64, steps=500):
           f"positions at every step, {repeats} repeats, {os.cpu_count()} cores, load average "
           f"{min(loads):.2f}-{max(loads):.2f}; the arrays equal bit for bit")
     loop = min(w for w, _ in times["Python loop of step()"])
+    labels = {"jelly.rollout, all cores": f"`jelly.rollout`, all cores ({os.cpu_count()})",
+              "jelly.rollout, threads=1": "`jelly.rollout`, `threads=1`",
+              "Python loop of step()": "Python loop of `sim.step()`"}
+    rows = []
+    for name, values in times.items():
+        best = min(values)
+        rows.append([labels[name], f"{best[0]:.3f} s", f"{best[1]:.3f} s",
+                     f"{best[1] / best[0]:.2f}", f"{loop / best[0]:.2f}"])
+    save(measured, ["case", "wall (best)", "CPU", "cores used", "loop / case"], rows)
     for name, values in times.items():
         best = min(values)
         print(f"  {name:26s} best {best[0]:6.3f} s wall, {best[1]:6.3f} s CPU "
@@ -228,7 +285,10 @@ def bench_rollout(repeats=3, runs=64, steps=500):
 
 
 if __name__ == "__main__":
-    chosen = sys.argv[1:] or ["step", "view", "sweep", "threads", "rollout"]
+    arguments = sys.argv[1:]
+    if arguments[:1] == ["--out"] and len(arguments) >= 2:
+        OUT, arguments = arguments[1], arguments[2:]
+    chosen = arguments or ["step", "view", "sweep", "threads", "rollout"]
     for name in chosen:
         {"step": bench_step, "view": bench_view, "sweep": bench_sweep,
          "threads": bench_threads, "rollout": bench_rollout}[name]()

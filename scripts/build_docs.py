@@ -10,7 +10,8 @@ Generated, never committed (all under BUILD/docs-src):
   reference/scene-keys.md  the field tables as `jelly fields` prints them (generated from the
                            C++ declarations), then the rows of docs/scenes.md's key tables
                            whose keys no field table declares
-  reference/cpp.md, cpp-api/  Doxygen HTML of the headers listed in cmake/public_headers.txt
+  reference/cpp.md, cpp-api/  Doxygen HTML of the headers listed in cmake/public_headers.txt,
+                           a table of them with each header's first sentence
   reference/python.md      pydoc of every name in jelly.__all__ (the module's docstrings)
 
 A built page that loads a script, style sheet, icon or image from another site fails the
@@ -20,7 +21,12 @@ every link of the site resolves offline. A generator
 whose program is missing (doxygen; the built jelly, jelly-bench or Python module) leaves a page
 that says so and what to build, and a warning on stderr; --require-all makes that an error.
 
-Usage: build_docs.py [--source DIR] [--build DIR] [--require-all] [--stage-only]
+The C++ reference documents exactly the public headers, from their own comments
+(scripts/doxygen_filter.py): any Doxygen warning (an undocumented public class, function,
+member, enum or typedef) and any public header without its page is a problem; --cpp-only runs
+that part alone (the test jelly_docs_cpp_reference).
+
+Usage: build_docs.py [--source DIR] [--build DIR] [--require-all] [--stage-only] [--cpp-only]
 Exit codes: 0 built; 1 mkdocs failed (a warning under --strict) or a generator failed; 2 bad
 arguments; 77 mkdocs (or its material theme) is not installed.
 """
@@ -241,57 +247,136 @@ def scene_keys_page(source, build, problems):
                     else m.group(1) + "../" + m.group(2) + m.group(3), text)
 
 
-def cpp_page(source, stage, build, problems):
+NAMESPACE_DOC = """/// \\namespace jelly
+/// The public API of jelly: the headers of cmake/public_headers.txt. Names in a `detail`
+/// namespace or under a detail/ folder are internal and may change in any release.
+"""
+
+
+def doxygen_reference(source, output, work, headers):
+    """Runs Doxygen on exactly `headers` (paths in the repository) into the HTML folder
+    `output`, reading their plain `//` comments through scripts/doxygen_filter.py. Returns
+    (problems, pages): every Doxygen warning (an undocumented public class, function, member,
+    enum or typedef; a malformed comment) is a problem, and so is a header without its page in
+    the reference; `pages` maps each header to its page, relative to `output`'s parent."""
     doxygen = shutil.which("doxygen")
-    parts = ["# C++ API\n"]
-    with open(os.path.join(source, "cmake", "public_headers.txt"), encoding="utf-8") as f:
-        headers = [line.split()[0] for line in f if re.match(r"^[a-z]", line)]
     if not doxygen:
-        problems.append("doxygen is not installed (scripts/install-deps.sh --docs): no C++ API")
-        parts.append("Not generated: Doxygen was not installed when the site was built.\n")
-        return "\n".join(parts)
-    output = os.path.join(stage, "reference", "cpp-api")
-    work = os.path.join(build, "docs-doxygen")
+        return ["doxygen is not installed (scripts/install-deps.sh --docs): no C++ API"], {}
     os.makedirs(work, exist_ok=True)
-    inputs = " ".join(os.path.join(source, h) for h in headers)
+    shutil.rmtree(output, ignore_errors=True)
+    namespace_doc = os.path.join(work, "namespace.dox")
+    with open(namespace_doc, "w", encoding="utf-8") as f:
+        f.write(NAMESPACE_DOC)
+    log = os.path.join(work, "warnings.log")
+    inputs = " ".join([os.path.join(source, h) for h in headers] + [namespace_doc])
+    doc_filter = os.path.join(source, "scripts", "doxygen_filter.py")
     doxyfile = "\n".join([
         "PROJECT_NAME = jelly", "PROJECT_BRIEF = \"public C++ API\"",
         f"OUTPUT_DIRECTORY = {work}", "CREATE_SUBDIRS = NO",
         f"INPUT = {inputs}", f"STRIP_FROM_PATH = {source}",
         f"STRIP_FROM_INC_PATH = {source}", "FULL_PATH_NAMES = YES",
-        "EXTRACT_ALL = YES", "EXTRACT_PRIVATE = NO", "EXTRACT_STATIC = YES",
-        "EXCLUDE_SYMBOLS = detail detail::* *::detail *::detail::*",
-        "JAVADOC_AUTOBRIEF = YES", "QUIET = YES", "WARNINGS = NO", "WARN_IF_UNDOCUMENTED = NO",
+        f"INPUT_FILTER = \"/usr/bin/python3 {doc_filter}\"", "FILTER_SOURCE_FILES = NO",
+        "EXTRACT_ALL = NO", "EXTRACT_PRIVATE = NO", "EXTRACT_STATIC = YES",
+        "EXCLUDE_SYMBOLS = detail detail::* *::detail *::detail::* nlohmann nlohmann::*",
+        "JAVADOC_AUTOBRIEF = YES", "QUIET = YES", "WARNINGS = YES",
+        "WARN_IF_UNDOCUMENTED = YES", "WARN_IF_DOC_ERROR = YES", "WARN_NO_PARAMDOC = NO",
+        f"WARN_LOGFILE = {log}",
         "GENERATE_HTML = YES", f"HTML_OUTPUT = {output}", "SEARCHENGINE = YES",
         "SERVER_BASED_SEARCH = NO", "USE_MATHJAX = NO", "GENERATE_LATEX = NO",
         "GENERATE_XML = NO", "HAVE_DOT = NO", "SOURCE_BROWSER = NO", "HTML_TIMESTAMP = NO",
         "ENABLE_PREPROCESSING = YES", "MACRO_EXPANSION = NO", ""])
     with open(os.path.join(work, "Doxyfile"), "w", encoding="utf-8") as f:
         f.write(doxyfile)
+    if os.path.exists(log):
+        os.remove(log)
     status, text = run([doxygen, os.path.join(work, "Doxyfile")])
+    problems = []
     if status != 0:
         problems.append(f"doxygen exited {status}:\n{text[-2000:]}")
-        parts.append("Not generated: Doxygen failed when the site was built.\n")
+    if os.path.exists(log):
+        with open(log, encoding="utf-8") as f:
+            warnings = [line.replace(source + os.sep, "") for line in f.read().split("\n")
+                        if line.strip()]
+        if warnings:
+            problems.append(f"{len(warnings)} Doxygen warnings on the public headers (each"
+                            " public class, function, member, enum and typedef needs its"
+                            " comment):\n  " + "\n  ".join(warnings))
+    # Doxygen writes `#include <solvers/simulator.hpp>`; users write <jelly/solvers/...>.
+    for name in os.listdir(output) if os.path.isdir(output) else []:
+        if name.endswith(".html"):
+            path = os.path.join(output, name)
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+            fixed = re.sub(r'(#include &lt;(?:<a class="el" href="[^"]*">)?)(?=(?:core|geometry|terrain|solvers|io|fit)/)',
+                           r"\1jelly/",
+                           text)
+            if fixed != text:
+                with open(path, "w", encoding="utf-8") as f:
+                    f.write(fixed)
+    pages = {}
+    # Doxygen names a file's page by its base name, or by its path where two share one
+    mangle = lambda name: name.replace("_", "__").replace("/", "_2").replace(".", "_8")
+    base = os.path.basename(output)
+    for h in headers:
+        candidates = [f"{base}/{mangle(name)}.html" for name in (os.path.basename(h), h)]
+        page = next((p for p in candidates
+                     if os.path.exists(os.path.join(os.path.dirname(output), p))), None)
+        if page:
+            pages[h] = page
+        else:
+            problems.append(f"{h} is in cmake/public_headers.txt but has no page in the C++"
+                            " reference (its first comment, after #pragma once, documents it)")
+    return problems, pages
+
+
+def public_headers(source):
+    with open(os.path.join(source, "cmake", "public_headers.txt"), encoding="utf-8") as f:
+        return [line.split()[0] for line in f if re.match(r"^[a-z]", line)]
+
+
+def cpp_page(source, stage, build, problems):
+    parts = ["# C++ API\n"]
+    headers = public_headers(source)
+    found, pages = doxygen_reference(source, os.path.join(stage, "reference", "cpp-api"),
+                                     os.path.join(build, "docs-doxygen"), headers)
+    problems.extend(found)
+    if not pages:
+        parts.append("Not generated: Doxygen was not installed, or failed, when the site was"
+                     " built.\n")
         return "\n".join(parts)
     parts.append(f"The {len(headers)} headers of `cmake/public_headers.txt` (what `cmake --install`"
                  " installs; `<jelly/jelly.hpp>` includes them), documented by Doxygen from their"
                  " comments. Everything else is internal and may change.\n")
     parts.append("**[Open the C++ API reference](cpp-api/index.html)** ("
                  "[classes](cpp-api/annotated.html), [files](cpp-api/files.html)).\n")
-    parts.append("| header | Doxygen page |\n|---|---|")
+    parts.append("| header | what it holds |\n|---|---|")
     for h in headers:
-        # Doxygen names a file's page by its base name, or by its path where two share one
-        mangle = lambda name: name.replace("_", "__").replace("/", "_2").replace(".", "_8")
-        pages = [f"cpp-api/{mangle(name)}.html" for name in (os.path.basename(h), h)]
-        page = next((p for p in pages if os.path.exists(os.path.join(stage, "reference", p))),
-                    None)
-        parts.append(f"| `<jelly/{h}>` | " + (f"[{os.path.basename(h)}]({page})" if page else "")
-                     + " |")
+        summary = header_summary(os.path.join(source, h))
+        link = f"[`<jelly/{h}>`]({pages[h]})" if h in pages else f"`<jelly/{h}>`"
+        parts.append(f"| {link} | {summary} |")
     return "\n".join(parts) + "\n"
 
 
+def header_summary(path):
+    """The first sentence of a header's own comment (the one after #pragma once)."""
+    text = []
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            if line.startswith("#pragma") or (not text and not line.strip()):
+                continue
+            if not line.startswith("//"):
+                break
+            text.append(line[2:].strip())
+    sentence = re.split(r"(?<=\.)\s", " ".join(text) + " ", maxsplit=1)[0].strip()
+    if len(sentence) > 160:  # a long sentence: up to its first colon or semicolon
+        short = re.split(r"(?<=[:;])\s", sentence, maxsplit=1)[0]
+        if short.count("(") == short.count(")"):
+            sentence = short
+    return sentence.rstrip(".:;").replace("|", "\\|")
+
+
 PYTHON_SNIPPET = r"""
-import pydoc, sys, jelly
+import inspect, pydoc, re, sys, jelly
 names = sorted(getattr(jelly, "__all__", [n for n in dir(jelly) if not n.startswith("_")]))
 print("MODULE\t" + jelly.__file__)
 for name in names:
@@ -299,6 +384,12 @@ for name in names:
     if not (callable(obj) or isinstance(obj, type)):
         continue
     text = pydoc.render_doc(obj, title="%s", renderer=pydoc.plaintext)
+    # pybind11 starts a function's docstring with its signature: what follows is the doc
+    doc = [line for line in (inspect.getdoc(obj) or "").split("\n")
+           if line.strip() and not re.match(r"^(\d+\. )?" + re.escape(name) + r"\(", line)
+           and line.strip() != "Overloaded function."]
+    if not doc:
+        print("UNDOCUMENTED\t" + name)
     print("NAME\t" + name)
     print(text.replace("\x00", ""))
 """
@@ -318,6 +409,11 @@ def python_page(source, build, problems):
                  " `pydoc` renders them (generated by `make docs` from the built module). The"
                  " guide is [Python](../python.md); the type stub `python/jelly/__init__.pyi`"
                  " has the signatures too.\n")
+    undocumented = re.findall(r"^UNDOCUMENTED\t(\S+)$", text, re.M)
+    if undocumented:
+        problems.append("names of jelly.__all__ without a docstring (python/src/*.cpp): "
+                        + ", ".join(undocumented))
+    text = re.sub(r"^UNDOCUMENTED\t\S+\n", "", text, flags=re.M)
     sections = text.split("\nNAME\t")[1:]
     index = []
     body = []
@@ -356,11 +452,28 @@ def main():
     parser.add_argument("--require-all", action="store_true",
                         help="a reference page that cannot be generated is an error")
     parser.add_argument("--stage-only", action="store_true", help="do not run mkdocs")
+    parser.add_argument("--cpp-only", action="store_true",
+                        help="only the C++ reference (Doxygen) and its checks, into"
+                        " BUILD/docs-doxygen/cpp-api; exit 77 without doxygen")
     args = parser.parse_args()
     source = os.path.abspath(args.source)
     build = os.path.abspath(args.build or os.path.join(source, "build"))
     stage = os.path.join(build, "docs-src")
     site = os.path.join(build, "site")
+
+    if args.cpp_only:
+        if not shutil.which("doxygen"):
+            print("build_docs: doxygen is not installed (Debian package doxygen:"
+                  " scripts/install-deps.sh --docs): skipped", file=sys.stderr)
+            return 77
+        work = os.path.join(build, "docs-doxygen")
+        headers = public_headers(source)
+        problems, pages = doxygen_reference(source, os.path.join(work, "cpp-api"), work, headers)
+        for problem in problems:
+            print(f"build_docs: {problem}", file=sys.stderr)
+        print(f"build_docs: C++ reference of {len(pages)} of {len(headers)} public headers in"
+              f" {os.path.join(work, 'cpp-api')}")
+        return 1 if problems else 0
 
     if not args.stage_only:
         status, text = run(["/usr/bin/python3", "-c", "import mkdocs, material"])

@@ -56,7 +56,9 @@ class Dynamics {
   // stage_acceleration() (integrator_supports_in_evaluation_contact()).
   bool has_in_evaluation_contact() const { return in_evaluation_contact_; }
 
+  // The model.
   const Model& model() const { return *model_; }
+  // The terrain contact of the step.
   const ContactSolver& contacts() const { return *contacts_; }
   // The terrains of the scene, or null.
   const Terrains* terrains() const { return terrains_; }
@@ -69,6 +71,7 @@ class Dynamics {
   const AnchorSprings* anchors() const { return anchors_; }
   // The added Force plugins, or null when there are none.
   const ForceList* added_forces() const { return forces_; }
+  // Force evaluations so far.
   long force_evaluations() const { return evaluations_; }
   // Threads the integrator may use for its own loops (results do not depend on it).
   int threads() const { return threads_; }

@@ -15,6 +15,7 @@
 // the origin, or (when max_energy is finite) a total energy above max_energy.
 namespace jelly {
 
+// When a run counts as diverged: speed, distance from the origin, total energy, NaN or Inf.
 struct DivergenceGuard {
   Real max_speed = 500;     // m/s
   Real max_distance = 1e4;  // m
@@ -23,11 +24,13 @@ struct DivergenceGuard {
   // (docs/benchmarking.md); checking it costs one pass over the springs per step.
   Real max_energy = std::numeric_limits<Real>::infinity();
 
+  // Throws InputError for a limit that is not > 0.
   void validate() const;
   // The reason the state counts as diverged, or nothing. Without the model the energy is not
   // checked. The particles are scanned on up to `threads` threads (the same answer for any
   // count: the first offending particle is named).
   std::optional<std::string> check(const State& state, int threads = 1) const;
+  // The same, with the model's energy checked against max_energy.
   std::optional<std::string> check(const Model& model, const State& state, int threads = 1) const;
 };
 
@@ -35,6 +38,7 @@ struct DivergenceGuard {
 
 namespace jelly {
 
+// How a run ended.
 enum class RunStatus {
   kCompleted,              // reached the requested time
   kCompletedWithWarnings,  // reached it, but some steps missed the solver's own tolerance, or
@@ -42,19 +46,22 @@ enum class RunStatus {
   kDiverged,               // NaN, Inf or runaway speed: the divergence guard stopped the run
   kSolverFailed,  // the integrator returned a failure (e.g. a matrix not positive definite)
 };
+// "completed", "completed_with_warnings", "diverged", "solver_failed".
 std::string_view run_status_name(RunStatus status);
 
+// What a run did: how it ended, the time reached, steps, wall time, the integrator's counters and
+// notes.
 struct RunReport {
-  RunStatus status = RunStatus::kCompleted;
-  Real t = 0;      // simulated time reached
-  long steps = 0;  // steps taken in this run
+  RunStatus status = RunStatus::kCompleted;  // how the run ended
+  Real t = 0;                                // simulated time reached
+  long steps = 0;                            // steps taken in this run
   // Why the run stopped early, or for kCompletedWithWarnings which tolerances how many steps
   // missed ("implicit_euler: Newton did not converge (...) on 111 of 180 steps"); empty when
   // completed.
   std::string reason;
-  double wall_seconds = 0;
-  long force_evaluations = 0;
-  Statistics statistics;  // the integrator's counters
+  double wall_seconds = 0;     // s of wall time the run took
+  long force_evaluations = 0;  // force evaluations of the run
+  Statistics statistics;       // the integrator's counters
   // What the caller should know that is not a warning: an added force without Jacobians that
   // an implicit integrator treats explicitly within its step, said once per simulator.
   std::vector<std::string> notes;
@@ -63,6 +70,7 @@ struct RunReport {
   bool ok() const {
     return status == RunStatus::kCompleted || status == RunStatus::kCompletedWithWarnings;
   }
+  // Reached the requested time, with warnings.
   bool has_warnings() const { return status == RunStatus::kCompletedWithWarnings; }
   // One line: status, time, steps, wall time (and the reason when it stopped early).
   std::string brief() const;

@@ -14,8 +14,8 @@
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/body_contact_params.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
-#include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
+#include <jelly/solvers/run_report.hpp>
 
 namespace jelly {
 
@@ -37,11 +37,14 @@ class Observer {
   Observer() = default;
   // A copy is a new observer: it observes nothing until it is added itself.
   Observer(const Observer& /*other*/) noexcept {}
+  // A copy is a new observer (see the copy constructor).
   Observer& operator=(const Observer& /*other*/) noexcept { return *this; }
   // Removes this observer from every simulator it was added to.
   virtual ~Observer();
 
+  // Called at the first output time and then every output interval.
   virtual void on_frame(const Simulator& simulator) = 0;
+  // Called when run_until() ends, with its report.
   virtual void on_finish(const Simulator& /*simulator*/, const RunReport& /*report*/) {}
   // Called by Simulator::add_observer before adding it: an observer made for one simulator's
   // model (a recorder) throws InputError for a simulator it does not fit.
@@ -61,7 +64,9 @@ class Observer {
 class ObserverList {
  public:
   ObserverList() = default;
+  // Takes the links of `other`.
   ObserverList(ObserverList&& other) noexcept;
+  // Takes the links of `other`.
   ObserverList& operator=(ObserverList&& other) noexcept;
   ObserverList(const ObserverList&) = delete;
   ObserverList& operator=(const ObserverList&) = delete;
@@ -72,7 +77,7 @@ class ObserverList {
   void add(std::shared_ptr<Observer> observer);  // shared ownership: kept alive while added
   // False when the observer was not in the list.
   bool remove(const Observer& observer);
-  std::size_t size() const;
+  std::size_t size() const;  // the number of observers
   // Calls f(observer) for each observer, in the order they were added.
   template <typename F>
   void for_each(F f);
@@ -103,10 +108,11 @@ void ObserverList::for_each(F f) {
   }
 }
 
+// How a Simulator steps: dt, output interval, divergence guard, threads, crush limits.
 struct SimulatorOptions {
-  Real dt = 0.001;           // s, > 0
-  Real output_interval = 0;  // s between observer frames; 0 = every step
-  DivergenceGuard divergence;
+  Real dt = 0.001;             // s, > 0
+  Real output_interval = 0;    // s between observer frames; 0 = every step
+  DivergenceGuard divergence;  // when the run stops as diverged
   // Threads for the force loop, the integrators' solves and the contact after a step; 0 = all
   // cores this process may run on or one thread, chosen step by step from which ran faster (a
   // busy neighbour can make a team slower than one thread; docs/threads.md). Results are the
@@ -114,16 +120,18 @@ struct SimulatorOptions {
   int threads = 0;
   // When the end of a run reports a body crushed (run_report.hpp).
   CrushLimits crush{};
+  // Throws InputError naming the first value out of range.
   void validate() const;
 };
 
 // The values of a model that live edits change (Simulator::set_spring_coefficients, set_gravity,
 // set_particle_mass, pins): a snapshot of an edited model carries them.
 struct ModelValues {
-  std::vector<Real> ks, kd;  // [M] per spring
-  VecX mass;                 // [N]
-  Vec3 gravity = Vec3::Zero();
-  Pins pins;
+  std::vector<Real> ks;         // [M] per spring (N/m)
+  std::vector<Real> kd;         // [M] per spring (N s/m)
+  VecX mass;                    // [N]
+  Vec3 gravity = Vec3::Zero();  // m/s^2
+  Pins pins;                    // the pins with their paths
 };
 
 // What the future of a run depends on besides the model, terrains, integrator and options: a
@@ -133,9 +141,9 @@ struct SimulatorSnapshot {
   // The largest step count a snapshot may carry: 2^53 (exact as a double; no run takes that many
   // steps, and counting on from it cannot overflow).
   static constexpr long kMaxTotalSteps = 1L << 53;
-  State state;
+  State state;                                // time, positions, velocities
   std::vector<CarriedContact> seed_contacts;  // active during the next step
-  int contact_count = 0;
+  int contact_count = 0;                      // contacts resolved so far
   long total_steps = 0;  // at most kMaxTotalSteps (the count goes on from there)
   // Time of the next observer frame (taken inside on_frame: that frame's own time, which the
   // frame restore() emits first moves on as the original run did).
@@ -150,13 +158,17 @@ struct SimulatorSnapshot {
 // Names a force added to a simulator (Simulator::add_force), for removing it.
 using ForceHandle = long;
 
+// Steps a model among terrains with an integrator: contact, pins, forces, observers at the output
+// interval and a divergence guard (docs/scenes.md, README's "Library API").
 class Simulator {
  public:
   // Throws InputError for an invalid model, state size or option.
   Simulator(Model model, State state, std::unique_ptr<Integrator> integrator,
             SimulatorOptions options = {});
   ~Simulator();
+  // Moves the simulator (observers follow it).
   Simulator(Simulator&&) noexcept;
+  // Moves the simulator (observers follow it).
   Simulator& operator=(Simulator&&) noexcept;
 
   // Throws InputError for a seed_framework terrain when the integrator does not support it.
@@ -177,6 +189,7 @@ class Simulator {
   ForceHandle add_force(std::shared_ptr<Force> force);
   // False when no force has this handle.
   bool remove_force(ForceHandle handle);
+  // The added forces, in order.
   const ForceList& forces() const { return forces_; }
 
   // Live edits of the model between steps, validated like a scene (an invalid value throws
@@ -184,6 +197,7 @@ class Simulator {
   // checkpoint taken after them holds the edited model (model()).
   // ks and kd of every spring of `type` in body `body` (N/m, N s/m; finite, >= 0).
   void set_spring_coefficients(int body, SpringType type, SpringCoefficients coefficients);
+  // Sets gravity (m/s^2) for the next steps.
   void set_gravity(const Vec3& gravity);
   // Every particle of body `body` gets `particle_mass` (kg, finite, > 0).
   void set_particle_mass(int body, Real particle_mass);
@@ -193,6 +207,7 @@ class Simulator {
   void set_integrator(std::unique_ptr<Integrator> integrator);
   // Sets options().dt, options().output_interval (validated like SimulatorOptions).
   void set_dt(Real dt);
+  // Sets the time between observer frames (s; 0 = every step).
   void set_output_interval(Real interval);
   // Pins particle `particle` (global index) to move along `path` from `anchor` (its position
   // at t = 0 of the path), or re-pins it when it is pinned already. Throws InputError for an
@@ -219,6 +234,7 @@ class Simulator {
   // Stops calling `observer` (and releases the simulator's share of it); false when it was not
   // added. Allowed inside a callback: the observer is not called again.
   bool remove_observer(const Observer& observer);
+  // The observers added.
   std::size_t num_observers() const { return observers_.size(); }
 
   // One step of options().dt, then contact. Returns the integrator's failure, if any; does not
@@ -229,12 +245,15 @@ class Simulator {
   // the simulator at the last completed step and propagates.
   RunReport run_until(Real t_end);
 
+  // The model, with its live edits.
   const Model& model() const { return model_; }
+  // The state: time, positions, velocities.
   const State& state() const { return state_; }
   // Springs pulling particles to points (the viewer's mouse drag): part of the forces of every
   // step until replaced; implicit integrators take their Jacobian into the solve. Throws
   // InputError for an invalid anchor (validate_anchors). Not part of snapshots.
   void set_anchors(AnchorSprings anchors);
+  // The anchor springs.
   const AnchorSprings& anchors() const { return anchors_; }
   // For changing positions or velocities between steps in place (an external force, a drag),
   // keeping the active contacts, the step count and the output clock; sizes must not change.
@@ -243,24 +262,32 @@ class Simulator {
   State& mutable_state() { return state_; }
   // Replaces the state (a restart); forgets the active contacts.
   void set_state(State state);
+  // What restore() needs to continue this run bit for bit.
   SimulatorSnapshot snapshot() const;
   // Continues from a snapshot (taken from a simulator with the same model, terrains, integrator
   // and options; a snapshot of an edited model puts its edited values back); the next
   // run_until() first emits a frame of the restored state. Throws InputError for a snapshot
   // that does not fit the model.
   void restore(SimulatorSnapshot snapshot);
+  // The terrains, in order.
   const Terrains& terrains() const { return terrains_; }
+  // The integrator.
   const Integrator& integrator() const { return *integrator_; }
+  // The integrator.
   Integrator& integrator() { return *integrator_; }
+  // The options.
   const SimulatorOptions& options() const { return options_; }
   // Sets options().threads (0 = all cores). Throws InputError for a negative count.
   void set_threads(int threads);
   // The contact machinery (internal types: for jelly's own programs and tests).
   const ContactSolver& contacts() const;
+  // The contact between bodies and within one.
   const BodyContact& body_contact() const;
+  // Steps taken since the run began.
   long total_steps() const { return total_steps_; }
   // Live edits of the model so far (0: the model as it was built).
   long model_revision() const { return model_revision_; }
+  // Force evaluations since the run began.
   long force_evaluations() const { return force_evaluations_; }
 
  private:

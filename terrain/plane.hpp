@@ -5,6 +5,7 @@
 
 namespace jelly {
 
+// An infinite fixed plane (the seed's slope and floor): contact on the side its normal points to.
 class Plane final : public Terrain {
  public:
   // Throws InputError for a zero or non-finite normal or point.
@@ -14,6 +15,7 @@ class Plane final : public Terrain {
   static Plane slope(Real angle_degrees, const Vec3& point = Vec3::Zero(),
                      ContactParams contact = {});
 
+  // "plane".
   std::string_view kind() const override { return "plane"; }
   Real signed_distance(const Vec3& p, Real /*t*/) const override { return normal_.dot(p - point_); }
   Vec3 normal(const Vec3& /*p*/, Real /*t*/) const override { return normal_; }
@@ -23,10 +25,12 @@ class Plane final : public Terrain {
   // A square of side kRenderSize centred at the point.
   TriangleMesh render_mesh() const override;
 
+  // A point of the plane.
   const Vec3& point() const { return point_; }
+  // Its outward unit normal.
   const Vec3& unit_normal() const { return normal_; }
 
-  static constexpr Real kRenderSize = 20;
+  static constexpr Real kRenderSize = 20;  // m, the side of the square drawn for it
 
  private:
   Vec3 point_;
@@ -35,25 +39,29 @@ class Plane final : public Terrain {
 
 // Scene kind "plane": a fixed plane through `point` with outward `normal` (any length > 0).
 struct PlaneSpec final : TerrainSpecOf<PlaneSpec> {
-  Vec3 point = Vec3::Zero();
-  Vec3 normal = Vec3::UnitY();
+  Vec3 point = Vec3::Zero();    // m, a point of the plane
+  Vec3 normal = Vec3::UnitY();  // outward, any length > 0
 
+  // "plane".
   std::string_view kind() const override { return "plane"; }
   void validate(const std::string& prefix) const override;
   std::unique_ptr<Terrain> make() const override;
   void write(Json& object) const override;
+  // Reads the kind's keys from `fields`.
   static std::unique_ptr<TerrainSpec> read(JsonFields& fields);
 };
 
 // Scene kind "slope": a plane through `point` tilted by `angle_degrees` about z.
 struct SlopeSpec final : TerrainSpecOf<SlopeSpec> {
-  Real angle_degrees = 20;
-  Vec3 point = Vec3::Zero();
+  Real angle_degrees = 20;    // degrees about z: normal (sin a, cos a, 0)
+  Vec3 point = Vec3::Zero();  // m, a point of the plane
 
+  // "slope".
   std::string_view kind() const override { return "slope"; }
   void validate(const std::string& prefix) const override;
   std::unique_ptr<Terrain> make() const override;
   void write(Json& object) const override;
+  // Reads the kind's keys from `fields`.
   static std::unique_ptr<TerrainSpec> read(JsonFields& fields);
 };
 

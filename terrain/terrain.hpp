@@ -16,6 +16,7 @@
 // How a terrain answers a particle that touches it: the contact model and its coefficients.
 namespace jelly {
 
+// How a terrain answers a particle that touches it.
 enum class ContactModel {
   // Impulses on the relative velocity: restitution above a resting speed, Coulomb friction
   // (static and kinetic, bounded by mu times the normal impulse), penetration projected out.
@@ -31,7 +32,7 @@ enum class ContactModel {
 };
 // Every contact model with its name and description.
 const std::vector<EnumName<ContactModel>>& contact_models();
-std::string_view contact_model_name(ContactModel model);
+std::string_view contact_model_name(ContactModel model);  // "coulomb", "seed", "seed_framework"
 // Throws InputError naming `field` for an unknown name.
 ContactModel contact_model_from_name(std::string_view name, std::string_view field);
 // The seed rules (either placement): reflection within epsilon, no projection.
@@ -39,9 +40,10 @@ inline bool is_seed_model(ContactModel model) {
   return model == ContactModel::kSeed || model == ContactModel::kSeedFramework;
 }
 
+// The contact model of a terrain and its coefficients.
 struct ContactParams {
-  ContactModel model = ContactModel::kCoulomb;
-  Real restitution = 0.8;      // in [0, 1]
+  ContactModel model = ContactModel::kCoulomb;  // coulomb, seed or seed_framework
+  Real restitution = 0.8;                       // in [0, 1]
   Real friction = 0.5;         // kinetic mu (coulomb), the report's coefFriction (seed); >= 0
   Real static_friction = 0.5;  // coulomb: sticking when |v_t| <= mu_s * dv_n; >= friction
   Real epsilon = 0.01;         // seed: contact distance (m); > 0
@@ -54,18 +56,22 @@ struct ContactParams {
   void validate(const std::string& prefix) const;
   // Reads the keys of a scene's "contact" object (missing keys keep their defaults), validated.
   static ContactParams read(JsonFields& fields);
-  Json to_json() const;
+  Json to_json() const;  // the scene's "contact" object that read() reads back
 };
 
 }  // namespace jelly
 
 namespace jelly {
 
+// A terrain or obstacle: its signed distance, normal and surface velocity at time t, and the
+// contact model that answers particles touching it.
 class Terrain {
  public:
+  // A terrain that answers with `contact`.
   explicit Terrain(ContactParams contact) : contact_(contact) {}
   virtual ~Terrain() = default;
 
+  // The terrain kind's name in scenes ("plane", "sphere", ...).
   virtual std::string_view kind() const = 0;
   // Distance of p above the surface at time t: > 0 outside, < 0 penetrating.
   virtual Real signed_distance(const Vec3& p, Real t) const = 0;
@@ -86,7 +92,9 @@ class Terrain {
   // The kind's dimensions as named numbers (a recording stores them as attributes).
   virtual std::vector<std::pair<std::string, Real>> attributes() const { return {}; }
 
+  // Its contact model and coefficients.
   const ContactParams& contact() const { return contact_; }
+  // Replaces its contact parameters; throws InputError for a value out of range.
   void set_contact(const ContactParams& contact);
 
  private:

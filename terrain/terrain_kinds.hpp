@@ -14,12 +14,15 @@
 // makes its terrain and writes itself back as JSON; the registry (terrain_kinds.hpp) reads it.
 namespace jelly {
 
+// A terrain as a scene gives it: its kind's parameters and its contact; makes the Terrain.
 class TerrainSpec {
  public:
   ContactParams contact;  // the contact model that answers particles touching the terrain
 
   virtual ~TerrainSpec() = default;
+  // The terrain kind's name in scenes ("plane", ...).
   virtual std::string_view kind() const = 0;
+  // A copy of the same class.
   virtual std::unique_ptr<TerrainSpec> clone() const = 0;
   // Throws InputError naming `prefix`field (a scene passes its JSON path, "terrains[0]."); the
   // contact is validated by the caller.
@@ -34,6 +37,7 @@ class TerrainSpec {
 template <typename Derived>
 class TerrainSpecOf : public TerrainSpec {
  public:
+  // A copy of the same class.
   std::unique_ptr<TerrainSpec> clone() const override {
     return std::make_unique<Derived>(static_cast<const Derived&>(*this));
   }
@@ -43,8 +47,9 @@ class TerrainSpecOf : public TerrainSpec {
 
 namespace jelly {
 
+// One terrain kind of the registry: its name, description and how its keys are read.
 struct TerrainKindInfo {
-  std::string_view name;
+  std::string_view name;         // the kind's name in scenes
   std::string_view description;  // one line, with the kind's keys
   // Reads the kind's keys from `fields` (which names the JSON path), validates them and returns
   // the spec; leaves "kind" and "contact" to the caller.

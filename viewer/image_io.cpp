@@ -11,7 +11,7 @@
 namespace jelly::viewer {
 
 void write_png(const std::string& path, int width, int height, const std::uint8_t* rgb) {
-  stbi_write_png_compression_level = 4;  // faster than the default 8, files ~10 % larger
+  stbi_write_png_compression_level = 4;  // faster than the default 8, for slightly larger files
   // Encoded in memory (stbi_write_png ignores failed writes of its file), then written beside the
   // path and renamed: a failed write leaves an existing image as it was.
   std::string png;

@@ -8,6 +8,7 @@
 
 namespace jelly {
 
+// Contact between bodies and within a body (docs/contact.md): restitution, friction, passes.
 struct BodyContactParams {
   bool enabled = true;         // contact between different bodies
   bool self_contact = false;   // contact between parts of one body that no spring joins
@@ -21,7 +22,7 @@ struct BodyContactParams {
   void validate(const std::string& prefix) const;
   // The keys of a scene's "body_contact" object (missing keys keep their defaults), validated.
   static BodyContactParams read(JsonFields& fields);
-  Json to_json() const;
+  Json to_json() const;  // the scene's "body_contact" object that read() reads back
 };
 
 }  // namespace jelly

@@ -21,25 +21,28 @@ namespace jelly {
 // A particle that touched a terrain at the last after-step response and keeps a contact force
 // during the next step: the inward force is cancelled and friction -mu N v_t added.
 struct CarriedContact {
-  int particle;
-  Vec3 normal;
-  Real friction;
+  int particle;   // the particle's global index
+  Vec3 normal;    // the terrain's outward unit normal there
+  Real friction;  // mu of the terrain's contact
 };
 
 // What a model's after-step response works on: the step from `before` to `state` (time
 // state.t) of size h, against `terrain` with its contact parameters.
 struct AfterStepContact {
-  const Model& model;
-  const Terrain& terrain;
-  const ContactParams& params;
-  const State& before;
-  State& state;
-  Real h;
+  const Model& model;           // the model stepped
+  const Terrain& terrain;       // the terrain touched
+  const ContactParams& params;  // its contact parameters
+  const State& before;          // the state at the step's start
+  State& state;                 // the state after the step, which the response changes
+  Real h;                       // s, the step
 };
 
+// A contact model (coulomb, seed, seed_framework): what it does after a step, inside force
+// evaluations, or as constraints of a solve. No integrator knows one by name.
 class TerrainContactModel {
  public:
   virtual ~TerrainContactModel() = default;
+  // The ContactModel value this implements.
   virtual ContactModel kind() const = 0;
 
   // The response of particles [begin, end) after a step; returns how many touched the terrain.
@@ -61,7 +64,9 @@ class TerrainContactModel {
 
  protected:
   TerrainContactModel() = default;
+  // For derived models.
   TerrainContactModel(const TerrainContactModel&) = default;
+  // For derived models.
   TerrainContactModel& operator=(const TerrainContactModel&) = default;
 };
 

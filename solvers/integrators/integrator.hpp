@@ -41,13 +41,17 @@ struct StepContact {
 
 // A recoverable numerical failure is a returned status, not an exception.
 struct StepResult {
-  bool ok = true;
-  std::string message;
-  StepContact contact;
+  bool ok = true;       // false when the step failed
+  std::string message;  // why it failed (empty on success)
+  StepContact contact;  // what the step resolved of the contact
+  // A step that succeeded.
   static StepResult success() { return {}; }
+  // A step that failed, saying why.
   static StepResult failure(std::string why) { return {false, std::move(why), {}}; }
 };
 
+// An integration method (explicit Euler, RK4, implicit Euler, ...): a non-virtual step() that
+// checks its input and counts, around each method's do_step().
 class Integrator {
  public:
   virtual ~Integrator() = default;
@@ -60,8 +64,11 @@ class Integrator {
   // (integrator_supports_in_evaluation_contact()).
   StepResult step(const Dynamics& dynamics, State& state, Real h);
 
+  // The method's registry name ("rk4", "implicit_euler", ...).
   virtual std::string_view name() const = 0;
+  // The order of accuracy of its fixed steps (1 for Euler, 4 for RK4).
   virtual int order() const = 0;
+  // True for a method that solves a system per step.
   virtual bool is_implicit() const { return false; }
   // True when the method takes the Jacobians of added forces (Force::add_jacobian) into its
   // solve; an implicit method without them treats added forces explicitly within its step.
@@ -78,6 +85,7 @@ class Integrator {
   // ignores it, e.g. when a run continues with another integrator on purpose) and throws
   // InputError for data it cannot read.
   virtual std::vector<Real> internal_state() const { return {}; }
+  // Restores what internal_state() gave.
   virtual void restore_internal_state(const std::vector<Real>& data);
   // Counters of this integrator (steps, and whatever the method adds).
   virtual Statistics statistics() const;
@@ -85,9 +93,11 @@ class Integrator {
   // that missed it so far (empty for methods without an iteration limit below a tolerance).
   virtual std::vector<ToleranceMiss> tolerance_misses() const { return {}; }
 
+  // Steps taken so far.
   long steps() const { return steps_; }
 
  protected:
+  // The method's step, called by step() after its checks.
   virtual StepResult do_step(const Dynamics& dynamics, State& state, Real h) = 0;
 
  private:

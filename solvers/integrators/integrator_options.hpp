@@ -15,6 +15,7 @@
 // in the sparse matrices.
 namespace jelly {
 
+// CHOLMOD's fill-reducing orderings.
 enum class CholmodOrdering {
   kAmd,     // approximate minimum degree
   kMetis,   // METIS nested dissection of A + A^T
@@ -23,8 +24,10 @@ enum class CholmodOrdering {
 };
 // "amd", "metis", "nesdis", "best".
 const std::vector<EnumName<CholmodOrdering>>& cholmod_orderings();
+// "amd", "metis", "nesdis", "best".
 std::string_view cholmod_ordering_name(CholmodOrdering ordering);
 
+// How implicit_euler and projective_dynamics use CHOLMOD.
 struct CholmodOptions {
   // METIS gives the least fill and the fastest factorization on the seed cube (docs/implicit.md).
   CholmodOrdering ordering = CholmodOrdering::kMetis;
@@ -42,14 +45,17 @@ struct CholmodOptions {
 // validated once with the JSON path of the field.
 namespace jelly {
 
+// The linear solvers of implicit_euler.
 enum class ImplicitLinearSolver {
   kAuto,     // CHOLMOD up to 1000 unknowns, block-Jacobi CG above (the fastest measured there)
   kCholmod,  // CHOLMOD, a numeric factorization every step
   kLdlt,     // Eigen's simplicial LDL^T, a factorization every step
   kCg,       // conjugate gradients with cg_preconditioner
 };
+// Every implicit_euler linear solver with its name.
 const std::vector<EnumName<ImplicitLinearSolver>>& implicit_linear_solvers();
 
+// The preconditioners of implicit_euler's CG.
 enum class CgPreconditionerKind {
   kJacobi,   // 3x3 block Jacobi
   kCholmod,  // a CHOLMOD factor of an earlier matrix, refreshed when it stops paying
@@ -58,6 +64,7 @@ enum class CgPreconditionerKind {
   // Smoothed-aggregation algebraic multigrid on any body (the assembled matrix's CG)
   kAmg,
 };
+// Every CG preconditioner with its name.
 const std::vector<EnumName<CgPreconditionerKind>>& cg_preconditioner_kinds();
 
 // The cycle of cg_preconditioner = amg (docs/implicit.md, "Algebraic multigrid on any body").
@@ -65,33 +72,38 @@ enum class AmgCycle {
   kW,  // Chebyshev smoothing of degree 2 on level 0 and 4 below, levels below 1 visited twice
   kV,  // a V-cycle, Chebyshev smoothing of degree 2 on every level
 };
-const std::vector<EnumName<AmgCycle>>& amg_cycles();
+const std::vector<EnumName<AmgCycle>>& amg_cycles();  // "w", "v"
 
 // How coulomb terrains enter the step.
 enum class ImplicitContactMode {
   kImplicit,   // constraints inside the linear solve, with friction and restitution
   kAfterStep,  // the resolve after the step of the explicit integrators (crushes at large dt)
 };
+// "implicit", "after_step".
 const std::vector<EnumName<ImplicitContactMode>>& implicit_contact_modes();
 
+// The options of implicit_euler (docs/implicit.md).
 struct ImplicitEulerOptions {
   // 1 = linearized backward Euler (Baraff & Witkin 1998), one linear solve per step;
   // > 1 = fully nonlinear backward Euler by Newton, at most this many linear solves per step.
   int newton_iterations = 1;
   // Newton stops when |M (v1 - v0) - h f(x0 + h v1, v1)| <= newton_tolerance |h f(x0, v0)|.
   Real newton_tolerance = 1e-8;
+  // How compressed springs keep the matrix definite.
   DefinitenessFix definiteness = DefinitenessFix::kClampCompressed;
+  // CHOLMOD, LDL^T, CG or chosen by size.
   ImplicitLinearSolver linear_solver = ImplicitLinearSolver::kAuto;
   // For kCg: the lagged CHOLMOD factor is refreshed when its solves cost more than the average
   // since the refresh, when CG needs more than refactor_iterations with it, or when dt changes.
   CgPreconditionerKind cg_preconditioner = CgPreconditionerKind::kJacobi;
   // 1e-5: at dt = 1/60 the solve then moves the particles about 1/1000 of backward Euler's own
   // error (docs/implicit.md, "CG tolerance").
-  Real cg_tolerance = 1e-5;  // relative residual |b - A x| / |b|
-  int cg_max_iterations = 1000;
-  int refactor_iterations = 20;
-  AmgCycle amg_cycle = AmgCycle::kW;                   // cg_preconditioner = amg: its cycle
+  Real cg_tolerance = 1e-5;           // relative residual |b - A x| / |b|
+  int cg_max_iterations = 1000;       // CG stops there and reports a tolerance miss
+  int refactor_iterations = 20;       // kCholmod preconditioner: refresh when CG needs more
+  AmgCycle amg_cycle = AmgCycle::kW;  // cg_preconditioner = amg: its cycle
   CholmodOrdering ordering = CholmodOrdering::kMetis;  // CHOLMOD's fill-reducing ordering
+  // Contact inside the solve or after the step.
   ImplicitContactMode contact = ImplicitContactMode::kImplicit;
   // kImplicit: at most this many linear solves per step while the active set changes.
   int contact_iterations = 10;
@@ -108,7 +120,7 @@ struct ImplicitEulerOptions {
   void validate(const std::string& prefix) const;
   // The scene's integrator.options of implicit_euler; validated with the fields' JSON path.
   static ImplicitEulerOptions read(JsonFields& fields);
-  Json to_json() const;
+  Json to_json() const;  // the integrator's "options" object that read() reads back
 };
 
 }  // namespace jelly
@@ -125,14 +137,16 @@ enum class ArkodeLinearSolver {
   kSchur,   // Schur reduction factorized by CHOLMOD at each setup
   kKlu,     // SUNDIALS' KLU on the 6N Jacobian (to check the others)
 };
+// Every arkode_dirk linear solver with its name.
 const std::vector<EnumName<ArkodeLinearSolver>>& arkode_linear_solvers();
 
 // The ARKODE Butcher tables with an embedding (an error estimate), by the names ARKODE gives
 // them; the value is ARKODE's table id. Explicit ones for arkode_erk, diagonally implicit ones
 // for arkode_dirk.
 const std::vector<EnumName<int>>& arkode_erk_methods();
-const std::vector<EnumName<int>>& arkode_dirk_methods();
+const std::vector<EnumName<int>>& arkode_dirk_methods();  // ARKODE's DIRK tables by name
 
+// The options of arkode_erk and arkode_dirk (docs/arkode.md).
 struct ArkodeOptions {
   Real rtol = 1e-6;  // relative tolerance of the local error test, in (0, 1)
   Real atol = 1e-8;  // absolute tolerance (m and m/s), > 0
@@ -150,7 +164,7 @@ struct ArkodeOptions {
   void validate(const std::string& prefix) const;
   // The scene's integrator.options of arkode_erk and arkode_dirk, validated with their paths.
   static ArkodeOptions read(JsonFields& fields);
-  Json to_json() const;
+  Json to_json() const;  // the integrator's "options" object that read() reads back
 };
 
 // The ARKODE table id of `method` in `table` (empty: `default_method`); throws InputError naming
@@ -173,6 +187,7 @@ enum class PositionContactMode {
 // "projection", "after_step".
 const std::vector<EnumName<PositionContactMode>>& position_contact_modes();
 
+// The options of projective_dynamics (docs/realtime.md).
 struct ProjectiveDynamicsOptions {
   // Local/global iterations per step (one force evaluation and one prefactored solve each).
   int iterations = 10;
@@ -199,7 +214,7 @@ struct ProjectiveDynamicsOptions {
   void validate(const std::string& prefix = "integrator.options.") const;
   // The scene's integrator.options of projective_dynamics; validated with the fields' JSON path.
   static ProjectiveDynamicsOptions read(JsonFields& fields);
-  Json to_json() const;
+  Json to_json() const;  // the integrator's "options" object that read() reads back
 };
 
 }  // namespace jelly
@@ -215,8 +230,9 @@ enum class XpbdSweep {
                  // travels up the lattice within a sweep, but the order breaks symmetry and
                  // angular momentum; one thread)
 };
-const std::vector<EnumName<XpbdSweep>>& xpbd_sweeps();
+const std::vector<EnumName<XpbdSweep>>& xpbd_sweeps();  // "jacobi", "gauss_seidel"
 
+// The options of xpbd (docs/realtime.md).
 struct XpbdOptions {
   // Substeps per step (Macklin et al. 2019: many small steps of one iteration each beat few
   // steps of many iterations). Three with two Jacobi sweeps each hold the seed jelly's landing
@@ -236,7 +252,7 @@ struct XpbdOptions {
   void validate(const std::string& prefix = "integrator.options.") const;
   // The scene's integrator.options of xpbd; validated with the fields' JSON path.
   static XpbdOptions read(JsonFields& fields);
-  Json to_json() const;
+  Json to_json() const;  // the integrator's "options" object that read() reads back
 };
 
 }  // namespace jelly
@@ -244,6 +260,7 @@ struct XpbdOptions {
 // Options of the vertex block descent integrator (docs/realtime.md).
 namespace jelly {
 
+// The options of vbd (docs/realtime.md).
 struct VbdOptions {
   // Sweeps over all colours per step (each vertex one 3x3 Newton step per sweep).
   int iterations = 10;
@@ -267,13 +284,14 @@ struct VbdOptions {
   void validate(const std::string& prefix = "integrator.options.") const;
   // The scene's integrator.options of vbd; validated with the fields' JSON path.
   static VbdOptions read(JsonFields& fields);
-  Json to_json() const;
+  Json to_json() const;  // the integrator's "options" object that read() reads back
 };
 
 }  // namespace jelly
 
 namespace jelly {
 
+// The options of every method a scene can name; only the chosen integrator's are used.
 struct IntegratorOptions {
   ImplicitEulerOptions implicit;  // implicit_euler
   ArkodeOptions arkode;           // arkode_erk, arkode_dirk

@@ -17,15 +17,19 @@ namespace jelly {
 // fields' JSON paths) into its member of IntegratorOptions, written back, validated. All null for
 // an integrator that takes none.
 struct IntegratorOptionsIo {
+  // Reads the method's keys from `fields` into `options`.
   void (*read)(JsonFields& fields, IntegratorOptions& options) = nullptr;
+  // Writes the method's keys.
   Json (*write)(const IntegratorOptions& options) = nullptr;
+  // Throws InputError naming `prefix`field for a value out of range.
   void (*validate)(const IntegratorOptions& options, const std::string& prefix) = nullptr;
 };
 
+// One integrator of the registry: its name, description, options and what contact it supports.
 struct IntegratorInfo {
-  std::string_view name;
-  std::string_view description;
-  IntegratorOptionsIo options;
+  std::string_view name;         // "rk4", "implicit_euler", ...
+  std::string_view description;  // one line
+  IntegratorOptionsIo options;   // how its options are read, written and validated
   // True when every force evaluation of the method's step goes through
   // Dynamics::stage_acceleration(), so that the models acting inside evaluations
   // (seed_framework) work with it (the explicit methods). The others refuse such terrains: a
@@ -44,7 +48,7 @@ void register_integrator(const IntegratorInfo& info, IntegratorFactory make);
 
 // Every registered integrator, sorted by name.
 const std::vector<IntegratorInfo>& integrator_infos();
-std::vector<std::string> integrator_names();
+std::vector<std::string> integrator_names();  // the names of integrator_infos(), sorted
 // The registered integrator's IntegratorInfo::in_evaluation_contact; false for a name the
 // registry does not know (an integrator of the user's own that was not registered).
 bool integrator_supports_in_evaluation_contact(std::string_view name);
