@@ -145,6 +145,14 @@ def main():
         print(f"{name:32s} best {min(t):8.3f} s  median {statistics.median(t):8.3f} s  "
               f"ratio {statistics.median(t) / base:5.2f}  cpu median {c:8.3f} s  "
               f"ratio {c / base_cpu:5.2f}")
+    # One more gradient for what its passes did (not timed above).
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        raw = jelly._jelly._gradient(jelly.Simulator(s), steps, lambda x, v, f: loss(x, v), [],
+                                     [], np.zeros((0, 3)), 0)
+    print(f"backward solver {raw['backward_solver']}: {raw['backward_iterations'] / steps:.1f} "
+          f"iterations per step; forward part {raw['forward_seconds']:.3f} s, backward pass "
+          f"{raw['backward_seconds']:.3f} s; forward residual {raw['forward_residual']:.2g}")
 
 
 if __name__ == "__main__":

@@ -44,8 +44,9 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
     every S steps and runs each segment again during the backward pass (one more forward run,
     memory for S steps).
     Returns (value, {path: array}). Warns when sliding or bouncing contacts (terrain or between
-    bodies) made the gradient approximate (a friction viscosity or restitution held fixed), and
-    when a Newton step did not converge.
+    bodies) made the gradient approximate (a friction viscosity or restitution held fixed), when
+    a Newton step did not converge, and when projective_dynamics' iterations stopped short of the
+    fixed point (the gradient is that of the converged steps).
     """
     sim = _jelly.Simulator(scene)
     steps = _steps(float(duration), sim.options.dt)

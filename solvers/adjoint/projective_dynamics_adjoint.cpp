@@ -14,7 +14,6 @@
 #include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/integrators/detail/implicit_euler.hpp>
 #include <jelly/solvers/integrators/detail/projective_dynamics.hpp>
-#include <jelly/solvers/linear/detail/cholmod_solver.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {
@@ -26,37 +25,12 @@ namespace {
 constexpr Real kPdBackwardTolerance = 1e-10;
 constexpr int kPdBackwardMaxIterations = 2000;
 
-// The preconditioner of the backward pass: the projective-dynamics matrix h^2 A = M + h^2 L_ks +
-// h L_kd (the forward's global matrix, shared by x, y and z), the pinned particles' rows and
-// columns replaced by the identity, as the transposed system's are. Factorized once per run.
+// The preconditioner of the backward pass: the forward's own factor of the projective-dynamics
+// matrix A = M / h^2 + L_ks + L_kd / h (shared by x, y and z; its pins held by a penalty), so
+// that (h^2 A)^-1 approximates the inverse of J = M - h D - h^2 K. Nothing is factorized again.
 class PdAdjointPreconditioner {
  public:
-  PdAdjointPreconditioner(const Model& model, Real h, const std::vector<char>& pinned,
-                          CholmodOrdering ordering) {
-    const int np = model.num_particles();
-    const Springs& s = model.springs;
-    std::vector<Eigen::Triplet<Real, int>> entries;
-    entries.reserve(np + 4 * static_cast<size_t>(s.size()));
-    for (int i = 0; i < np; ++i) entries.emplace_back(i, i, pinned[i] ? 1.0 : model.mass[i]);
-    for (int k = 0; k < s.size(); ++k) {
-      const Real w = h * h * s.ks[k] + h * s.kd[k];
-      const int a = s.a[k], b = s.b[k];
-      if (!pinned[a]) entries.emplace_back(a, a, w);
-      if (!pinned[b]) entries.emplace_back(b, b, w);
-      if (!pinned[a] && !pinned[b]) {
-        entries.emplace_back(a, b, -w);
-        entries.emplace_back(b, a, -w);
-      }
-    }
-    SparseMatrix a(np, np);
-    a.setFromTriplets(entries.begin(), entries.end());
-    a.makeCompressed();
-    CholmodOptions options;
-    options.ordering = ordering;
-    solver_ = std::make_unique<CholmodSolver>(options);
-    LinearResult r = solver_->analyze(a);
-    if (r.ok()) r = solver_->factorize(a);
-    if (!r.ok()) throw std::runtime_error("gradient: projective_dynamics' matrix: " + r.message);
+  PdAdjointPreconditioner(ProjectiveDynamics& pd, int np, Real h) : pd_(pd), scale_(1 / (h * h)) {
     rhs_.setZero(np, 3);
     solution_.setZero(np, 3);
   }
@@ -66,14 +40,15 @@ class PdAdjointPreconditioner {
     const Eigen::Index np = rhs_.rows();
     for (Eigen::Index i = 0; i < np; ++i)
       for (int c = 0; c < 3; ++c) rhs_(i, c) = x[3 * i + c];
-    const LinearResult r = solver_->solve_columns(rhs_, solution_);
-    if (!r.ok()) throw std::runtime_error("gradient: projective_dynamics' matrix: " + r.message);
+    const LinearResult r = pd_.solve_with_factor(rhs_, solution_);
+    if (!r.ok()) throw std::runtime_error("gradient: projective_dynamics' factor: " + r.message);
     for (Eigen::Index i = 0; i < np; ++i)
-      for (int c = 0; c < 3; ++c) y[3 * i + c] = solution_(i, c);
+      for (int c = 0; c < 3; ++c) y[3 * i + c] = scale_ * solution_(i, c);
   }
 
  private:
-  std::unique_ptr<CholmodSolver> solver_;
+  ProjectiveDynamics& pd_;
+  Real scale_;
   Eigen::MatrixXd rhs_, solution_;
 };
 
@@ -234,7 +209,7 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
   // M / h^2 - K - D / h (K, D the exact Jacobians at (x1, v)) and g the adjoint of x1,
   //   H^T lambda = g  (free rows; lambda = 0 at the pins),  then  dL/dp += lambda . dr/dp,
   // solved as J^T lambda = h^2 g with J = h^2 H = M - h D - h^2 K (implicit_euler's Newton
-  // matrix), preconditioned by the forward's prefactored h^2 A = M + h^2 L_ks + h L_kd.
+  // matrix), preconditioned by the forward's own factor of h^2 A = M + h^2 L_ks + h L_kd.
   start = Clock::now();
   out.backward_solver = "bicgstab_pd_prefactored";
   SpringJacobian jacobian(model);
@@ -243,7 +218,7 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
   JacobianOptions exact;
   exact.definiteness = DefinitenessFix::kNone;
   exact.exact_damper = true;
-  PdAdjointPreconditioner preconditioner(model, h, pinned, pd->options().ordering);
+  PdAdjointPreconditioner preconditioner(*pd, np, h);
   PdBiCgStab bicgstab(n);
   const int bodies = model.num_bodies();
   out.ks.assign(static_cast<size_t>(kSpringTypeCount) * bodies, 0.0);
