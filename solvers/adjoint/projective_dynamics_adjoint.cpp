@@ -9,6 +9,7 @@
 #include <jelly/core/detail/clock.hpp>
 #include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/model.hpp>
 #include <jelly/solvers/contact/detail/body_contact.hpp>
@@ -60,6 +61,9 @@ struct PdBiCgStab {
     for (VecX* w : {&r, &r0, &p, &v, &s, &t, &y, &z}) w->setZero(n);
   }
   int solve(const SparseMatrix& j, PdAdjointPreconditioner& pre, const VecX& b, VecX& x) {
+    // (Eigen runs a transposed product as a row-major one in an OpenMP region: kept on this
+    // thread, whose spinning team would slow it down on a busy machine.)
+    const parallel::SerialLibraries serial;
     const Real target = kPdBackwardTolerance * b.norm();
     r.noalias() = b - j.transpose() * x;
     if (r.norm() <= target) return 0;
@@ -297,8 +301,11 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
       for (int i : model.pins.particles) particle(lambda, i).setZero();
       // x0 enters through v (dr/dx0 = M / h^2 - D / h), v0 through M v0 / h, a driven pin's
       // target through x1 (dr/dx1 = K + D / h at its columns).
-      kl.noalias() = k_matrix.transpose() * lambda;
-      dl.noalias() = d_matrix.transpose() * lambda;
+      {
+        const parallel::SerialLibraries serial;
+        kl.noalias() = k_matrix.transpose() * lambda;
+        dl.noalias() = d_matrix.transpose() * lambda;
+      }
       for (int i = 0; i < np; ++i) {
         const Real m = model.mass[i];
         particle(x0b, i) += (m / (h * h)) * particle(lambda, i) - particle(dl, i) / h;
