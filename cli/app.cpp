@@ -149,7 +149,8 @@ int run_jelly(int argc, char** argv) {
                 "replays every window twice per coordinate of its start state (6 x particles "
                 "replays per window), most of the time on a large body");
   fit->add_option("--gradients", fit_args.gradients,
-                  "auto: exact gradients from the adjoint of implicit_euler when it supports the "
+                  "auto: exact gradients from the adjoint of implicit_euler or projective_dynamics "
+                  "when it supports the "
                   "recording, else numeric; adjoint: those or an error; numeric: central "
                   "differences of replays")
       ->capture_default_str();

@@ -23,6 +23,7 @@
 #include <jelly/fit/detail/implicit_euler_ceres.hpp>
 #include <jelly/fit/detail/window_adjoint.hpp>
 #include <jelly/fit/detail/window_start.hpp>
+#include <jelly/solvers/adjoint/detail/projective_dynamics_adjoint.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {
@@ -623,9 +624,9 @@ void take_summary(const Summary& summary, const std::vector<double>& log_k, FitR
 
 // Why the adjoint cannot take this fit before trying it ("" when it may).
 std::string adjoint_refusal(const Trajectory& trajectory, const FitOptions& options) {
-  if (trajectory.integrator != "implicit_euler")
+  if (!has_adjoint(trajectory.integrator))
     return "the recording's integrator is " + trajectory.integrator +
-           " (the adjoint differentiates implicit_euler)";
+           " (the adjoint differentiates implicit_euler and projective_dynamics)";
   if (options.fit_restart_velocities)
     return "fit_restart_velocities (the covariance needs the velocities' full Jacobian)";
   return "";

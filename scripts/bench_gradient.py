@@ -13,8 +13,12 @@ gradient with respect to both bodies' initial velocities (6 n^3 parameters).
     PYTHONPATH=build/python /usr/bin/python3 scripts/bench_gradient.py [n] [steps] [repeats]
     PYTHONPATH=build/python /usr/bin/python3 scripts/bench_gradient.py --contact 6 5 1
     PYTHONPATH=build/python /usr/bin/python3 scripts/bench_gradient.py --newton 5 6 5 1
+    PYTHONPATH=build/python /usr/bin/python3 scripts/bench_gradient.py --free --pd 10 6 5 1
 
 --newton K: implicit_euler with newton_iterations = K (the adjoint of the converged step).
+--pd K: projective_dynamics with K iterations per step (the adjoint of its fixed point).
+--free: no floor: the cube spins in the air (angular velocity (2, 5, 1) rad/s), so that the
+springs stretch from the first step (the scene projective_dynamics' adjoint takes).
 """
 
 import argparse
@@ -28,7 +32,23 @@ import numpy as np
 import jelly
 
 
-def scene(n, overrides):
+def integrator(args):
+    if args.pd > 0:
+        return {"name": "projective_dynamics", "dt": 0.01,
+                "options": {"iterations": args.pd}}
+    return {"name": "implicit_euler", "dt": 0.01}
+
+
+def scene(n, overrides, args):
+    body = {"kind": "cube", "name": "jelly", "n": n, "edge_length": 1.0,
+            "origin": [-0.5, 0.05, -0.5], "particle_mass": 0.05,
+            "velocity": [0.5, -1.0, 0.0],
+            "springs": {t: {"ks": 2000, "kd": 2} for t in ("structural", "shear", "bending")}}
+    if args.free:
+        body["angular_velocity"] = [2.0, 5.0, 1.0]
+        return jelly.Scene({"bodies": [body], "gravity": [0, -9.8, 0],
+                            "integrator": integrator(args), "threads": 1, "duration": 1},
+                           overrides)
     return jelly.Scene({
         "bodies": [{"kind": "cube", "name": "jelly", "n": n, "edge_length": 1.0,
                     "origin": [-0.5, 0.05, -0.5], "particle_mass": 0.05,
@@ -73,10 +93,13 @@ def main():
     parser.add_argument("--contact", action="store_true",
                         help="two cubes pressed together instead of one on a floor")
     parser.add_argument("--newton", type=int, default=1, help="newton_iterations")
+    parser.add_argument("--pd", type=int, default=0,
+                        help="projective_dynamics with this many iterations per step")
+    parser.add_argument("--free", action="store_true", help="no floor: a spinning cube")
     args = parser.parse_args()
     n, steps, repeats = args.n, args.steps, args.repeats
     overrides = {"integrator.options.newton_iterations": args.newton} if args.newton > 1 else {}
-    s = contact_scene(n, overrides) if args.contact else scene(n, overrides)
+    s = contact_scene(n, overrides) if args.contact else scene(n, overrides, args)
     bodies = 2 if args.contact else 1
     dt = 0.01
 
@@ -110,7 +133,10 @@ def main():
             run()
             times[name].append(time.perf_counter() - start)
             cpu[name].append(time.process_time() - start_cpu)
-    print(f"{bodies} x n = {n} ({bodies * n ** 3} particles), {steps} steps, load average "
+    name = f"projective_dynamics ({args.pd} iterations)" if args.pd > 0 else (
+        f"implicit_euler (newton_iterations {args.newton})")
+    print(f"{name}{', free' if args.free else ''}: "
+          f"{bodies} x n = {n} ({bodies * n ** 3} particles), {steps} steps, load average "
           f"{os.getloadavg()[0]:.2f}")
     base = statistics.median(times["forward"])
     base_cpu = statistics.median(cpu["forward"])
@@ -119,6 +145,14 @@ def main():
         print(f"{name:32s} best {min(t):8.3f} s  median {statistics.median(t):8.3f} s  "
               f"ratio {statistics.median(t) / base:5.2f}  cpu median {c:8.3f} s  "
               f"ratio {c / base_cpu:5.2f}")
+    # One more gradient for what its passes did (not timed above).
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        raw = jelly._jelly._gradient(jelly.Simulator(s), steps, lambda x, v, f: loss(x, v), [],
+                                     [], np.zeros((0, 3)), 0)
+    print(f"backward solver {raw['backward_solver']}: {raw['backward_iterations'] / steps:.1f} "
+          f"iterations per step; forward part {raw['forward_seconds']:.3f} s, backward pass "
+          f"{raw['backward_seconds']:.3f} s; forward residual {raw['forward_residual']:.2g}")
 
 
 if __name__ == "__main__":

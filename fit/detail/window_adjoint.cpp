@@ -4,16 +4,17 @@
 #include <vector>
 
 #include <jelly/core/errors.hpp>
-#include <jelly/fit/detail/window_start.hpp>
 #include <jelly/fit/detail/implicit_euler_ceres.hpp>
+#include <jelly/fit/detail/window_start.hpp>
+#include <jelly/solvers/adjoint/detail/projective_dynamics_adjoint.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 namespace jelly {
 
 GradientResult fit_window_gradient(const Trajectory& trajectory, const Model& model, int first,
                                    int last, const State& start, const WindowFrameLoss& loss) {
-  require(trajectory.integrator == "implicit_euler", "recording integrator", trajectory.integrator,
-          "implicit_euler for exact gradients");
+  require(has_adjoint(trajectory.integrator), "recording integrator", trajectory.integrator,
+          "implicit_euler or projective_dynamics for exact gradients");
   // One thread: the fit's windows are its unit of parallel work, and results must not depend on
   // the thread count. The recording's carried contact state at frame `first`, when it holds
   // one (the adjoint holds it: the first step's friction viscosities are constants of the
@@ -35,7 +36,7 @@ GradientResult fit_window_gradient(const Trajectory& trajectory, const Model& mo
   problem.loss = [&](int step, const State& state, VecX& dl_dx, VecX&) {
     return loss(frame_at[step], state.x, dl_dx);
   };
-  return implicit_euler_gradient(sim, problem);
+  return integrator_gradient(sim, problem);
 }
 
 }  // namespace jelly

@@ -1,4 +1,5 @@
-"""jelly.gradient: exact gradients through implicit_euler (the discrete adjoint, docs/gradients.md)."""
+"""jelly.gradient: exact gradients through implicit_euler or projective_dynamics (the discrete
+adjoint, docs/gradients.md)."""
 
 import re
 import warnings
@@ -24,8 +25,8 @@ def _steps(duration: float, dt: float) -> int:
 def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
              frames: Optional[Sequence[int]] = None, pins: Sequence[int] = (),
              pin_targets: Any = None, checkpoint_every: int = 0) -> tuple:
-    """The loss of a run of ``scene`` (implicit_euler) over ``duration`` seconds and its exact
-    gradient (docs/gradients.md).
+    """The loss of a run of ``scene`` (implicit_euler or projective_dynamics) over ``duration``
+    seconds and its exact gradient (docs/gradients.md).
 
     loss(x, v) -> (value, dL/dx, dL/dv): x, v the (N, 3) positions and velocities of the final
     state (or of each step index in ``frames``, 0..K with K = duration / dt, the terms summed).
@@ -43,8 +44,9 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
     every S steps and runs each segment again during the backward pass (one more forward run,
     memory for S steps).
     Returns (value, {path: array}). Warns when sliding or bouncing contacts (terrain or between
-    bodies) made the gradient approximate (a friction viscosity or restitution held fixed), and
-    when a Newton step did not converge.
+    bodies) made the gradient approximate (a friction viscosity or restitution held fixed), when
+    a Newton step did not converge, and when projective_dynamics' iterations stopped short of the
+    fixed point (the gradient is that of the converged steps).
     """
     sim = _jelly.Simulator(scene)
     steps = _steps(float(duration), sim.options.dt)
@@ -86,6 +88,11 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
         if count:
             warnings.warn(f"jelly.gradient: {count} {what}; the gradient there is approximate "
                           "(docs/gradients.md)", stacklevel=2)
+    if raw["forward_residual"] > 1e-6:
+        warnings.warn("jelly.gradient: projective_dynamics' iterations stopped with a residual "
+                      f"of {raw['forward_residual']:.2g} times the step's first; the gradient is "
+                      "that of the converged steps (more iterations or a tolerance: "
+                      "docs/gradients.md)", stacklevel=2)
     out = {}
     for path, (body, what) in zip(wrt, requests):
         if isinstance(what, tuple) and what[0] == "force":

@@ -1,7 +1,8 @@
-// jelly._gradient: the discrete adjoint of implicit_euler (solvers/adjoint/) for
-// jelly.gradient, which maps its arrays to scene paths (python/jelly/__init__.py).
+// jelly._gradient: the discrete adjoints of implicit_euler and projective_dynamics
+// (solvers/adjoint/) for jelly.gradient, which maps its arrays to scene paths
+// (python/jelly/__init__.py).
 #include <jelly/core/model.hpp>
-#include <jelly/solvers/adjoint/detail/implicit_euler_adjoint.hpp>
+#include <jelly/solvers/adjoint/detail/projective_dynamics_adjoint.hpp>
 #include <jelly/solvers/simulator.hpp>
 
 #include "common.hpp"
@@ -48,7 +49,7 @@ void bind_adjoint(py::module_& m) {
           dv += gv;
           return t[0].cast<Real>();
         };
-        const GradientResult g = implicit_euler_gradient(sim, problem);
+        const GradientResult g = integrator_gradient(sim, problem);
         py::dict out;
         out["loss"] = g.loss;
         out["position"] = copy_n3(g.initial_position);
@@ -94,6 +95,7 @@ void bind_adjoint(py::module_& m) {
         out["pair_bounce_steps"] = g.pair_bounce_steps;
         out["pair_projected_steps"] = g.pair_projected_steps;
         out["newton_unconverged_steps"] = g.newton_unconverged_steps;
+        out["forward_residual"] = g.forward_residual;
         out["backward_solver"] = g.backward_solver;
         out["backward_iterations"] = g.backward_iterations;
         out["forward_seconds"] = g.forward_seconds;

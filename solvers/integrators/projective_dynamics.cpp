@@ -293,6 +293,12 @@ StepResult ProjectiveDynamics::solve() {
   return StepResult::success();
 }
 
+LinearResult ProjectiveDynamics::solve_with_factor(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
+  if (!solver_ || h_ == 0)
+    return LinearResult::failure(LinearStatus::kInvalidInput, "projective_dynamics: no factor yet");
+  return solver_->solve_columns(b, x);
+}
+
 StepResult ProjectiveDynamics::do_step(const Dynamics& dynamics, State& s, Real h) {
   const Model& model = dynamics.model();
   if (StepResult r = prepare(model, h); !r.ok) return r;

@@ -1,5 +1,6 @@
-"""jelly.gradient (the discrete adjoint of implicit_euler, docs/gradients.md) against central
-finite differences of the loss, and its messages for bad paths and shapes."""
+"""jelly.gradient (the discrete adjoints of implicit_euler and projective_dynamics,
+docs/gradients.md) against central finite differences of the loss, and its messages for bad paths
+and shapes."""
 
 import warnings
 
@@ -12,7 +13,7 @@ STEPS = 10
 DT = 1 / 60
 
 
-def cloth_scene(overrides=None):
+def cloth_scene(overrides=None, integrator=None):
     scene = {
         "bodies": [{
             "kind": "cloth", "name": "cloth", "nu": 5, "nv": 5, "size_u": 1, "size_v": 1,
@@ -23,7 +24,7 @@ def cloth_scene(overrides=None):
             "pins": [{"group": "corner_00"}, {"group": "corner_10"}]}],
         "gravity": [0, -9.8, 0],
         "terrains": [],
-        "integrator": {"name": "implicit_euler", "dt": DT},
+        "integrator": integrator or {"name": "implicit_euler", "dt": DT},
         "duration": STEPS * DT,
     }
     return jelly.Scene(scene, overrides or {})
@@ -207,3 +208,34 @@ def test_contact_between_bodies_agrees_with_finite_differences():
             (path, grads[path], expected)
     expected = fd(lambda e: {"bodies[1].velocity": [0.1 + e, -0.05, 0]}, 1e-7)
     assert abs(grads["bodies[1].velocity"][0] - expected) <= 1e-5 * abs(expected)
+
+
+# projective_dynamics run to convergence (the adjoint is of its fixed point).
+PD = {"name": "projective_dynamics", "dt": DT, "options": {"iterations": 600}}
+
+
+def test_projective_dynamics_agrees_with_finite_differences():
+    scene = cloth_scene(integrator=PD)
+    pin = driven_pin(scene)
+    base = targets(scene)
+    wrt = ["bodies[0].springs.structural.ks", "bodies[0].mass", "pin_targets"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # converged: no warning
+        L, grads = jelly.gradient(scene, STEPS * DT, loss, wrt, pins=[pin], pin_targets=base)
+    assert np.isclose(L, value(scene, base), rtol=1e-14)
+    fixed = lambda e: base  # noqa: E731
+    fd_ks = central(lambda e: cloth_scene({"bodies[0].springs.structural.ks": 300 + e}, PD),
+                    fixed, 1e-4)
+    assert abs(float(grads[wrt[0]]) - fd_ks) <= 1e-5 * abs(fd_ks)
+    fd_mass = central(lambda e: cloth_scene({"bodies[0].particle_mass": 0.05 + e}, PD), fixed,
+                      1e-8)
+    assert abs(float(grads[wrt[1]]) - fd_mass) <= 1e-5 * abs(fd_mass)
+    direction = np.random.default_rng(5).uniform(-1, 1, base.shape)
+    fd_targets = central(lambda e: scene, lambda e: base + e * direction, 1e-6)
+    adjoint = float((grads["pin_targets"] * direction).sum())
+    assert abs(adjoint - fd_targets) <= 1e-5 * abs(fd_targets)
+    # A few iterations stop short of the fixed point: the gradient says so.
+    short = cloth_scene(integrator={"name": "projective_dynamics", "dt": DT,
+                                    "options": {"iterations": 3}})
+    with pytest.warns(UserWarning, match="converged steps"):
+        jelly.gradient(short, STEPS * DT, loss, wrt[:1], pins=[pin], pin_targets=base)

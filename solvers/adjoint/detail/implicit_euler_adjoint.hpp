@@ -70,9 +70,13 @@ struct GradientResult {
   // newton_iterations > 1: steps whose Newton iterations stopped above the tolerance (the
   // adjoint is of the converged step, so it is approximate there).
   long newton_unconverged_steps = 0;
+  // projective_dynamics: the largest ratio over the steps of the residual at the step's last
+  // iterate to its first (the gradient is of the converged steps; near 0 when they converged).
+  Real forward_residual = 0;
   // "cholmod", "ldlt", "cg_jacobi", "cg_lagged_cholmod", "cg_jacobi_matrix_free" or (Newton)
   // "sparse_lu" (assembled, up to 1000 unknowns), "bicgstab_jacobi" (assembled, above),
-  // "bicgstab_block_jacobi_matrix_free" (after a matrix-free forward)
+  // "bicgstab_block_jacobi_matrix_free" (after a matrix-free forward); projective_dynamics:
+  // "bicgstab_pd_prefactored"
   std::string backward_solver;
   // The iterations of the matrix-free backward solves (CG, BiCGSTAB), summed over the steps.
   long backward_iterations = 0;

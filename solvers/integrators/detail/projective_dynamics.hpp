@@ -13,10 +13,11 @@
 #include <memory>
 #include <vector>
 
-#include <jelly/core/force.hpp>
 #include <jelly/core/detail/sparse_matrix.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
 #include <jelly/solvers/integrators/integrator_options.hpp>
+#include <jelly/solvers/linear/detail/linear_solver.hpp>
 
 namespace jelly {
 
@@ -55,6 +56,9 @@ class ProjectiveDynamics final : public Integrator {
   const std::vector<Real>& last_residuals() const { return residuals_; }
   // The spectral radius the acceleration uses (the option, or the measured one; 0 before).
   Real chebyshev_rho() const { return rho_; }
+  // x = P^-1 b (N x 3) with the factor of the last step, P = A plus the penalties it held (the
+  // pins'): the preconditioner of projective_dynamics' adjoint. Fails before the first step.
+  LinearResult solve_with_factor(const Eigen::MatrixXd& b, Eigen::MatrixXd& x);
 
  protected:
   StepResult do_step(const Dynamics& dynamics, State& state, Real h) override;
