@@ -567,8 +567,8 @@ std::string FitResult::report() const {
         << restart_velocities.front().size() << " unknowns\n";
   }
   if (gradient_path == "adjoint") {
-    out << "derivatives: adjoint (exact gradients of implicit_euler, " << adjoint_passes
-        << " adjoint window passes; Ceres line search, BFGS)\n";
+    out << "derivatives: adjoint (exact gradients of " << adjoint_integrator << ", "
+        << adjoint_passes << " adjoint window passes; Ceres line search, BFGS)\n";
   } else {
     out << "derivatives: numeric (central differences of replays, Levenberg-Marquardt): "
         << gradient_reason << "\n";
@@ -670,6 +670,7 @@ bool fit_with_adjoint(const Trajectory& trajectory, const FitOptions& options,
   ceres::Solve(solver, problem, log_k.data(), &summary);
   if (!function->refused.empty()) return refuse(function->refused + " (during the fit)");
   result.gradient_path = "adjoint";
+  result.adjoint_integrator = trajectory.integrator;
   result.adjoint_passes = function->passes;
   take_summary(summary, log_k, result);
   const auto covariance_start = std::chrono::steady_clock::now();

@@ -173,6 +173,9 @@ struct FitResult {
   std::string gradient_path;
   std::string gradient_reason;  // why the numeric path was taken, or empty
   long adjoint_passes = 0;      // window replays differentiated by the adjoint (forward + backward)
+  // The integrator whose adjoint gave the gradients (the recording's), when gradient_path is
+  // "adjoint".
+  std::string adjoint_integrator;
   // The fitted initial velocity of each window (fit_restart_velocities), else empty.
   std::vector<VecX> restart_velocities;
   long replays = 0;             // window replays (each one simulation of a window)
