@@ -10,7 +10,7 @@
 #include <jelly/core/errors.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/viewer/exports.hpp>
+#include <jelly/viewer/detail/exports.hpp>
 #ifdef JELLY_HAVE_RENDER
 #include <jelly/viewer/render_video.hpp>
 #include <jelly/viewer/video_writer.hpp>

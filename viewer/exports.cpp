@@ -1,4 +1,4 @@
-#include <jelly/viewer/exports.hpp>
+#include <jelly/viewer/detail/exports.hpp>
 
 #include <algorithm>
 #include <cstdio>

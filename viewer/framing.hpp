@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 
 #include <jelly/core/types.hpp>
-#include <jelly/solvers/contact/detail/contact_solver.hpp>
+#include <jelly/terrain/terrain.hpp>
 #include <jelly/viewer/camera.hpp>
 
 namespace jelly::viewer {

@@ -7,7 +7,7 @@
 // would copy the triangles once per frame and give importers one object per frame. Morph
 // targets import as one object whose shape keys (Blender 3.4), morphTargetInfluences (three.js)
 // or blend shapes (Godot 4) play the animation. docs/output.md says what was checked.
-#include <jelly/viewer/exports.hpp>
+#include <jelly/viewer/detail/exports.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -13,7 +13,7 @@
 #include <jelly/core/model.hpp>
 #include <jelly/geometry/triangle_mesh.hpp>
 #include <jelly/io/recording.hpp>
-#include <jelly/solvers/contact/detail/contact_solver.hpp>
+#include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain.hpp>
 
 namespace jelly::viewer {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include <jelly/core/model.hpp>
-#include <jelly/solvers/contact/detail/contact_solver.hpp>
+#include <jelly/terrain/terrain.hpp>
 #include <jelly/viewer/render_scene.hpp>
 #include <jelly/viewer/scene_adapter.hpp>
 

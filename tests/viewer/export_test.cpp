@@ -16,7 +16,7 @@
 #include <jelly/io/h5_recorder.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/io/scene.hpp>
-#include <jelly/viewer/exports.hpp>
+#include <jelly/viewer/detail/exports.hpp>
 #include <jelly/viewer/scene_adapter.hpp>
 
 #ifdef JELLY_WITH_TINYGLTF

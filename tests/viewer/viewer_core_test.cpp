@@ -19,7 +19,7 @@
 #include <jelly/io/scene.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/viewer/camera.hpp>
-#include <jelly/viewer/exports.hpp>
+#include <jelly/viewer/detail/exports.hpp>
 #include <jelly/viewer/live_simulation.hpp>
 #include <jelly/viewer/recording_view.hpp>
 #include <jelly/viewer/scene_adapter.hpp>
