@@ -4,9 +4,13 @@
 Runs each integrator on cubes (n = 20, 40), a cloth and a tetrahedral body (a TetGen grid written
 to a temporary folder) for three steps without a recording, reads the peak resident size from
 `/usr/bin/time -f %M`, and the estimate from the message `jelly run` gives with max_particles = 1.
-Prints a Markdown table (docs/scenes.md, "How close the memory estimate is", shows part of it).
+Prints a Markdown table; with --out DIR it also writes DIR/memory_estimate/table.csv (one row
+per integrator, a column "peak / estimate (MB)" per case, with the date, machine and load:
+scripts/bench_csv.py), which scripts/bench_page.py renders into docs/scenes.md ("How close the
+memory estimate is").
 
   scripts/memory_figures.py --jelly build/cli/jelly [--integrators rk4,xpbd] [--cases cube20]
+                            [--out docs/bench]
 """
 import argparse
 import os
@@ -16,6 +20,8 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_csv import MeasuredTable  # noqa: E402
 INTEGRATORS = ["explicit_euler", "symplectic_euler", "midpoint", "rk4", "xpbd", "arkode_erk",
                "implicit_euler", "projective_dynamics", "arkode_dirk"]
 
@@ -68,6 +74,11 @@ def cases(folder):
     return out
 
 
+# The column headings of the table --out writes.
+CASE_NAMES = {"cube20": "cube n = 20", "cube40": "cube n = 40", "cloth200": "cloth 200 x 200",
+              "tet20": "tet mesh 20^3", "tet40": "tet mesh 40^3"}
+
+
 def estimate(jelly, scene, extra, integrator):
     r = subprocess.run([jelly, "run", scene, "-q", "--integrator", integrator,
                         "--set", "max_particles=1"] + extra, capture_output=True, text=True)
@@ -91,8 +102,16 @@ def main():
     ap.add_argument("--jelly", default=os.path.join(ROOT, "build", "cli", "jelly"))
     ap.add_argument("--integrators", default=",".join(INTEGRATORS))
     ap.add_argument("--cases", default="cube20,cube40,cloth200,tet20,tet40")
+    ap.add_argument("--out", help="also write OUT/memory_estimate/table.csv")
     args = ap.parse_args()
     print(f"load average: {os.getloadavg()[0]:.1f}", file=sys.stderr)
+    version = subprocess.run([args.jelly, "--version"], capture_output=True, text=True)
+    table = MeasuredTable(
+        "memory_estimate",
+        "peak resident size of `jelly run` (3 steps at dt = 1 ms, no recording, /usr/bin/time "
+        "-f %M) against the run-limit estimate, MB, each integrator's default options",
+        version.stdout.split()[-1] if version.returncode == 0 and version.stdout else None)
+    cells = {}
     with tempfile.TemporaryDirectory() as folder:
         all_cases = cases(folder)
         print("| integrator | body | particles | measured peak, MB | estimate, MB | estimate / peak |")
@@ -103,9 +122,17 @@ def main():
                 n, est = estimate(args.jelly, scene, extra, integrator)
                 measured, rc = peak(args.jelly, scene, extra, integrator)
                 note = "" if rc == 0 else f" (exit {rc})"
+                cells[(integrator, name)] = f"{measured / 1e6:.0f}{note} / {est / 1e6:.0f}"
                 print(f"| {integrator} | {name} | {n} | {measured / 1e6:.0f}{note} | "
                       f"{est / 1e6:.0f} | {est / measured:.2f} |", flush=True)
     print(f"load average: {os.getloadavg()[0]:.1f}", file=sys.stderr)
+    if args.out:
+        names = args.cases.split(",")
+        header = ["integrator"] + [f"{CASE_NAMES.get(n, n)}: peak / estimate (MB)"
+                                   for n in names]
+        rows = [[f"`{i}`"] + [cells[(i, n)] for n in names]
+                for i in args.integrators.split(",")]
+        print(table.write(args.out, header, rows), file=sys.stderr)
 
 
 if __name__ == "__main__":
