@@ -57,6 +57,41 @@ function(jelly_precompile_headers target)
   endif()
 endfunction()
 
+# jelly_precompile_layers(component): the rule above for a component compiled by layer
+# (cmake/JellyLayers.cmake), counted over all its sources: its first layer's objects precompile
+# the headers and its other layers reuse them (same definitions and options; only the include
+# root differs, which the third-party headers do not read): one header per component, as before.
+function(jelly_precompile_layers target)
+  if(NOT JELLY_PRECOMPILE_HEADERS)
+    return()
+  endif()
+  get_target_property(layers ${target} JELLY_LAYER_TARGETS)
+  if(NOT layers)  # a component of one layer, compiled as itself
+    jelly_precompile_headers(${target})
+    return()
+  endif()
+  set(source_count 0)
+  foreach(layer IN LISTS layers)
+    get_target_property(sources ${layer} SOURCES)
+    list(LENGTH sources count)
+    math(EXPR source_count "${source_count} + ${count}")
+  endforeach()
+  math(EXPR two_units "2 * ${CMAKE_UNITY_BUILD_BATCH_SIZE}")
+  if(JELLY_UNITY_BUILD AND source_count LESS_EQUAL two_units)
+    return()
+  endif()
+  list(POP_FRONT layers first)
+  target_precompile_headers(${first} PRIVATE ${JELLY_PCH_HEADERS})
+  foreach(layer IN LISTS layers)
+    target_precompile_headers(${layer} REUSE_FROM ${first})
+  endforeach()
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    foreach(layer IN ITEMS ${first} ${layers})
+      target_compile_options(${layer} PRIVATE "SHELL:-Xclang -fno-pch-timestamp")
+    endforeach()
+  endif()
+endfunction()
+
 # ccache caches compiles that use a precompiled header only with this sloppiness (ccache's
 # manual, "Precompiled headers"); without it every such compile is a miss.
 # Only C++ sources use them (the project has no C sources).
