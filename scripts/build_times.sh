@@ -18,6 +18,10 @@ combos="U1P1 U0P0 U1P0 U0P1"
 jobs=2
 targets="jelly_core jelly_io"
 touched="core/model.cpp io/scene.cpp"
+if [[ ${1:-} == --help || ${1:-} == -h ]]; then
+  sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'
+  exit 0
+fi
 while [[ $# -gt 1 ]]; do
   case $1 in
     --rounds) rounds=$2; shift 2 ;;
