@@ -34,8 +34,8 @@ set(JELLY_PCH_HEADERS
 # In a unity build (JELLY_UNITY_BUILD) a target of at most two units (16 sources) gets none: its
 # header would cost more than it saves (measured from nothing on 2 cores: the small test
 # programs, the CLI, jelly-bench's library, the viewer's core and the Python module compiled
-# faster without; the library and the solver tests slower). Call it after the target's sources
-# are all added.
+# faster without; the solver tests slower). The library's components follow
+# jelly_precompile_layers below. Call it after the target's sources are all added.
 function(jelly_precompile_headers target)
   if(NOT JELLY_PRECOMPILE_HEADERS)
     return()
@@ -54,6 +54,34 @@ function(jelly_precompile_headers target)
   # the cache filled from another build directory; its .pch may hold that directory's path.)
   if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
     target_compile_options(${target} PRIVATE "SHELL:-Xclang -fno-pch-timestamp")
+  endif()
+endfunction()
+
+# jelly_precompile_layers(component): a component of the library (compiled by layer,
+# cmake/JellyLayers.cmake) gets precompiled headers only without unity builds: measured from
+# nothing on 2 cores (docs/CONTRIBUTING.md, "Build times"), they save CPU when each source is its
+# own unit and cost more than they save once sources are compiled 8 to a unit, now that
+# jelly's headers no longer bring nlohmann's JSON everywhere. Its first layer's objects then
+# precompile the headers and its other layers reuse them (same definitions and options; only the
+# include root differs, which the third-party headers do not read): one header per component.
+function(jelly_precompile_layers target)
+  if(NOT JELLY_PRECOMPILE_HEADERS OR JELLY_UNITY_BUILD)
+    return()
+  endif()
+  get_target_property(layers ${target} JELLY_LAYER_TARGETS)
+  if(NOT layers)  # a component of one layer, compiled as itself
+    jelly_precompile_headers(${target})
+    return()
+  endif()
+  list(POP_FRONT layers first)
+  target_precompile_headers(${first} PRIVATE ${JELLY_PCH_HEADERS})
+  foreach(layer IN LISTS layers)
+    target_precompile_headers(${layer} REUSE_FROM ${first})
+  endforeach()
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    foreach(layer IN ITEMS ${first} ${layers})
+      target_compile_options(${layer} PRIVATE "SHELL:-Xclang -fno-pch-timestamp")
+    endforeach()
   endif()
 endfunction()
 

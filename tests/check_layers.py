@@ -14,6 +14,12 @@ layers to its left (a detail/ header counts as its module's):
     check_layers.py --self-test              both checks catch violations in a temporary tree
 
 Exit status 0 when clean, 1 with one line per violation on stderr.
+
+The build enforces the layers on what it compiles (cmake/JellyLayers.cmake: each layer's
+sources and public headers see only their layer and those to its left; the ctest
+jelly_layers_compile proves it). This scan still covers what the compiler cannot see: an
+internal header that reaches up but is included only by higher layers, the programs' folders,
+jelly/ paths naming no module and quoted includes relative to the including file.
 """
 import argparse
 import os
