@@ -86,9 +86,9 @@ namespace jelly {
 
 struct AnchorSpring {
   int particle = 0;
-  Vec3 target = Vec3::Zero();  // m
-  Real stiffness = 0;          // k, N/m, >= 0
-  Real damping = 0;            // c, N s/m, >= 0, on the particle's own velocity
+  Vec3 target{0, 0, 0};  // m
+  Real stiffness = 0;    // k, N/m, >= 0
+  Real damping = 0;      // c, N s/m, >= 0, on the particle's own velocity
 };
 using AnchorSprings = std::vector<AnchorSpring>;
 

@@ -63,9 +63,9 @@ namespace jelly {
 enum class PathKind { kFixed, kPhases, kKeyframes, kOscillation, kCircle, kLinear };
 
 struct PathSample {
-  Vec3 offset = Vec3::Zero();
-  Vec3 velocity = Vec3::Zero();
-  Vec3 acceleration = Vec3::Zero();
+  Vec3 offset{0, 0, 0};
+  Vec3 velocity{0, 0, 0};
+  Vec3 acceleration{0, 0, 0};
 };
 
 class Path {
@@ -123,19 +123,19 @@ class Path {
   PathSample sample_cubic(Real t) const;
 
   PathKind kind_ = PathKind::kFixed;
-  Vec3 axis_ = Vec3::UnitY();
+  Vec3 axis_{0, 1, 0};
   ElevatorMotion cycle_;
   std::vector<Real> times_;
   std::vector<Vec3> offsets_;
-  Vec3 amplitude_ = Vec3::Zero();
+  Vec3 amplitude_{0, 0, 0};
   Real frequency_ = 0, phase_ = 0;
-  bool cubic_ = false;                          // keyframes: cubic Hermite segments
-  bool added_start_ = false;                    // cubic: (0, 0) was put before the first keyframe
-  std::vector<Vec3> tangents_;                  // cubic keyframes: velocity at each keyframe
-  Vec3 center_ = Vec3::Zero();                  // circle: centre relative to the start
-  Vec3 e1_ = Vec3::Zero(), e2_ = Vec3::Zero();  // circle: -center and axis x (-center)
+  bool cubic_ = false;              // keyframes: cubic Hermite segments
+  bool added_start_ = false;        // cubic: (0, 0) was put before the first keyframe
+  std::vector<Vec3> tangents_;      // cubic keyframes: velocity at each keyframe
+  Vec3 center_{0, 0, 0};            // circle: centre relative to the start
+  Vec3 e1_{0, 0, 0}, e2_{0, 0, 0};  // circle: -center and axis x (-center)
   Real period_ = 0;
-  Vec3 velocity_ = Vec3::Zero();  // linear
+  Vec3 velocity_{0, 0, 0};  // linear
 };
 
 std::string_view path_kind_name(PathKind kind);

@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include <jelly/core/model.hpp>
 #include <jelly/core/json_fwd.hpp>
+#include <jelly/core/model.hpp>
 
 // A lattice body: particles at the occupied points of a regular grid, joined by the seed's
 // springs (structural to the axis neighbours, shear along the face and body diagonals of each
@@ -33,8 +33,8 @@ struct Material {
 
 struct LatticeGrid {
   std::array<int, 3> n{2, 2, 2};  // points along the grid's x, y, z
-  Vec3 spacing = Vec3::Ones();    // m between neighbouring points along each axis
-  Vec3 origin = Vec3::Zero();     // position of point (0, 0, 0)
+  Vec3 spacing{1, 1, 1};          // m between neighbouring points along each axis
+  Vec3 origin{0, 0, 0};           // position of point (0, 0, 0)
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // the grid's axes in the world
   // One flag per point, index (i n_y + j) n_z + k; empty = every point occupied.
   std::vector<char> occupied;

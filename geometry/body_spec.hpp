@@ -5,13 +5,28 @@
 #include <string>
 #include <vector>
 
-#include <jelly/core/model.hpp>
 #include <jelly/core/json_fwd.hpp>
+#include <jelly/core/model.hpp>
 #include <jelly/core/pins.hpp>
 #include <jelly/core/polymorphic_value.hpp>
 #include <jelly/geometry/body_shape.hpp>
 
 namespace jelly {
+
+// An axis-aligned box: the points p with min() <= p <= max() in every coordinate (what
+// Eigen::AlignedBox3d holds, kept here so that public headers need no <Eigen/Geometry>).
+class Box3 {
+ public:
+  Box3() = default;
+  Box3(const Vec3& min, const Vec3& max) : min_(min), max_(max) {}
+  const Vec3& min() const { return min_; }
+  const Vec3& max() const { return max_; }
+  bool contains(const Vec3& p) const;
+
+ private:
+  Vec3 min_{0, 0, 0};
+  Vec3 max_{0, 0, 0};
+};
 
 // Particles of a body chosen by body-local index, by a box region of the rest pose (world
 // coordinates) and/or by a named group of the body (a mesh's vertex group, a cloth corner);
@@ -19,7 +34,7 @@ namespace jelly {
 struct ParticleSelection {
   std::vector<int> indices;
   bool has_region = false;
-  Eigen::AlignedBox3d region;
+  Box3 region;
   std::string group;
 
   bool selects_all() const { return indices.empty() && !has_region && group.empty(); }
@@ -39,7 +54,7 @@ struct PinSpec {
 struct ExternalForceSpec {
   ExternalForceKind kind = ExternalForceKind::kConstant;
   ParticleSelection select;
-  Vec3 vector = Vec3::Zero();  // "force" (N) or, for wind, "velocity" (m/s)
+  Vec3 vector{0, 0, 0};  // "force" (N) or, for wind, "velocity" (m/s)
   Real drag = 0, gust = 0, gust_frequency = 0, start = 0;
   Real end = std::numeric_limits<Real>::infinity();
 };
@@ -52,8 +67,8 @@ struct BodySpec {
   // The distance its particles keep from terrains and obstacles (m); none = the contact radius
   // for a cloth, 0 for a body with volume.
   std::optional<Real> thickness;
-  Vec3 velocity = Vec3::Zero();          // m/s at the start, every particle
-  Vec3 angular_velocity = Vec3::Zero();  // rad/s at the start, about the centre of mass
+  Vec3 velocity{0, 0, 0};          // m/s at the start, every particle
+  Vec3 angular_velocity{0, 0, 0};  // rad/s at the start, about the centre of mass
   std::vector<PinSpec> pins;
   std::vector<ExternalForceSpec> forces;
   std::optional<Vec3> color;  // sRGB [r, g, b] in [0, 1]; none = the viewer's palette

@@ -15,7 +15,7 @@ struct TriangleMesh {
 
   int num_vertices() const { return static_cast<int>(vertices.size()); }
   int num_triangles() const { return static_cast<int>(triangles.size()); }
-  Eigen::AlignedBox3d bounds() const;
+  Eigen::AlignedBox<Real, 3> bounds() const;  // Eigen::AlignedBox3d (<Eigen/Geometry>)
   // The surface's area, and the volume it encloses (divergence theorem: the sum of
   // a . (b x c) / 6 over the triangles; negative when they face inwards).
   Real area() const;

@@ -14,8 +14,8 @@
 #include <jelly/core/state.hpp>
 #include <jelly/solvers/contact/body_contact_params.hpp>
 #include <jelly/solvers/contact/terrain_contact_model.hpp>
-#include <jelly/solvers/run_report.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
+#include <jelly/solvers/run_report.hpp>
 
 namespace jelly {
 
@@ -122,7 +122,7 @@ struct SimulatorOptions {
 struct ModelValues {
   std::vector<Real> ks, kd;  // [M] per spring
   VecX mass;                 // [N]
-  Vec3 gravity = Vec3::Zero();
+  Vec3 gravity{0, 0, 0};
   Pins pins;
 };
 
@@ -201,7 +201,7 @@ class Simulator {
   // Drives pinned particle `particle` from now on: at time t >= now it is at
   // position + velocity (t - now) (the controller's target for the next steps). Throws
   // InputError when the particle is not pinned or a value is not finite.
-  void set_pin_target(int particle, const Vec3& position, const Vec3& velocity = Vec3::Zero());
+  void set_pin_target(int particle, const Vec3& position, const Vec3& velocity = Vec3(0, 0, 0));
   // Frees a pinned particle; false when it was not pinned.
   bool remove_pin(int particle);
   // Contact between bodies and within a body (default: between bodies, when there are two or

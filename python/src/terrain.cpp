@@ -1,10 +1,12 @@
 // terrain/: obstacles (plane, slope, elevator, and every kind of the registry from its scene
 // JSON) and their contact parameters. A Simulator takes a copy of a Plane or an Elevator, or
 // builds any kind from its spec (Simulator.add_terrain); scenes name terrains in their JSON.
+#include <Eigen/Geometry>
+
 #include <jelly/core/detail/json.hpp>
 #include <jelly/terrain/detail/contact_fields.hpp>
-#include <jelly/terrain/detail/terrain_fields.hpp>
 #include <jelly/terrain/detail/elevator.hpp>
+#include <jelly/terrain/detail/terrain_fields.hpp>
 #include <jelly/terrain/plane.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
