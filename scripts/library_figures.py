@@ -17,6 +17,7 @@ measuring is printed with the table. Exit status 1 when a measurement could not 
 import argparse
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -68,15 +69,20 @@ def umbrella_lines(tree, work):
     return out.count("\n"), nlohmann
 
 
+def children_cpu():
+    """CPU seconds (user + system) of the finished child processes, to the microsecond
+    (os.times() counts clock ticks of 10 ms)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def timed(command, **kwargs):
     """Runs command; (wall seconds, CPU seconds: user + system of the child)."""
-    before = os.times()
+    before = children_cpu()
     start = time.perf_counter()
     run(command, **kwargs)
     wall = time.perf_counter() - start
-    after = os.times()
-    return wall, (after.children_user - before.children_user) + (after.children_system -
-                                                                 before.children_system)
+    return wall, children_cpu() - before
 
 
 def umbrella_cpu(tree, work):
@@ -146,9 +152,11 @@ def alternate(measures, trees, work, repeat):
         for names, measure in measures:
             for index, tree in enumerate(trees):
                 values = measure(tree, work)
-                if not isinstance(names, tuple):
-                    names, values = (names,), (values,)
-                for name, value in zip(names, values):
+                if isinstance(names, tuple):
+                    pairs = zip(names, values)
+                else:
+                    pairs = [(names, values)]
+                for name, value in pairs:
                     results[name][index].append(value)
     return {name: [statistics.median(v) for v in values] for name, values in results.items()}
 
@@ -199,7 +207,8 @@ def main():
             print(f"library_figures: a measurement failed: {e}\n{detail}", file=sys.stderr)
             return 1
     for name, values in medians.items():
-        rows.append((name + f" (median of {args.repeat})", [f"{v:.3f}" for v in values]))
+        digits = 4 if ": CPU, s" in name else 3
+        rows.append((name + f" (median of {args.repeat})", [f"{v:.{digits}f}" for v in values]))
 
     header = ["", *names] + (["ratio"] if len(trees) == 2 else [])
     print("| " + " | ".join(header) + " |")
