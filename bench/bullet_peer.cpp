@@ -15,6 +15,7 @@
 //  * terrains: a sphere is a static btSphereShape, a plane a static box whose top face is the
 //    plane (Bullet's soft-rigid collision takes convex shapes); the soft body's collision margin
 //    is a quarter of its smallest rest length.
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <iostream>

@@ -1,6 +1,7 @@
 // Micro-benchmarks of the mesh bodies: voxelizing a 100,000-triangle mesh (winding-number tree,
 // inside test of every lattice point, the whole body with its embedded surface), building the
 // springs of a 100,000-tet mesh, and reading both kinds of file.
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>

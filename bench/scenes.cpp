@@ -1,5 +1,6 @@
 #include <jelly/bench/scenes.hpp>
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include <jelly/core/errors.hpp>

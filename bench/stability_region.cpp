@@ -1,5 +1,6 @@
 #include <jelly/bench/stability_region.hpp>
 
+#include <Eigen/LU>
 #include <cmath>
 #include <complex>
 #include <vector>

@@ -1,5 +1,6 @@
 // jelly mesh IN.stl -o OUT.msh [--size h]: fills a closed surface with tetrahedra (Gmsh) for the
 // tetmesh body kind.
+#include <Eigen/Geometry>
 #include <cstdio>
 #include <filesystem>
 

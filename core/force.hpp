@@ -94,10 +94,10 @@ namespace jelly {
 
 // A spring from particle `particle` to a point in space (the viewer's drag).
 struct AnchorSpring {
-  int particle = 0;            // the particle pulled
-  Vec3 target = Vec3::Zero();  // m
-  Real stiffness = 0;          // k, N/m, >= 0
-  Real damping = 0;            // c, N s/m, >= 0, on the particle's own velocity
+  int particle = 0;      // the particle pulled
+  Vec3 target{0, 0, 0};  // m
+  Real stiffness = 0;    // k, N/m, >= 0
+  Real damping = 0;      // c, N s/m, >= 0, on the particle's own velocity
 };
 using AnchorSprings = std::vector<AnchorSpring>;  // the anchor springs of a simulator
 

@@ -1,5 +1,6 @@
 #include <jelly/core/measures.hpp>
 
+#include <Eigen/Geometry>
 #include <array>
 #include <vector>
 

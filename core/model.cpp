@@ -1,5 +1,6 @@
 #include <jelly/core/model.hpp>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <string>
 

@@ -145,11 +145,11 @@ struct Body {
   Real thickness = 0;
   // The body's motion at the start (initial_state): every particle moves with
   // velocity + angular_velocity x (x - c), c the body's centre of mass at rest.
-  Vec3 velocity = Vec3::Zero();          // m/s
-  Vec3 angular_velocity = Vec3::Zero();  // rad/s
-  Surface surface;                       // global particle indices
-  std::vector<ParticleGroup> groups;     // global particle indices
-  VolumeElements volume;                 // global particle indices
+  Vec3 velocity{0, 0, 0};             // m/s
+  Vec3 angular_velocity{0, 0, 0};     // rad/s
+  Surface surface;                    // global particle indices
+  std::vector<ParticleGroup> groups;  // global particle indices
+  VolumeElements volume;              // global particle indices
   // Its colour in pictures and exports: sRGB [r, g, b], each in [0, 1]; none = the viewer's
   // palette by body index.
   std::optional<Vec3> color;
@@ -187,11 +187,11 @@ ExternalForceKind external_force_kind_from_name(std::string_view name, std::stri
 struct ExternalForce {
   ExternalForceKind kind = ExternalForceKind::kConstant;  // constant, wind or point
   std::vector<int> particles;                             // global particle indices it acts on
-  Vec3 vector = Vec3::Zero();  // force (N) or, for wind, air velocity (m/s)
-  Real drag = 0;               // wind: N s/m per particle, >= 0
-  Real gust = 0;               // vector(t) = vector (1 + gust sin(2 pi gust_frequency t))
-  Real gust_frequency = 0;     // Hz, >= 0
-  Real start = 0;              // acts for start <= t < end
+  Vec3 vector{0, 0, 0};     // force (N) or, for wind, air velocity (m/s)
+  Real drag = 0;            // wind: N s/m per particle, >= 0
+  Real gust = 0;            // vector(t) = vector (1 + gust sin(2 pi gust_frequency t))
+  Real gust_frequency = 0;  // Hz, >= 0
+  Real start = 0;           // acts for start <= t < end
   Real end = std::numeric_limits<Real>::infinity();  // s
 
   Vec3 vector_at(Real t) const;  // `vector` with the gust factor at time t

@@ -1,5 +1,6 @@
 #include <jelly/core/pins.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <string>

@@ -68,9 +68,9 @@ enum class PathKind { kFixed, kPhases, kKeyframes, kOscillation, kCircle, kLinea
 
 // A path's offset, velocity and acceleration at one time.
 struct PathSample {
-  Vec3 offset = Vec3::Zero();        // m, from where the path starts
-  Vec3 velocity = Vec3::Zero();      // m/s
-  Vec3 acceleration = Vec3::Zero();  // m/s^2
+  Vec3 offset{0, 0, 0};        // m, from where the path starts
+  Vec3 velocity{0, 0, 0};      // m/s
+  Vec3 acceleration{0, 0, 0};  // m/s^2
 };
 
 // A prescribed translation as a function of time, offset(0) = 0: drives pins and moving obstacles.
@@ -130,19 +130,19 @@ class Path {
   PathSample sample_cubic(Real t) const;
 
   PathKind kind_ = PathKind::kFixed;
-  Vec3 axis_ = Vec3::UnitY();
+  Vec3 axis_{0, 1, 0};
   ElevatorMotion cycle_;
   std::vector<Real> times_;
   std::vector<Vec3> offsets_;
-  Vec3 amplitude_ = Vec3::Zero();
+  Vec3 amplitude_{0, 0, 0};
   Real frequency_ = 0, phase_ = 0;
-  bool cubic_ = false;                          // keyframes: cubic Hermite segments
-  bool added_start_ = false;                    // cubic: (0, 0) was put before the first keyframe
-  std::vector<Vec3> tangents_;                  // cubic keyframes: velocity at each keyframe
-  Vec3 center_ = Vec3::Zero();                  // circle: centre relative to the start
-  Vec3 e1_ = Vec3::Zero(), e2_ = Vec3::Zero();  // circle: -center and axis x (-center)
+  bool cubic_ = false;              // keyframes: cubic Hermite segments
+  bool added_start_ = false;        // cubic: (0, 0) was put before the first keyframe
+  std::vector<Vec3> tangents_;      // cubic keyframes: velocity at each keyframe
+  Vec3 center_{0, 0, 0};            // circle: centre relative to the start
+  Vec3 e1_{0, 0, 0}, e2_{0, 0, 0};  // circle: -center and axis x (-center)
   Real period_ = 0;
-  Vec3 velocity_ = Vec3::Zero();  // linear
+  Vec3 velocity_{0, 0, 0};  // linear
 };
 
 // "fixed", "phases", "keyframes", "oscillation", "circle", "linear".

@@ -1,7 +1,9 @@
 #pragma once
 // Scalar and vector types used throughout jelly: positions and velocities are flat 3N vectors.
+// Only <Eigen/Core>: public headers name Eigen's geometry types (AlignedBox, Transform) through
+// the forward declarations it holds; a source that uses them (or cross()) includes
+// <Eigen/Geometry> itself.
 #include <Eigen/Core>
-#include <Eigen/Geometry>
 
 namespace jelly {
 

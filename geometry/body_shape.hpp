@@ -35,8 +35,8 @@ struct Material {
 // A regular grid of points, some occupied: the lattice a cube, box or voxelized body is built on.
 struct LatticeGrid {
   std::array<int, 3> n{2, 2, 2};  // points along the grid's x, y, z
-  Vec3 spacing = Vec3::Ones();    // m between neighbouring points along each axis
-  Vec3 origin = Vec3::Zero();     // position of point (0, 0, 0)
+  Vec3 spacing{1, 1, 1};          // m between neighbouring points along each axis
+  Vec3 origin{0, 0, 0};           // position of point (0, 0, 0)
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // the grid's axes in the world
   // One flag per point, index (i n_y + j) n_z + k; empty = every point occupied.
   std::vector<char> occupied;

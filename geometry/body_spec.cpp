@@ -10,6 +10,10 @@
 
 namespace jelly {
 
+bool Box3::contains(const Vec3& p) const {
+  return (min_.array() <= p.array()).all() && (p.array() <= max_.array()).all();
+}
+
 namespace {
 
 constexpr const char* kSpringKeys[kSpringTypeCount] = {"structural", "shear", "bending"};
@@ -129,11 +133,11 @@ std::vector<Field<S>> selection_rows() {
           require((lo.array() <= hi.array()).all(), g.path("max"), hi.transpose(),
                   "a corner >= min in every coordinate");
           (s.*Select).has_region = true;
-          (s.*Select).region = Eigen::AlignedBox3d(lo, hi);
+          (s.*Select).region = Box3(lo, hi);
         }
       },
       [](const S& s, Json& j, std::string_view key) {
-        const Eigen::AlignedBox3d& r = (s.*Select).region;
+        const Box3& r = (s.*Select).region;
         j[std::string(key)] = {{"min", json_of(r.min())}, {"max", json_of(r.max())}};
       });
   region.is_default = [](const S& s) { return !(s.*Select).has_region; };

@@ -13,14 +13,31 @@
 
 namespace jelly {
 
+// An axis-aligned box: the points p with min() <= p <= max() in every coordinate (what
+// Eigen::AlignedBox3d holds, kept here so that public headers need no <Eigen/Geometry>).
+class Box3 {
+ public:
+  Box3() = default;
+  // The box from its lowest corner to its highest (m).
+  Box3(const Vec3& min, const Vec3& max) : min_(min), max_(max) {}
+  const Vec3& min() const { return min_; }  // the lowest corner
+  const Vec3& max() const { return max_; }  // the highest corner
+  // Whether p lies in the box, its faces included.
+  bool contains(const Vec3& p) const;
+
+ private:
+  Vec3 min_{0, 0, 0};
+  Vec3 max_{0, 0, 0};
+};
+
 // Particles of a body chosen by body-local index, by a box region of the rest pose (world
 // coordinates) and/or by a named group of the body (a mesh's vertex group, a cloth corner);
 // together: the union. Nothing chosen = every particle of the body.
 struct ParticleSelection {
-  std::vector<int> indices;    // body-local particle indices
-  bool has_region = false;     // true when `region` selects
-  Eigen::AlignedBox3d region;  // m, in the rest pose's world coordinates
-  std::string group;           // a named group of the body; empty: none
+  std::vector<int> indices;  // body-local particle indices
+  bool has_region = false;   // true when `region` selects
+  Box3 region;               // m, in the rest pose's world coordinates
+  std::string group;         // a named group of the body; empty: none
 
   // True when nothing is chosen: every particle of the body.
   bool selects_all() const { return indices.empty() && !has_region && group.empty(); }
@@ -43,11 +60,11 @@ struct PinSpec {
 struct ExternalForceSpec {
   ExternalForceKind kind = ExternalForceKind::kConstant;  // constant, wind or point
   ParticleSelection select;                               // the particles it acts on
-  Vec3 vector = Vec3::Zero();  // "force" (N) or, for wind, "velocity" (m/s)
-  Real drag = 0;               // wind: N s/m per particle
-  Real gust = 0;               // vector(t) = vector (1 + gust sin(2 pi gust_frequency t))
-  Real gust_frequency = 0;     // Hz
-  Real start = 0;              // s: acts for start <= t < end
+  Vec3 vector{0, 0, 0};     // "force" (N) or, for wind, "velocity" (m/s)
+  Real drag = 0;            // wind: N s/m per particle
+  Real gust = 0;            // vector(t) = vector (1 + gust sin(2 pi gust_frequency t))
+  Real gust_frequency = 0;  // Hz
+  Real start = 0;           // s: acts for start <= t < end
   Real end = std::numeric_limits<Real>::infinity();  // s
 };
 
@@ -61,8 +78,8 @@ struct BodySpec {
   // The distance its particles keep from terrains and obstacles (m); none = the contact radius
   // for a cloth, 0 for a body with volume.
   std::optional<Real> thickness;
-  Vec3 velocity = Vec3::Zero();           // m/s at the start, every particle
-  Vec3 angular_velocity = Vec3::Zero();   // rad/s at the start, about the centre of mass
+  Vec3 velocity{0, 0, 0};                 // m/s at the start, every particle
+  Vec3 angular_velocity{0, 0, 0};         // rad/s at the start, about the centre of mass
   std::vector<PinSpec> pins;              // pinned particles
   std::vector<ExternalForceSpec> forces;  // external forces
   std::optional<Vec3> color;              // sRGB [r, g, b] in [0, 1]; none = the viewer's palette

@@ -1,5 +1,6 @@
 #include <jelly/geometry/detail/mesh_io.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

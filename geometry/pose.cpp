@@ -1,5 +1,6 @@
 #include <jelly/geometry/detail/pose.hpp>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <string>
 

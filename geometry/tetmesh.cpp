@@ -1,5 +1,6 @@
 #include <jelly/geometry/detail/tetmesh.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
 #include <cmath>

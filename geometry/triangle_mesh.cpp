@@ -1,5 +1,6 @@
 #include <jelly/geometry/triangle_mesh.hpp>
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 namespace jelly {

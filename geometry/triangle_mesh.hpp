@@ -18,7 +18,8 @@ struct TriangleMesh {
   int num_vertices() const { return static_cast<int>(vertices.size()); }
   // The number of triangles.
   int num_triangles() const { return static_cast<int>(triangles.size()); }
-  Eigen::AlignedBox3d bounds() const;  // the box around the vertices
+  // The box around the vertices: an Eigen::AlignedBox3d (<Eigen/Geometry>).
+  Eigen::AlignedBox<Real, 3> bounds() const;
   // The surface's area, and the volume it encloses (divergence theorem: the sum of
   // a . (b x c) / 6 over the triangles; negative when they face inwards).
   Real area() const;

@@ -1,5 +1,6 @@
 #include <jelly/geometry/detail/voxelized.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
 #include <climits>

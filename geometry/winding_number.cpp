@@ -1,5 +1,6 @@
 #include <jelly/geometry/detail/winding_number.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <numeric>

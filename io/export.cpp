@@ -1,5 +1,6 @@
 #include <jelly/io/detail/export.hpp>
 
+#include <Eigen/Geometry>
 #include <cerrno>
 #include <cmath>
 #include <cstring>

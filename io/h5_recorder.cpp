@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>

@@ -8,8 +8,8 @@
 
 #include <jelly/core/errors.hpp>
 #include <jelly/io/detail/json_parse.hpp>
-#include <jelly/io/detail/scene_fields.hpp>
 #include <jelly/io/detail/memory_estimate.hpp>
+#include <jelly/io/detail/scene_fields.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 
 namespace jelly {
@@ -37,6 +37,8 @@ BodySpec cube_body(const CubeSpec& cube, const std::string& name) {
   b.material = cube.material();
   return b;
 }
+
+Scene::Scene() : bodies{seed_cube_body()} {}
 
 BodySpec Scene::seed_cube_body() { return cube_body(CubeSpec{}); }
 

@@ -31,7 +31,7 @@ struct Scene {
   std::string description;  // free text, not used by the solver
   // The bodies, in order (their particles follow each other in the model). A scene file
   // without "bodies" holds one cube named "jelly" described by its "cube" and "springs" keys.
-  std::vector<BodySpec> bodies{seed_cube_body()};
+  std::vector<BodySpec> bodies;                         // Scene(): {seed_cube_body()}
   Vec3 gravity{0, -9.8, 0};                             // m/s^2
   std::vector<PolymorphicValue<TerrainSpec>> terrains;  // terrains and obstacles, in order
   // Contact between bodies (and, with self_contact, within a body): docs/contact.md.
@@ -49,6 +49,10 @@ struct Scene {
   // Threads for the force loop, the solves and contact (0 = all cores); the results are the
   // same bit for bit for any number (docs/threads.md). `jelly run --threads` overrides it.
   int threads = 0;
+
+  // The defaults: one body, seed_cube_body(). Out of line, so that includers do not compile the
+  // list's construction.
+  Scene();
 
   // Throws InputError naming the JSON path of the first invalid field (e.g.
   // "terrains[0].contact.restitution"), its value and what is allowed.

@@ -1,6 +1,7 @@
 #include <jelly/io/h5_recorder.hpp>
 
 #include <unistd.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>

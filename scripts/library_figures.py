@@ -2,7 +2,10 @@
 """What linking and including jelly costs (docs/CONTRIBUTING.md, "The public API"), as a
 Markdown table: the installed headers, the umbrella header's preprocessed lines and compile CPU,
 the shared libraries libjelly (the core) and a program of the core alone load, the start-up of
-`jelly run` (one step of the seed scene) and of `import jelly`.
+`jelly run` (one step of the seed scene) and of `import jelly`, each in wall time and in CPU
+time (user + system: on a busy machine the wall time is mostly waiting for a core). The floors
+come last: a file of `#include <Eigen/Core>` alone and `python3 -c pass`, measured the same way
+(the same for both trees).
 
     library_figures.py [--build DIR] [--source DIR] [--before-build DIR --before-source DIR]
                        [--repeat 5]
@@ -14,6 +17,7 @@ measuring is printed with the table. Exit status 1 when a measurement could not 
 import argparse
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -21,6 +25,7 @@ import tempfile
 import time
 
 UMBRELLA_SOURCE = "#include <jelly/jelly.hpp>\nint main() { return 0; }\n"
+EIGEN_SOURCE = "#include <Eigen/Core>\nint main() { return 0; }\n"
 
 
 class Tree:
@@ -64,15 +69,36 @@ def umbrella_lines(tree, work):
     return out.count("\n"), nlohmann
 
 
+def children_cpu():
+    """CPU seconds (user + system) of the finished child processes, to the microsecond
+    (os.times() counts clock ticks of 10 ms)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def timed(command, **kwargs):
+    """Runs command; (wall seconds, CPU seconds: user + system of the child)."""
+    before = children_cpu()
+    start = time.perf_counter()
+    run(command, **kwargs)
+    wall = time.perf_counter() - start
+    return wall, children_cpu() - before
+
+
 def umbrella_cpu(tree, work):
     """CPU seconds (user + system) of `g++ -O2 -c` of a file that includes the umbrella."""
     source = os.path.join(work, "umbrella.cpp")
-    before = os.times()
-    run(["g++", "-std=c++17", "-O2", "-c", *tree.include_flags(), source, "-o",
-         os.path.join(work, "umbrella.o")])
-    after = os.times()
-    return (after.children_user - before.children_user) + (after.children_system -
-                                                           before.children_system)
+    return timed(["g++", "-std=c++17", "-O2", "-c", *tree.include_flags(), source, "-o",
+                  os.path.join(work, "umbrella.o")])[1]
+
+
+def eigen_core_cpu(tree, work):
+    """The floor of umbrella_cpu: a file of `#include <Eigen/Core>` alone."""
+    source = os.path.join(work, "eigen_core.cpp")
+    with open(source, "w", encoding="utf-8") as f:
+        f.write(EIGEN_SOURCE)
+    return timed(["g++", "-std=c++17", "-O2", "-c", *tree.include_flags(), source, "-o",
+                  os.path.join(work, "eigen_core.o")])[1]
 
 
 def linked_libraries(path):
@@ -100,27 +126,38 @@ def run_one_step(tree, work):
     scene = os.path.join(tree.source, "scenes", "seed_slope.json")
     # The tree's own libjelly, also for a program copied from another build tree.
     env = dict(os.environ, LD_LIBRARY_PATH=tree.build)
-    start = time.perf_counter()
-    run([tree.jelly(), "run", scene, "--duration", "0.001", "-o",
-         os.path.join(work, "one.h5"), "--overwrite"], env=env)
-    return time.perf_counter() - start
+    return timed([tree.jelly(), "run", scene, "--duration", "0.001", "-o",
+                  os.path.join(work, "one.h5"), "--overwrite"], env=env)
 
 
 def import_jelly(tree, work):
     env = dict(os.environ, PYTHONPATH=os.path.join(tree.build, "python"),
                LD_LIBRARY_PATH=tree.build)
-    start = time.perf_counter()
-    run([sys.executable, "-c", "import jelly"], env=env, cwd=work)
-    return time.perf_counter() - start
+    return timed([sys.executable, "-c", "import jelly"], env=env, cwd=work)
+
+
+def python_alone(tree, work):
+    """The floor of import_jelly: the interpreter's own start-up."""
+    return timed([sys.executable, "-c", "pass"], cwd=work)
 
 
 def alternate(measures, trees, work, repeat):
-    """{name: [median per tree]} for each timing, the trees taking turns run by run."""
-    results = {name: [[] for _ in trees] for name, _ in measures}
+    """{name: [median per tree]} for each timing, the trees taking turns run by run. A measure
+    with a tuple of names gives a tuple of values (wall and CPU of one run)."""
+    results = {}
+    for names, _ in measures:
+        for name in names if isinstance(names, tuple) else (names,):
+            results[name] = [[] for _ in trees]
     for _ in range(repeat):
-        for name, measure in measures:
+        for names, measure in measures:
             for index, tree in enumerate(trees):
-                results[name][index].append(measure(tree, work))
+                values = measure(tree, work)
+                if isinstance(names, tuple):
+                    pairs = zip(names, values)
+                else:
+                    pairs = [(names, values)]
+                for name, value in pairs:
+                    results[name][index].append(value)
     return {name: [statistics.median(v) for v in values] for name, values in results.items()}
 
 
@@ -155,16 +192,23 @@ def main():
             rows.append(("a program of the core alone: shared libraries loaded (ldd)",
                          [str(core_program_libraries(t, work)) for t in trees]))
             timings = [("umbrella: compile CPU (g++ -O2), s", umbrella_cpu),
-                       ("jelly run, 1 step of the seed slope: wall, s", run_one_step)]
+                       (("jelly run, 1 step of the seed slope: wall, s",
+                         "jelly run, 1 step of the seed slope: CPU, s"), run_one_step)]
             if all(os.path.isdir(os.path.join(t.build, "python", "jelly")) for t in trees):
-                timings.append(("python3 -c 'import jelly': wall, s", import_jelly))
+                timings.append((("python3 -c 'import jelly': wall, s",
+                                 "python3 -c 'import jelly': CPU, s"), import_jelly))
+            timings.append(("floor: #include <Eigen/Core> alone: compile CPU (g++ -O2), s",
+                            eigen_core_cpu))
+            timings.append((("floor: python3 -c pass: wall, s", "floor: python3 -c pass: CPU, s"),
+                            python_alone))
             medians = alternate(timings, trees, work, args.repeat)
         except (subprocess.CalledProcessError, OSError) as e:
             detail = getattr(e, "stderr", "") or ""
             print(f"library_figures: a measurement failed: {e}\n{detail}", file=sys.stderr)
             return 1
     for name, values in medians.items():
-        rows.append((name + f" (median of {args.repeat})", [f"{v:.3f}" for v in values]))
+        digits = 4 if ": CPU, s" in name else 3
+        rows.append((name + f" (median of {args.repeat})", [f"{v:.{digits}f}" for v in values]))
 
     header = ["", *names] + (["ratio"] if len(trees) == 2 else [])
     print("| " + " | ".join(header) + " |")

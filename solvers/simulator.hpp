@@ -127,11 +127,11 @@ struct SimulatorOptions {
 // The values of a model that live edits change (Simulator::set_spring_coefficients, set_gravity,
 // set_particle_mass, pins): a snapshot of an edited model carries them.
 struct ModelValues {
-  std::vector<Real> ks;         // [M] per spring (N/m)
-  std::vector<Real> kd;         // [M] per spring (N s/m)
-  VecX mass;                    // [N]
-  Vec3 gravity = Vec3::Zero();  // m/s^2
-  Pins pins;                    // the pins with their paths
+  std::vector<Real> ks;   // [M] per spring (N/m)
+  std::vector<Real> kd;   // [M] per spring (N s/m)
+  VecX mass;              // [N]
+  Vec3 gravity{0, 0, 0};  // m/s^2
+  Pins pins;              // the pins with their paths
 };
 
 // What the future of a run depends on besides the model, terrains, integrator and options: a
@@ -216,7 +216,7 @@ class Simulator {
   // Drives pinned particle `particle` from now on: at time t >= now it is at
   // position + velocity (t - now) (the controller's target for the next steps). Throws
   // InputError when the particle is not pinned or a value is not finite.
-  void set_pin_target(int particle, const Vec3& position, const Vec3& velocity = Vec3::Zero());
+  void set_pin_target(int particle, const Vec3& position, const Vec3& velocity = Vec3(0, 0, 0));
   // Frees a pinned particle; false when it was not pinned.
   bool remove_pin(int particle);
   // Contact between bodies and within a body (default: between bodies, when there are two or

@@ -1,5 +1,6 @@
 #include <jelly/terrain/detail/mesh_obstacle.hpp>
 
+#include <Eigen/Geometry>
 #include <atomic>
 #include <cmath>
 

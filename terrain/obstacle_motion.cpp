@@ -1,5 +1,6 @@
 #include <jelly/terrain/detail/obstacle_motion.hpp>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <utility>
 

@@ -24,6 +24,10 @@ Plane Plane::slope(Real angle_degrees, const Vec3& point, ContactParams contact)
   return Plane(point, Vec3(std::sin(a), std::cos(a), 0), contact);
 }
 
+Real Plane::signed_distance(const Vec3& p, Real /*t*/) const { return normal_.dot(p - point_); }
+
+Vec3 Plane::surface_velocity(const Vec3& /*p*/, Real /*t*/) const { return Vec3::Zero(); }
+
 TriangleMesh Plane::render_mesh() const { return square_mesh(normal_, kRenderSize); }
 
 const FieldTable<PlaneSpec>& plane_fields() {

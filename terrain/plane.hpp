@@ -12,14 +12,14 @@ class Plane final : public Terrain {
   Plane(const Vec3& point, const Vec3& normal, ContactParams contact = {});
   // The plane through `point` tilted by `angle_degrees` about z: normal (sin a, cos a, 0).
   // The seed slope is slope(20, origin).
-  static Plane slope(Real angle_degrees, const Vec3& point = Vec3::Zero(),
+  static Plane slope(Real angle_degrees, const Vec3& point = Vec3(0, 0, 0),
                      ContactParams contact = {});
 
   // "plane".
   std::string_view kind() const override { return "plane"; }
-  Real signed_distance(const Vec3& p, Real /*t*/) const override { return normal_.dot(p - point_); }
+  Real signed_distance(const Vec3& p, Real t) const override;
   Vec3 normal(const Vec3& /*p*/, Real /*t*/) const override { return normal_; }
-  Vec3 surface_velocity(const Vec3& /*p*/, Real /*t*/) const override { return Vec3::Zero(); }
+  Vec3 surface_velocity(const Vec3& p, Real t) const override;
   bool can_contact(const Vec3& /*p*/, Real /*t*/) const override { return true; }
   Vec3 position(Real /*t*/) const override { return point_; }
   // A square of side kRenderSize centred at the point.
@@ -39,8 +39,8 @@ class Plane final : public Terrain {
 
 // Scene kind "plane": a fixed plane through `point` with outward `normal` (any length > 0).
 struct PlaneSpec final : TerrainSpecOf<PlaneSpec> {
-  Vec3 point = Vec3::Zero();    // m, a point of the plane
-  Vec3 normal = Vec3::UnitY();  // outward, any length > 0
+  Vec3 point{0, 0, 0};   // m, a point of the plane
+  Vec3 normal{0, 1, 0};  // outward, any length > 0
 
   // "plane".
   std::string_view kind() const override { return "plane"; }
@@ -53,8 +53,8 @@ struct PlaneSpec final : TerrainSpecOf<PlaneSpec> {
 
 // Scene kind "slope": a plane through `point` tilted by `angle_degrees` about z.
 struct SlopeSpec final : TerrainSpecOf<SlopeSpec> {
-  Real angle_degrees = 20;    // degrees about z: normal (sin a, cos a, 0)
-  Vec3 point = Vec3::Zero();  // m, a point of the plane
+  Real angle_degrees = 20;  // degrees about z: normal (sin a, cos a, 0)
+  Vec3 point{0, 0, 0};      // m, a point of the plane
 
   // "slope".
   std::string_view kind() const override { return "slope"; }

@@ -1,3 +1,4 @@
+#include <Eigen/Geometry>
 #include <jelly/terrain/terrain.hpp>
 
 namespace jelly {

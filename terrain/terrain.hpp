@@ -88,7 +88,7 @@ class Terrain {
   // The terrain's shape for drawing and export, in its own frame (a plane: a large square).
   virtual TriangleMesh render_mesh() const = 0;
   // Where render_mesh() is at time t: its rigid placement in the world.
-  virtual Eigen::Isometry3d pose(Real t) const;
+  virtual Eigen::Transform<Real, 3, Eigen::Isometry> pose(Real t) const;  // Isometry3d
   // The kind's dimensions as named numbers (a recording stores them as attributes).
   virtual std::vector<std::pair<std::string, Real>> attributes() const { return {}; }
 

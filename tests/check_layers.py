@@ -36,6 +36,13 @@ LIBRARY = ["core", "geometry", "terrain", "solvers", "io", "fit"]  # libjelly, i
 GENERATED = {"jelly.hpp": "fit", "version.hpp": "core"}
 SOURCE_EXTENSIONS = (".hpp", ".cpp", ".h", ".cc", ".inl")
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]')
+# What a public header may include besides public headers and the light standard headers: the
+# umbrella's compile time (docs/CONTRIBUTING.md, "The public API") is <Eigen/Core> and little
+# else. Eigen's geometry types are named through the forward declarations <Eigen/Core> holds.
+PUBLIC_THIRD_PARTY = {"Eigen/Core", "nlohmann/json_fwd.hpp"}
+HEAVY_STANDARD = {"regex", "iostream", "fstream", "filesystem", "thread", "mutex", "future",
+                  "chrono", "random", "variant", "unordered_map", "unordered_set", "set", "deque",
+                  "list", "omp.h"}
 
 
 def sources(root, module):
@@ -99,10 +106,19 @@ def public_list(root):
     return out
 
 
+def is_heavy(include):
+    """A header that a header of the umbrella may not include (<...> form, not jelly's own)."""
+    if include.startswith("jelly/"):
+        return False
+    third_party = "/" in include or include[0].isupper() or include.endswith(".h")
+    return include in HEAVY_STANDARD or (third_party and include not in PUBLIC_THIRD_PARTY)
+
+
 def check_umbrella(root):
     """The umbrella includes exactly the public headers (less the extension ones); a public
     header exists, is not from a detail/ folder and includes only public headers (an installed
-    header that includes another one would not compile in a consumer)."""
+    header that includes another one would not compile in a consumer); a header of the umbrella
+    includes no heavy third-party or standard header (PUBLIC_THIRD_PARTY, HEAVY_STANDARD)."""
     path = os.path.join(root, "cmake", "jelly.hpp.in")
     with open(path, encoding="utf-8") as f:
         included = [m.group(2) for m in map(INCLUDE.match, f) if m]
@@ -118,7 +134,7 @@ def check_umbrella(root):
         if header not in public or dict(listed).get(header) is False:
             violations.append(f"cmake/jelly.hpp.in: includes <{header}>, which is not a public "
                               f"header of the umbrella (cmake/public_headers.txt)")
-    for header, _ in listed:
+    for header, umbrella in listed:
         file = os.path.join(root, header[len("jelly/"):])
         if not os.path.exists(file):
             violations.append(f"cmake/public_headers.txt: {header} does not exist")
@@ -130,6 +146,12 @@ def check_umbrella(root):
                     violations.append(f"{header[len('jelly/'):]}:{number}: a public header "
                                       f"includes <{m.group(2)}>, which is not public "
                                       f"(cmake/public_headers.txt)")
+                elif m and umbrella and m.group(1) == "<" and is_heavy(m.group(2)):
+                    violations.append(f"{header[len('jelly/'):]}:{number}: a public header "
+                                      f"includes <{m.group(2)}>, which every includer would "
+                                      f"compile: include it in a .cpp (or a detail/ header); "
+                                      f"allowed: {', '.join(sorted(PUBLIC_THIRD_PARTY))} and the "
+                                      f"light standard headers")
     # Every header of the library is either public (listed, installed) or internal under a
     # detail/ folder: a new header outside detail/ that is not listed is a mistake either way.
     for module in LIBRARY:
@@ -217,6 +239,11 @@ def self_test():
     files["solvers/dynamics.hpp"] = ""
     if not any("solvers/simulator.hpp:2" in v for v in check_umbrella(tree(files))):
         failures.append("a public header including an internal one is not reported")
+    for heavy in ("Eigen/Geometry", "regex", "omp.h", "nlohmann/json.hpp"):
+        files = dict(clean)
+        files["terrain/plane.hpp"] = "#include <Eigen/Core>\n#include <" + heavy + ">\n"
+        if not any("terrain/plane.hpp:2" in v and heavy in v for v in check_umbrella(tree(files))):
+            failures.append(f"a public header including <{heavy}> is not reported")
     files = dict(clean)
     files["geometry/box.hpp"] = "#include <jelly/core/model.hpp>\n"
     if not any("geometry/box.hpp: neither" in v for v in check_umbrella(tree(files))):

@@ -1,5 +1,6 @@
 #include <jelly/viewer/detail/exports.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>

@@ -9,6 +9,7 @@
 // or blend shapes (Godot 4) play the animation. docs/output.md says what was checked.
 #include <jelly/viewer/detail/exports.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

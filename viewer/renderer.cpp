@@ -1,5 +1,6 @@
 #include <jelly/viewer/renderer.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>

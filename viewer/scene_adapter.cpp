@@ -1,5 +1,6 @@
 #include <jelly/viewer/scene_adapter.hpp>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <optional>
 

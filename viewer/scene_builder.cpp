@@ -1,5 +1,6 @@
 #include <jelly/viewer/scene_builder.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
 #include <cmath>

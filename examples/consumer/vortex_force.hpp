@@ -1,6 +1,7 @@
 #pragma once
 // A force of one's own: a vortex about a vertical axis that swirls particles around it and
 // pulls them in. It gives its Jacobians, so implicit_euler takes it into its solve.
+#include <Eigen/Geometry>
 #include <string>
 
 #include <jelly/jelly.hpp>

@@ -4,6 +4,7 @@
 // triangle a query cannot prune), signed by the angle-weighted pseudo-normal of the nearest
 // feature (face, edge or vertex; Baerentzen and Aanaes 2005), which is exact for a closed,
 // consistently oriented mesh that does not intersect itself and costs nothing beyond the search.
+#include <Eigen/Geometry>
 #include <array>
 #include <vector>
 

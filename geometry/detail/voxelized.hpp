@@ -2,6 +2,7 @@
 // Body kind "voxelized": a closed triangle mesh (OBJ, STL, PLY) filled with the seed's lattice at
 // a given spacing (a particle at every lattice point inside, springs between points both
 // inside); its render surface is the mesh itself, each vertex embedded in a lattice cell.
+#include <Eigen/Geometry>
 #include <memory>
 #include <string>
 #include <vector>

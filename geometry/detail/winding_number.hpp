@@ -5,6 +5,7 @@
 // overlap (2 inside two intersecting spheres): "inside" is w >= 1/2. Evaluated in O(log n) per
 // point with a tree of second-order expansions (Barill, Dickson, Schmidt, Levin and Jacobson
 // 2018).
+#include <Eigen/Geometry>
 #include <array>
 #include <vector>
 

@@ -5,8 +5,6 @@ import re
 import warnings
 from typing import Any, Callable, Optional, Sequence
 
-import numpy
-
 from . import _jelly
 
 _SPRING_TYPES = ("structural", "shear", "bending")
@@ -48,6 +46,7 @@ def gradient(scene: Any, duration: float, loss: Callable, wrt: Sequence[str], *,
     a Newton step did not converge, and when projective_dynamics' iterations stopped short of the
     fixed point (the gradient is that of the converged steps).
     """
+    import numpy  # here, not at the top: `import jelly` does not load NumPy
     sim = _jelly.Simulator(scene)
     steps = _steps(float(duration), sim.options.dt)
     pins = [int(p) for p in pins]
@@ -120,6 +119,8 @@ _FORCE = re.compile(r"^forces\[(\d+)\]\.(force|velocity|drag|gust)$")
 
 def _force_gradient(raw, path: str, body: int, k: int, field: str):
     """The gradient of body `body`'s k-th external force's `field` from the raw result."""
+    import numpy
+
     indices = [e for e, b in enumerate(raw["force_body"]) if b == body]
     if k >= len(indices):
         raise _jelly.InputError(f"wrt: '{path}' is not allowed; allowed: a force index below "

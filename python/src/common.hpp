@@ -30,6 +30,11 @@ py::array view(const T* data, py::ssize_t count, py::handle owner, bool writeabl
   return a;
 }
 
+// The default (0, 0, 0) of a Vec3 argument, as a tuple: a Vec3 default would be converted to a
+// NumPy array when the module is imported, importing NumPy with it (most of `import jelly`'s
+// start-up); the tuple becomes a Vec3 when a call leaves the argument out.
+inline py::tuple zero_vec3_default() { return py::make_tuple(0.0, 0.0, 0.0); }
+
 // A flat 3N vector seen as an (N, 3) array without copying.
 inline py::array view_n3(const VecX& v, py::handle owner, bool writeable = false) {
   const py::ssize_t n = v.size() / 3;

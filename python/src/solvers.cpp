@@ -227,7 +227,7 @@ void bind_live_model(py::class_<Simulator>& simulator) {
           [](Simulator& s, int particle, const Vec3& position, const Vec3& velocity) {
             s.set_pin_target(particle, position, velocity);
           },
-          py::arg("particle"), py::arg("position"), py::arg("velocity") = Vec3(Vec3::Zero()),
+          py::arg("particle"), py::arg("position"), py::arg("velocity") = zero_vec3_default(),
           "Drives a pinned particle from now on: at time t it is at position + velocity (t - "
           "now) (a controller's target, the mouse's drag).")
       .def("remove_pin", &Simulator::remove_pin, py::arg("particle"),

@@ -1,10 +1,12 @@
 // terrain/: obstacles (plane, slope, elevator, and every kind of the registry from its scene
 // JSON) and their contact parameters. A Simulator takes a copy of a Plane or an Elevator, or
 // builds any kind from its spec (Simulator.add_terrain); scenes name terrains in their JSON.
+#include <Eigen/Geometry>
+
 #include <jelly/core/detail/json.hpp>
 #include <jelly/terrain/detail/contact_fields.hpp>
-#include <jelly/terrain/detail/terrain_fields.hpp>
 #include <jelly/terrain/detail/elevator.hpp>
+#include <jelly/terrain/detail/terrain_fields.hpp>
 #include <jelly/terrain/plane.hpp>
 #include <jelly/terrain/terrain.hpp>
 #include <jelly/terrain/terrain_kinds.hpp>
@@ -125,8 +127,8 @@ void bind_terrain(py::module_& m) {
       .def(py::init<const Vec3&, const Vec3&, ContactParams>(), py::arg("point"), py::arg("normal"),
            py::arg("contact") = ContactParams{},
            "The plane through point with outward normal (any non-zero length).")
-      .def_static("slope", &Plane::slope, py::arg("angle_degrees"), py::arg("point") = Vec3::Zero(),
-                  py::arg("contact") = ContactParams{},
+      .def_static("slope", &Plane::slope, py::arg("angle_degrees"),
+                  py::arg("point") = zero_vec3_default(), py::arg("contact") = ContactParams{},
                   "The plane through point tilted by angle_degrees about z: normal (sin a, cos a, "
                   "0). The seed slope is Plane.slope(20).")
       .def_property_readonly("point", &Plane::point, "A point of the plane.")

@@ -1,5 +1,6 @@
 #include <jelly/solvers/arkode/detail/arkode_iterative.hpp>
 
+#include <Eigen/LU>
 #include <cmath>
 #include <memory>
 

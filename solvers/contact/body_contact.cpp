@@ -1,5 +1,6 @@
 #include <jelly/solvers/contact/detail/body_contact.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -61,4 +61,8 @@ void finish_step(const StepResult& result, ContactSolver& contacts, BodyContact*
   if (!model.pins.empty()) model.pins.apply(state.t, state.x, state.v);
 }
 
+void ensure_size(VecX& v, Eigen::Index n) {
+  if (v.size() != n) v.setZero(n);
+}
+
 }  // namespace jelly

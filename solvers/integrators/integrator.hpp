@@ -118,8 +118,6 @@ void finish_step(const StepResult& result, ContactSolver& contacts, BodyContact*
 std::string in_evaluation_contact_requirement(std::string_view integrator);
 
 // Resizes v to n entries only when its size differs (no allocation in steady state).
-inline void ensure_size(VecX& v, Eigen::Index n) {
-  if (v.size() != n) v.setZero(n);
-}
+void ensure_size(VecX& v, Eigen::Index n);
 
 }  // namespace jelly

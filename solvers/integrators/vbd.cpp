@@ -1,5 +1,6 @@
 #include <jelly/solvers/integrators/detail/vbd.hpp>
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 

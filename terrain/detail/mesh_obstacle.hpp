@@ -5,6 +5,7 @@
 // angle-weighted pseudo-normal). Like the other obstacles it may move along a prescribed path
 // and spin about its origin (terrain/detail/obstacle_motion.hpp); the surface velocity at a contact
 // is the rigid motion's at the nearest surface point.
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
 #include <string>

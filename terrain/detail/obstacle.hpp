@@ -4,6 +4,7 @@
 // `rotation_degrees`, moving along a prescribed path (translation) and turning at a constant
 // angular velocity about its centre. The surface velocity at a contact is that of the rigid
 // motion at the closest surface point, so a moving or spinning obstacle carries what rests on it.
+#include <Eigen/Geometry>
 #include <string>
 #include <string_view>
 

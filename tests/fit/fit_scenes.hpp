@@ -1,12 +1,13 @@
 #pragma once
 // Recordings with known coefficients for the fitting tests: a small cube deformed and spinning in
 // free flight, and the same cube dropped onto the 20-degree slope (coulomb contact).
+#include <Eigen/Geometry>
 #include <cmath>
 #include <memory>
 #include <random>
 
-#include <jelly/geometry/cube.hpp>
 #include <jelly/fit/spring_fit.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/terrain/plane.hpp>
 
 #include "support/systems.hpp"

@@ -3,6 +3,7 @@
 // mesh whose triangles index existing vertices, with finite coordinates; a mesh that reads is
 // then used as the bodies and obstacles use it: its topology, a lattice filled from it (at a
 // spacing giving at most a few thousand points) and distances from a mesh obstacle.
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>

@@ -1,5 +1,6 @@
 // Body kinds: spring counts of the box and cloth lattices, closed and outward render surfaces,
 // masses from a density, scene JSON round trips, and free fall of every registered kind.
+#include <Eigen/Geometry>
 #include <cmath>
 #include <map>
 #include <string>

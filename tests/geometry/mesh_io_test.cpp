@@ -1,4 +1,5 @@
 // Reading meshes: formats, welding, vertex groups, topology, and each kind of bad file.
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <fstream>
 #include <iterator>

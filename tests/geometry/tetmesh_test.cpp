@@ -1,5 +1,6 @@
 // The tetmesh body kind: springs = unique edges, lumped masses, the boundary surface; the Gmsh
 // and TetGen readers, tetrahedralize, and their bad input.
+#include <Eigen/Geometry>
 #include <set>
 
 #include <gmock/gmock.h>

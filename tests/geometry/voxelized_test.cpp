@@ -1,5 +1,6 @@
 // The voxelized body kind: the lattice inside a mesh, its embedded render surface, the shape as
 // a scene reads it, and its bad input.
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include <gmock/gmock.h>

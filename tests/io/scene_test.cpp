@@ -3,6 +3,7 @@
 #include <jelly/core/detail/json.hpp>
 #include <jelly/io/scene.hpp>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>

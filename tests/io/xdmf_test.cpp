@@ -3,6 +3,7 @@
 // sidecar is the same whether written at the end of a run, in several runs or from the file
 // alone. (That ParaView's readers open it: the ctest jelly_paraview, tests/io/paraview_test.py.)
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <hdf5.h>
 

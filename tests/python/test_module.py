@@ -242,3 +242,19 @@ def test_every_class_prints_and_pickles_or_says_it_does_not(tmp_path):
     a.step(20)
     b.step(20)
     assert a.state.x.tobytes() == b.state.x.tobytes()
+
+
+def test_import_leaves_numpy_unloaded_and_defaults_still_work():
+    """`import jelly` does not import NumPy (most of its start-up, docs/CONTRIBUTING.md); an
+    argument whose default is (0, 0, 0) still takes it: the slope passes through the origin."""
+    import subprocess
+    import sys
+    code = ("import sys, jelly\n"
+            "loaded = 'numpy' in sys.modules\n"
+            "p = jelly.Plane.slope(20)\n"
+            "print(loaded, p.signed_distance([0, 0, 0], 0.0), p.signed_distance([0, 1, 0], 0.0))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out[0] == "False"
+    assert float(out[1]) == 0.0
+    assert abs(float(out[2]) - 0.9396926207859084) < 1e-15  # cos 20 degrees

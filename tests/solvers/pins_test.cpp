@@ -57,7 +57,7 @@ Model pinned_model() {
   cube.material.springs.fill({500, 2});
   PinSpec top;
   top.select.has_region = true;
-  top.select.region = Eigen::AlignedBox3d(Vec3(0.9, 0.55, -0.1), Vec3(1.5, 0.65, 0.5));
+  top.select.region = Box3(Vec3(0.9, 0.55, -0.1), Vec3(1.5, 0.65, 0.5));
   top.path = Path::oscillation(Vec3(0, 0.1, 0), 1.0);
   cube.pins = {top};
   add_body(model, cube, "bodies[1].");

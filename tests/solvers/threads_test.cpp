@@ -1,6 +1,7 @@
 // Every registered integrator gives the same trajectory, bit for bit, on 1, 2 and 3 threads
 // (docs/threads.md): fixed partitions, sums in a fixed order.
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <vector>
@@ -58,7 +59,7 @@ Model two_bodies() {
   hanging.material.particle_mass = 0.2;
   PinSpec top;
   top.select.has_region = true;
-  top.select.region = Eigen::AlignedBox3d(Vec3(-3.1, 4.45, -0.1), Vec3(-2.4, 4.55, 0.6));
+  top.select.region = Box3(Vec3(-3.1, 4.45, -0.1), Vec3(-2.4, 4.55, 0.6));
   top.path = Path::oscillation(Vec3(0.02, 0.05, 0), 2.0);
   hanging.pins = {top};
   ExternalForceSpec wind;

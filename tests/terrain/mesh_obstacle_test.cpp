@@ -2,6 +2,7 @@
 // analytic box obstacle, the scene's JSON (file relative to the scene's folder, round trip) and
 // bad input (missing, open, degenerate meshes, NaN).
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <fstream>

@@ -1,6 +1,7 @@
 // Obstacles of simple shapes: exact signed distances and normals against the analytic shapes,
 // their placement and motion, JSON round trips and bad input.
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <limits>

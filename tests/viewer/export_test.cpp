@@ -3,6 +3,7 @@
 // recording says it was), and the .glb (read with tinygltf) holds every body's surface at every
 // frame, its colour, the exact frame times and the obstacles' motion.
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <cstring>

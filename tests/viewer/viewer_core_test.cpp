@@ -2,6 +2,7 @@
 // OBJ and PC2 exports read back, the live simulation's commands and frames, and `jelly view`
 // without a display.
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <chrono>
 #include <cmath>

@@ -2,6 +2,7 @@
 // its rest state against backward Euler's static solution, the impact that crushes xpbd's jelly,
 // and its independence of the thread count (docs/realtime.md).
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <cstring>
