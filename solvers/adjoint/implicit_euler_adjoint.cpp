@@ -15,6 +15,7 @@
 #include <jelly/core/detail/clock.hpp>
 #include <jelly/core/detail/forces.hpp>
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/model.hpp>
@@ -744,14 +745,17 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       // The prescribed velocity changes z (and the sliding friction's C w0): their adjoint is
       // dvb - A lambda at the constrained particles.
       if (!cons.empty()) {
-        if (newton_free)
+        if (newton_free) {
           newton_free->multiply_transposed(lambda, a_lambda, threads);
-        else if (newton)
+        } else if (newton) {
+          // (Eigen runs a transposed sparse product in an OpenMP region: kept on this thread.)
+          const parallel::SerialLibraries serial;
           a_lambda.noalias() = a.transpose() * lambda;
-        else if (free)
+        } else if (free) {
           free->band.multiply(lambda, a_lambda, threads);
-        else
+        } else {
           a_lambda.noalias() = a * lambda;
+        }
       }
       // (Newton: v1 of a constrained particle is prescribed whatever v0 (z = ... - v0 cancels
       // v1 = v0 + dv); the free ones see v0 through M (v1 - v0) only.)

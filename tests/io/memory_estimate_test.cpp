@@ -139,7 +139,7 @@ INSTANTIATE_TEST_SUITE_P(EveryIntegrator, MemoryEstimateOf,
                          ::testing::Values("explicit_euler", "symplectic_euler", "midpoint", "rk4",
                                            "xpbd", "arkode_erk", "implicit_euler",
                                            "projective_dynamics", "arkode_dirk"),
-                         [](const auto& info) { return info.param; });
+                         [](const auto& param_info) { return param_info.param; });
 
 }  // namespace
 }  // namespace jelly

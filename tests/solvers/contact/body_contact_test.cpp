@@ -337,8 +337,8 @@ TEST(BodyContact, RunsTakeTheirPairsFromTheCollisionPhase) {
 }
 
 TEST(BodyContact, AfterStepElasticCollisionKeepsItsEnergy) {
-  for (const std::string& integrator : {"arkode_dirk", "arkode_erk", "implicit_euler",
-                                        "projective_dynamics", "rk4", "vbd", "xpbd"}) {
+  for (const char* integrator : {"arkode_dirk", "arkode_erk", "implicit_euler",
+                                 "projective_dynamics", "rk4", "vbd", "xpbd"}) {
     SCOPED_TRACE(integrator);
     Simulator sim = head_on(integrator, 1e-3, 1, 1, 0);
     const Real e0 = total_energy(sim.model(), sim.state());
@@ -364,7 +364,7 @@ TEST(BodyContact, AfterStepElasticCollisionKeepsItsEnergy) {
 // (pairs taken one after another broke it from the third contact step on; vbd's sweeps keep it
 // since their colouring is the springs' graph's own, detail/vertex_colouring.hpp).
 TEST(BodyContact, AfterStepMirroredCollisionStaysSymmetric) {
-  for (const std::string& integrator : {"implicit_euler", "projective_dynamics", "vbd", "xpbd"}) {
+  for (const char* integrator : {"implicit_euler", "projective_dynamics", "vbd", "xpbd"}) {
     SCOPED_TRACE(integrator);
     Simulator sim = head_on(integrator, 1.0 / 60, 0);
     Real asymmetry = 0;
