@@ -19,6 +19,7 @@
 #include <jelly/core/detail/spring_bands.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/model.hpp>
+#include <jelly/solvers/adjoint/detail/adjoint_run.hpp>
 #include <jelly/solvers/adjoint/detail/newton_backward.hpp>
 #include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/contact/detail/friction.hpp>
@@ -282,31 +283,12 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   auto* ie = dynamic_cast<ImplicitEuler*>(&sim.integrator());
   require(ie != nullptr, "integrator", sim.integrator().name(), "implicit_euler for gradients");
   adjoint_check_supported(sim, *ie);
+  const AdjointFrames frames = check_gradient_problem(sim.model(), problem);
+  const std::vector<int>& driven = frames.driven;
   const int steps = problem.steps;
-  require(steps >= 1, "steps", steps, "an integer >= 1");
-  require(problem.checkpoint_every >= 0, "checkpoint_every", problem.checkpoint_every,
-          "0 (store every step) or a number of steps >= 1");
-  require(static_cast<bool>(problem.loss), "loss", "none", "a function");
   const int np = sim.model().num_particles();
   const int n = 3 * np;
   const int pins = static_cast<int>(problem.driven_pins.size());
-  require(problem.pin_targets.size() == static_cast<size_t>(steps) * pins, "pin_targets",
-          problem.pin_targets.size(), "steps x driven pins = " + std::to_string(steps * pins));
-  std::vector<int> driven(np, -1);
-  for (int p = 0; p < pins; ++p) {
-    const int particle = problem.driven_pins[p];
-    require(particle >= 0 && particle < np && sim.model().pins.find(particle) >= 0,
-            "driven_pins[" + std::to_string(p) + "]", particle, "a pinned particle");
-    require(driven[particle] < 0, "driven_pins[" + std::to_string(p) + "]", particle,
-            "each pinned particle once");
-    driven[particle] = p;
-  }
-  std::vector<char> at_frame(steps + 1, 0);
-  if (problem.loss_frames.empty()) at_frame[steps] = 1;
-  for (int f : problem.loss_frames) {
-    require(f >= 0 && f <= steps, "loss_frames", f, "frames 0 to " + std::to_string(steps));
-    at_frame[f] = 1;
-  }
 
   GradientResult out;
   const Real h = sim.options().dt;
@@ -317,16 +299,7 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   const int segment = every > 0 ? std::min(every, steps) : steps;
   std::vector<StepRecord> records(segment);
   std::vector<SimulatorSnapshot> checkpoints;
-  std::vector<VecX> dl_dx(steps + 1), dl_dv(steps + 1);
-  const auto evaluate = [&](int frame) {
-    if (!at_frame[frame]) return;
-    dl_dx[frame].setZero(n);
-    dl_dv[frame].setZero(n);
-    const Real value = problem.loss(frame, sim.state(), dl_dx[frame], dl_dv[frame]);
-    require(std::isfinite(value) && dl_dx[frame].allFinite() && dl_dv[frame].allFinite(),
-            "loss at frame " + std::to_string(frame), value, "finite values and derivatives");
-    out.loss += value;
-  };
+  AdjointLoss loss(problem, frames, n);
   // Contact between bodies: the union of the pairs' blocks (the backward matrix's pattern), and
   // what the adjoint holds (the end of step's projection of deep overlaps, restitution).
   std::vector<std::pair<int, int>> pair_blocks;
@@ -373,12 +346,13 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       }
     }
   };
-  evaluate(0);
+  loss.evaluate(0, sim.state());
   for (int k = 0; k < steps; ++k) {
     if (every > 0 && k % segment == 0) checkpoints.push_back(sim.snapshot());
     forward_step(k, records[every > 0 ? 0 : k]);
-    evaluate(k + 1);
+    loss.evaluate(k + 1, sim.state());
   }
+  out.loss = loss.value();
   std::optional<SimulatorSnapshot> end_of_run;
   if (every > 0) end_of_run = sim.snapshot();
   out.forward_seconds = seconds_since(start);
@@ -448,18 +422,9 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
     if (LinearResult r = solver->analyze(a); !r.ok())
       throw std::runtime_error("gradient: " + r.message);
   }
-  const int bodies = model.num_bodies();
-  out.ks.assign(static_cast<size_t>(kSpringTypeCount) * bodies, 0.0);
-  out.kd.assign(out.ks.size(), 0.0);
-  out.particle_mass.assign(bodies, 0.0);
-  out.pin_targets.assign(problem.pin_targets.size(), Vec3::Zero());
-  std::vector<int> spring_body(model.springs.size(), 0), particle_body(np, 0);
-  for (int b = 0; b < bodies; ++b) {
-    const Body& body = model.bodies[b];
-    std::fill(spring_body.begin() + body.first_spring, spring_body.begin() + body.end_spring(), b);
-    std::fill(particle_body.begin() + body.first_particle,
-              particle_body.begin() + body.end_particle(), b);
-  }
+  const AdjointBodies map = start_gradient_result(model, problem, out);
+  const std::vector<int>& spring_body = map.spring_body;
+  const std::vector<int>& particle_body = map.particle_body;
   std::vector<int> slot(np, -1);
   // The inverse masses the body contact gives its pairs (0 for pins).
   VecX inverse_mass = model.mass.cwiseInverse();
@@ -480,16 +445,13 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
   std::vector<int> pair_order;  // the current step's pairs sorted by (i, j)
   const Real pair_mu = sim.body_contact().params().friction;
   const Real pair_mu_s = sim.body_contact().params().static_friction;
-  out.force_vector.assign(model.external_forces.size(), Vec3::Zero());
-  out.force_drag.assign(model.external_forces.size(), 0.0);
-  out.force_gust.assign(model.external_forces.size(), 0.0);
   VecX damping(np);
   VecX e_vec = VecX::Zero(n), a_e(n);
   VecX xb = VecX::Zero(n), vb = VecX::Zero(n), x0b(n), v0b(n), dvb(n), mu = VecX::Zero(n),
        lambda(n), a_lambda(n), kw(n);
-  if (at_frame[steps]) {
-    xb = dl_dx[steps];
-    vb = dl_dv[steps];
+  if (loss.at(steps)) {
+    xb = loss.dx(steps);
+    vb = loss.dv(steps);
   }
   const Springs& springs = model.springs;
   const Real* rest = springs.rest_length.data();
@@ -809,45 +771,18 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
         out.particle_mass[particle_body[i]] += l.dot(h * model.gravity - particle(r.dv, i));
         out.gravity += (h * model.mass[i]) * l;
       }
-      // External forces at t1 (b = h (f + ...)); wind's drag also in A = M + h drag - ...:
-      //   phi_i = h lambda_i . f_i - h drag lambda_i . dv_i on a wind particle.
-      for (size_t e = 0; e < model.external_forces.size(); ++e) {
-        const ExternalForce& force = model.external_forces[e];
-        if (t1 < force.start || t1 >= force.end) continue;
-        const Real wave = std::sin(2 * M_PI * force.gust_frequency * t1);
-        const Real factor = 1 + force.gust * wave;
-        const Vec3 w = force.vector * factor;
-        Vec3 sum = Vec3::Zero();  // d(phi)/d(w)
-        switch (force.kind) {
-          case ExternalForceKind::kConstant: {
-            // f_i = (m_i / total) w; a body's masses all change together: d(m_i / total) =
-            // [i in body] / total - m_i (its particles among the force's) / total^2.
-            Real total = 0;
-            for (int i : force.particles) total += model.mass[i];
-            Real weighted = 0;  // sum_i m_i lambda_i . w / total^2
-            for (int i : force.particles) {
-              const Vec3 l = particle(lambda, i);
-              sum += (h * model.mass[i] / total) * l;
-              out.particle_mass[particle_body[i]] += h * l.dot(w) / total;
-              weighted += h * model.mass[i] * l.dot(w) / (total * total);
-            }
-            for (int i : force.particles) out.particle_mass[particle_body[i]] -= weighted;
-            break;
-          }
-          case ExternalForceKind::kWind:
-            for (int i : force.particles) {
-              const Vec3 l = particle(lambda, i);
-              sum += (h * force.drag) * l;
-              out.force_drag[e] += h * l.dot(w - particle(r.v, i) - particle(r.dv, i));
-              if (!newton) particle(v0b, i) -= (h * force.drag) * l;
-            }
-            break;
-          case ExternalForceKind::kPoint:
-            for (int i : force.particles) sum += h * particle(lambda, i);
-            break;
+      // External forces at t1 (b = h (f + ...)), the wind's drag on v1 = v0 + dv; the drag also
+      // in A = M + h drag - ...: phi_i = h lambda_i . f_i - h drag lambda_i . dv_i on a wind
+      // particle, whose v0 term the linearized step takes.
+      if (!model.external_forces.empty()) {
+        v1 = r.v + r.dv;
+        add_external_force_gradients(model, t1, lambda, h, v1, particle_body, out);
+        for (const ExternalForce& force : model.external_forces) {
+          if (newton || force.kind != ExternalForceKind::kWind || t1 < force.start ||
+              t1 >= force.end)
+            continue;
+          for (int i : force.particles) particle(v0b, i) -= (h * force.drag) * particle(lambda, i);
         }
-        out.force_vector[e] += factor * sum;
-        out.force_gust[e] += wave * sum.dot(force.vector);
       }
       // Springs, per spring with d = xa - xb, L = |d|, u = d / L, w = va - vb, and the differences
       // l, e of lambda and dv at its ends (q = w + e):
@@ -960,9 +895,9 @@ GradientResult implicit_euler_gradient(Simulator& sim, const GradientProblem& pr
       for (const Constraint& c : cons) slot[c.particle] = -1;
       xb.swap(x0b);
       vb.swap(v0b);
-      if (at_frame[k]) {
-        xb += dl_dx[k];
-        vb += dl_dv[k];
+      if (loss.at(k)) {
+        xb += loss.dx(k);
+        vb += loss.dv(k);
       }
     }
   }

@@ -12,6 +12,7 @@
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/errors.hpp>
 #include <jelly/core/model.hpp>
+#include <jelly/solvers/adjoint/detail/adjoint_run.hpp>
 #include <jelly/solvers/contact/detail/body_contact.hpp>
 #include <jelly/solvers/integrators/detail/implicit_euler.hpp>
 #include <jelly/solvers/integrators/detail/projective_dynamics.hpp>
@@ -121,34 +122,15 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
   require(pd != nullptr, "integrator", sim.integrator().name(),
           "projective_dynamics for projective_dynamics_gradient");
   pd_adjoint_check_supported(sim);
-  const int steps = problem.steps;
-  require(steps >= 1, "steps", steps, "an integer >= 1");
-  require(problem.checkpoint_every >= 0, "checkpoint_every", problem.checkpoint_every,
-          "0 (store every step) or a number of steps >= 1");
-  require(static_cast<bool>(problem.loss), "loss", "none", "a function");
   const Model& model = sim.model();
+  const AdjointFrames frames = check_gradient_problem(model, problem);
+  const std::vector<int>& driven = frames.driven;
+  const int steps = problem.steps;
   const int np = model.num_particles();
   const int n = 3 * np;
   const int pins = static_cast<int>(problem.driven_pins.size());
-  require(problem.pin_targets.size() == static_cast<size_t>(steps) * pins, "pin_targets",
-          problem.pin_targets.size(), "steps x driven pins = " + std::to_string(steps * pins));
-  std::vector<int> driven(np, -1);
-  for (int p = 0; p < pins; ++p) {
-    const int particle = problem.driven_pins[p];
-    require(particle >= 0 && particle < np && model.pins.find(particle) >= 0,
-            "driven_pins[" + std::to_string(p) + "]", particle, "a pinned particle");
-    require(driven[particle] < 0, "driven_pins[" + std::to_string(p) + "]", particle,
-            "each pinned particle once");
-    driven[particle] = p;
-  }
   std::vector<char> pinned(np, 0);
   for (int i : model.pins.particles) pinned[i] = 1;
-  std::vector<char> at_frame(steps + 1, 0);
-  if (problem.loss_frames.empty()) at_frame[steps] = 1;
-  for (int f : problem.loss_frames) {
-    require(f >= 0 && f <= steps, "loss_frames", f, "frames 0 to " + std::to_string(steps));
-    at_frame[f] = 1;
-  }
 
   GradientResult out;
   const Real h = sim.options().dt;
@@ -157,16 +139,7 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
   const int segment = every > 0 ? std::min(every, steps) : steps;
   std::vector<PdStepRecord> records(segment);
   std::vector<SimulatorSnapshot> checkpoints;
-  std::vector<VecX> dl_dx(steps + 1), dl_dv(steps + 1);
-  const auto evaluate = [&](int frame) {
-    if (!at_frame[frame]) return;
-    dl_dx[frame].setZero(n);
-    dl_dv[frame].setZero(n);
-    const Real value = problem.loss(frame, sim.state(), dl_dx[frame], dl_dv[frame]);
-    require(std::isfinite(value) && dl_dx[frame].allFinite() && dl_dv[frame].allFinite(),
-            "loss at frame " + std::to_string(frame), value, "finite values and derivatives");
-    out.loss += value;
-  };
+  AdjointLoss loss(problem, frames, n);
   const auto not_converged = [&]() -> long {
     const Statistics stats = pd->statistics();
     const auto it = stats.find("not_converged");
@@ -197,12 +170,13 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
         out.forward_residual = std::max(out.forward_residual, residuals.back() / residuals.front());
     }
   };
-  evaluate(0);
+  loss.evaluate(0, sim.state());
   for (int k = 0; k < steps; ++k) {
     if (every > 0 && k % segment == 0) checkpoints.push_back(sim.snapshot());
     forward_step(k, records[every > 0 ? 0 : k]);
-    evaluate(k + 1);
+    loss.evaluate(k + 1, sim.state());
   }
+  out.loss = loss.value();
   std::optional<SimulatorSnapshot> end_of_run;
   if (every > 0) end_of_run = sim.snapshot();
   out.forward_seconds = seconds_since(start);
@@ -224,27 +198,15 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
   exact.exact_damper = true;
   PdAdjointPreconditioner preconditioner(*pd, np, h);
   PdBiCgStab bicgstab(n);
-  const int bodies = model.num_bodies();
-  out.ks.assign(static_cast<size_t>(kSpringTypeCount) * bodies, 0.0);
-  out.kd.assign(out.ks.size(), 0.0);
-  out.particle_mass.assign(bodies, 0.0);
-  out.pin_targets.assign(problem.pin_targets.size(), Vec3::Zero());
-  out.force_vector.assign(model.external_forces.size(), Vec3::Zero());
-  out.force_drag.assign(model.external_forces.size(), 0.0);
-  out.force_gust.assign(model.external_forces.size(), 0.0);
-  std::vector<int> spring_body(model.springs.size(), 0), particle_body(np, 0);
-  for (int b = 0; b < bodies; ++b) {
-    const Body& body = model.bodies[b];
-    std::fill(spring_body.begin() + body.first_spring, spring_body.begin() + body.end_spring(), b);
-    std::fill(particle_body.begin() + body.first_particle,
-              particle_body.begin() + body.end_particle(), b);
-  }
+  const AdjointBodies map = start_gradient_result(model, problem, out);
+  const std::vector<int>& spring_body = map.spring_body;
+  const std::vector<int>& particle_body = map.particle_body;
   const Springs& springs = model.springs;
   VecX damping(np), v(n), g(n), rhs(n), kl(n), dl(n);
   VecX xb = VecX::Zero(n), vb = VecX::Zero(n), x0b(n), v0b(n), lambda = VecX::Zero(n);
-  if (at_frame[steps]) {
-    xb = dl_dx[steps];
-    vb = dl_dv[steps];
+  if (loss.at(steps)) {
+    xb = loss.dx(steps);
+    vb = loss.dv(steps);
   }
   const int* outer = j_matrix.outerIndexPtr();
   const int* rows = j_matrix.innerIndexPtr();
@@ -323,45 +285,8 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
             l.dot(model.gravity - (particle(v, i) - particle(r.v0, i)) / h);
         out.gravity += model.mass[i] * l;
       }
-      // External forces at t1: a constant force spread by mass (f_i = m_i w / total), wind
-      // (f_i = drag (w - v_i)), point forces (f_i = w), w = vector (1 + gust sin(2 pi f t1)).
-      for (size_t e = 0; e < model.external_forces.size(); ++e) {
-        const ExternalForce& force = model.external_forces[e];
-        if (t1 < force.start || t1 >= force.end) continue;
-        const Real wave = std::sin(2 * M_PI * force.gust_frequency * t1);
-        const Real factor = 1 + force.gust * wave;
-        const Vec3 w = force.vector * factor;
-        Vec3 sum = Vec3::Zero();  // d(lambda . f)/d(w)
-        switch (force.kind) {
-          case ExternalForceKind::kConstant: {
-            // A body's masses all change together: d(m_i / total) = [i in body] / total - m_i
-            // (its particles among the force's) / total^2.
-            Real total = 0;
-            for (int i : force.particles) total += model.mass[i];
-            Real weighted = 0;
-            for (int i : force.particles) {
-              const Vec3 l = particle(lambda, i);
-              sum += (model.mass[i] / total) * l;
-              out.particle_mass[particle_body[i]] += l.dot(w) / total;
-              weighted += model.mass[i] * l.dot(w) / (total * total);
-            }
-            for (int i : force.particles) out.particle_mass[particle_body[i]] -= weighted;
-            break;
-          }
-          case ExternalForceKind::kWind:
-            for (int i : force.particles) {
-              const Vec3 l = particle(lambda, i);
-              sum += force.drag * l;
-              out.force_drag[e] += l.dot(w - particle(v, i));
-            }
-            break;
-          case ExternalForceKind::kPoint:
-            for (int i : force.particles) sum += particle(lambda, i);
-            break;
-        }
-        out.force_vector[e] += factor * sum;
-        out.force_gust[e] += wave * sum.dot(force.vector);
-      }
+      // External forces at t1, on v = v1.
+      add_external_force_gradients(model, t1, lambda, 1.0, v, particle_body, out);
       // Springs: f_a = -(ks (L - l0) + kd w.u) u at x1, w = v_a - v_b.
       for (int sp = 0; sp < springs.size(); ++sp) {
         const int ia = springs.a[sp], ib = springs.b[sp];
@@ -379,9 +304,9 @@ GradientResult projective_dynamics_gradient(Simulator& sim, const GradientProble
       }
       xb.swap(x0b);
       vb.swap(v0b);
-      if (at_frame[k]) {
-        xb += dl_dx[k];
-        vb += dl_dv[k];
+      if (loss.at(k)) {
+        xb += loss.dx(k);
+        vb += loss.dv(k);
       }
     }
   }

@@ -13,6 +13,8 @@
 #include <jelly/core/model.hpp>
 #include <jelly/core/state.hpp>
 #include <jelly/geometry/cube.hpp>
+#include <jelly/solvers/contact/body_contact_params.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/registry.hpp>
 #include <jelly/solvers/simulator.hpp>
 
@@ -187,6 +189,54 @@ inline EnergyTrace run_traced(Simulator& sim, Real t_end) {
     }
   }
   return trace;
+}
+
+// Two n = 4 cubes, mirror images of each other across x = 0 (0.1 m apart), thrown head on at
+// 2 m/s each without gravity, frictionless, with the given restitution; the Simulator resolves
+// their contact after each step (implicit_euler with contact "after_step"). `kd`: the springs'
+// damping.
+inline Simulator head_on_cubes(const std::string& integrator, Real dt, Real restitution = 0,
+                               int threads = 1, Real kd = 50) {
+  Model model;
+  CubeSpec a = small_cube(4, 0.3, Vec3(-0.35, 0, 0));
+  CubeSpec b = small_cube(4, 0.3, Vec3(0.05, 0, 0));
+  for (SpringCoefficients& c : a.springs) c.kd = kd;
+  for (SpringCoefficients& c : b.springs) c.kd = kd;
+  model.add_body("left", a.shape().build(a.material(), "a."));
+  model.add_body("right", b.shape().build(b.material(), "b."));
+  model.gravity.setZero();
+  State s = rest_state(model);
+  for (int i = 0; i < model.num_particles(); ++i)
+    particle(s.v, i) = Vec3(i < 64 ? 2.0 : -2.0, 0, 0);
+  SimulatorOptions so;
+  so.dt = dt;
+  so.threads = threads;
+  IntegratorOptions options;
+  options.implicit.contact = ImplicitContactMode::kAfterStep;
+  Simulator sim(model, s, make_integrator(integrator, options), so);
+  BodyContactParams params;
+  params.friction = params.static_friction = 0;
+  params.restitution = restitution;
+  sim.set_body_contact(params);
+  return sim;
+}
+
+// How far a state of head_on_cubes is from its mirror image: the largest difference between
+// particle (i, j, k) of the left cube and (3 - i, j, k) of the right one mirrored, positions and
+// velocities.
+inline Real head_on_asymmetry(const State& s) {
+  Real asymmetry = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 4; ++k) {
+        const int l = (i * 4 + j) * 4 + k, r = 64 + ((3 - i) * 4 + j) * 4 + k;
+        const Vec3 xl = particle(s.x, l), xr = particle(s.x, r);
+        const Vec3 vl = particle(s.v, l), vr = particle(s.v, r);
+        asymmetry = std::max({asymmetry, std::abs(xl.x() + xr.x()), std::abs(xl.y() - xr.y()),
+                              std::abs(xl.z() - xr.z()), std::abs(vl.x() + vr.x()),
+                              std::abs(vl.y() - vr.y()), std::abs(vl.z() - vr.z())});
+      }
+  return asymmetry;
 }
 
 }  // namespace jelly::testing

@@ -263,5 +263,32 @@ void check_external_forces(const std::function<AdjointCase(const Model&)>& make_
   }
 }
 
+// A constant force spread by mass over seven particles of a 3 x 3 x 3 cube, wind on its top
+// layer (from `wind_start` s) and two point forces, all gusting: every parameter kind of the
+// external forces.
+std::vector<ExternalForce> gusting_forces(Real wind_start = 0) {
+  ExternalForce push;
+  push.kind = ExternalForceKind::kConstant;
+  push.particles = {0, 1, 2, 5, 9, 13, 26};
+  push.vector = Vec3(0.3, -0.2, 0.4);
+  push.gust = 0.3;
+  push.gust_frequency = 2;
+  ExternalForce wind;
+  wind.kind = ExternalForceKind::kWind;
+  wind.particles = {18, 19, 20, 21, 22, 23, 24, 25, 26};
+  wind.vector = Vec3(2, 0.5, -1);
+  wind.drag = 0.05;
+  wind.gust = 0.2;
+  wind.gust_frequency = 3;
+  wind.start = wind_start;
+  ExternalForce point;
+  point.kind = ExternalForceKind::kPoint;
+  point.particles = {4, 22};
+  point.vector = Vec3(-0.1, 0.2, 0.05);
+  point.gust = -0.4;
+  point.gust_frequency = 5;
+  return {push, wind, point};
+}
+
 }  // namespace
 }  // namespace jelly

@@ -456,26 +456,7 @@ TEST(ImplicitEulerAdjoint, ExternalForcesOnASlopeAgreeWithFiniteDifferences) {
   model.mass.setConstant(0.2);
   for (int t = 0; t < kSpringTypeCount; ++t)
     model.springs.set_coefficients(static_cast<SpringType>(t), {400.0 + 100 * t, 4.0 + t});
-  ExternalForce push;
-  push.kind = ExternalForceKind::kConstant;
-  push.particles = {0, 1, 2, 5, 9, 13, 26};
-  push.vector = Vec3(0.3, -0.2, 0.4);
-  push.gust = 0.3;
-  push.gust_frequency = 2;
-  ExternalForce wind;
-  wind.kind = ExternalForceKind::kWind;
-  wind.particles = {18, 19, 20, 21, 22, 23, 24, 25, 26};
-  wind.vector = Vec3(2, 0.5, -1);
-  wind.drag = 0.05;
-  wind.gust = 0.2;
-  wind.gust_frequency = 3;
-  ExternalForce point;
-  point.kind = ExternalForceKind::kPoint;
-  point.particles = {4, 22};
-  point.vector = Vec3(-0.1, 0.2, 0.05);
-  point.gust = -0.4;
-  point.gust_frequency = 5;
-  model.external_forces = {push, wind, point};
+  model.external_forces = gusting_forces();
   check_external_forces(forced_cube_on_slope, model);
   const AdjointCase c = forced_cube_on_slope(model);
   check_every_kind(c, 0, {SpringType::kShear});

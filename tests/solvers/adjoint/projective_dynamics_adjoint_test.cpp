@@ -66,27 +66,7 @@ TEST(ProjectiveDynamicsAdjoint, FreeCubeEveryKindAgreesWithFiniteDifferences) {
 // every force parameter, the others with them, and the forces over particles of unequal masses.
 TEST(ProjectiveDynamicsAdjoint, ExternalForcesAgreeWithFiniteDifferences) {
   Model model = small_cube_model();
-  ExternalForce push;
-  push.kind = ExternalForceKind::kConstant;
-  push.particles = {0, 1, 2, 5, 9, 13, 26};
-  push.vector = Vec3(0.3, -0.2, 0.4);
-  push.gust = 0.3;
-  push.gust_frequency = 2;
-  ExternalForce wind;
-  wind.kind = ExternalForceKind::kWind;
-  wind.particles = {18, 19, 20, 21, 22, 23, 24, 25, 26};
-  wind.vector = Vec3(2, 0.5, -1);
-  wind.drag = 0.05;
-  wind.gust = 0.2;
-  wind.gust_frequency = 3;
-  wind.start = 0.04;  // (starts inside the run)
-  ExternalForce point;
-  point.kind = ExternalForceKind::kPoint;
-  point.particles = {4, 22};
-  point.vector = Vec3(-0.1, 0.2, 0.05);
-  point.gust = -0.4;
-  point.gust_frequency = 5;
-  model.external_forces = {push, wind, point};
+  model.external_forces = gusting_forces(0.04);  // (the wind starts inside the run)
   check_external_forces(free_cube, model);
   check_every_kind(free_cube(model), 0, {SpringType::kShear});
   // The spread by mass: the masses' gradient when the pushed particles' masses differ (the

@@ -260,35 +260,6 @@ TEST(BodyContact, ImplicitEulerTwoFreeCubesCollideAtLargeSteps) {
   for (const Real dt : {1.0 / 60, 1.0 / 30}) collide_two_cubes("implicit_euler", dt, 1.0);
 }
 
-// Two n = 4 cubes, mirror images of each other across x = 0 (0.1 m apart), thrown head on at
-// 2 m/s each without gravity, frictionless, with the given restitution; `integrator` resolves
-// body contact after its step (implicit_euler with contact "after_step").
-Simulator head_on(const std::string& integrator, Real dt, Real restitution, int threads = 1,
-                  Real kd = 50) {
-  Model model;
-  CubeSpec a = testing::small_cube(4, 0.3, Vec3(-0.35, 0, 0));
-  CubeSpec b = testing::small_cube(4, 0.3, Vec3(0.05, 0, 0));
-  for (SpringCoefficients& c : a.springs) c.kd = kd;
-  for (SpringCoefficients& c : b.springs) c.kd = kd;
-  model.add_body("left", a.shape().build(a.material(), "a."));
-  model.add_body("right", b.shape().build(b.material(), "b."));
-  model.gravity.setZero();
-  State s = rest_state(model);
-  for (int i = 0; i < model.num_particles(); ++i)
-    particle(s.v, i) = Vec3(i < 64 ? 2.0 : -2.0, 0, 0);
-  SimulatorOptions so;
-  so.dt = dt;
-  so.threads = threads;
-  IntegratorOptions options;
-  options.implicit.contact = ImplicitContactMode::kAfterStep;
-  Simulator sim(model, s, make_integrator(integrator, options), so);
-  BodyContactParams params;
-  params.friction = params.static_friction = 0;
-  params.restitution = restitution;
-  sim.set_body_contact(params);
-  return sim;
-}
-
 // The integrators whose body contact is the after-step response and which are stable at a
 // game's steps (the explicit ones diverge there on these cubes).
 std::vector<std::string> after_step_integrators() {
@@ -302,7 +273,7 @@ TEST(BodyContact, AfterStepHeadOnCollisionNeverGainsEnergy) {
   for (const std::string& integrator : after_step_integrators())
     for (const Real dt : {1.0 / 60, 1.0 / 30}) {
       SCOPED_TRACE(integrator + " at dt = " + std::to_string(dt));
-      Simulator sim = head_on(integrator, dt, 0);
+      Simulator sim = testing::head_on_cubes(integrator, dt, 0);
       const Real e0 = total_energy(sim.model(), sim.state());
       Real worst = 0;
       long touching = 0;
@@ -323,7 +294,7 @@ TEST(BodyContact, AfterStepHeadOnCollisionNeverGainsEnergy) {
 // (after_step) and inside implicit_euler's solve.
 TEST(BodyContact, RunsTakeTheirPairsFromTheCollisionPhase) {
   for (const bool inside : {false, true}) {
-    Simulator sim = head_on("implicit_euler", 1.0 / 60, 0);
+    Simulator sim = testing::head_on_cubes("implicit_euler", 1.0 / 60, 0);
     if (inside) sim.set_integrator(make_integrator("implicit_euler"));
     const RunReport report = sim.run_until(0.3);
     // (During the impact the springs accelerate particles beyond the reach their velocity at
@@ -340,7 +311,7 @@ TEST(BodyContact, AfterStepElasticCollisionKeepsItsEnergy) {
   for (const char* integrator : {"arkode_dirk", "arkode_erk", "implicit_euler",
                                  "projective_dynamics", "rk4", "vbd", "xpbd"}) {
     SCOPED_TRACE(integrator);
-    Simulator sim = head_on(integrator, 1e-3, 1, 1, 0);
+    Simulator sim = testing::head_on_cubes(integrator, 1e-3, 1, 1, 0);
     const Real e0 = total_energy(sim.model(), sim.state());
     Real worst = 0, lowest = 1e9;
     long touching = 0;
@@ -366,22 +337,13 @@ TEST(BodyContact, AfterStepElasticCollisionKeepsItsEnergy) {
 TEST(BodyContact, AfterStepMirroredCollisionStaysSymmetric) {
   for (const char* integrator : {"implicit_euler", "projective_dynamics", "vbd", "xpbd"}) {
     SCOPED_TRACE(integrator);
-    Simulator sim = head_on(integrator, 1.0 / 60, 0);
+    Simulator sim = testing::head_on_cubes(integrator, 1.0 / 60, 0);
     Real asymmetry = 0;
     long touching = 0;
     while (sim.state().t < 0.5) {
       ASSERT_TRUE(sim.step().ok);
       touching += sim.body_contact().pairs().empty() ? 0 : 1;
-      for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-          for (int k = 0; k < 4; ++k) {
-            const int l = (i * 4 + j) * 4 + k, r = 64 + ((3 - i) * 4 + j) * 4 + k;
-            const Vec3 xl = particle(sim.state().x, l), xr = particle(sim.state().x, r);
-            const Vec3 vl = particle(sim.state().v, l), vr = particle(sim.state().v, r);
-            asymmetry = std::max({asymmetry, std::abs(xl.x() + xr.x()), std::abs(xl.y() - xr.y()),
-                                  std::abs(xl.z() - xr.z()), std::abs(vl.x() + vr.x()),
-                                  std::abs(vl.y() - vr.y()), std::abs(vl.z() - vr.z())});
-          }
+      asymmetry = std::max(asymmetry, testing::head_on_asymmetry(sim.state()));
     }
     EXPECT_GT(touching, 0);
     EXPECT_LT(asymmetry, 1e-12);

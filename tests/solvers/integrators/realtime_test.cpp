@@ -457,29 +457,6 @@ TEST_P(RealtimeIntegrators, DrivenPinDragsTheJelly) {
 namespace jelly {
 namespace {
 
-// Two n = 4 cubes mirror images of each other across x = 0 (gap 0.1 m), thrown at each other
-// head on at 2 m/s each, without gravity; xpbd resolves their contact after each step.
-Simulator mirrored_collision(Real dt, int threads) {
-  Model model;
-  const CubeSpec a = testing::small_cube(4, 0.3, Vec3(-0.35, 0, 0));
-  const CubeSpec b = testing::small_cube(4, 0.3, Vec3(0.05, 0, 0));
-  model.add_body("left", a.shape().build(a.material(), "a."));
-  model.add_body("right", b.shape().build(b.material(), "b."));
-  model.gravity.setZero();
-  State s = rest_state(model);
-  for (int i = 0; i < model.num_particles(); ++i)
-    particle(s.v, i) = Vec3(i < 64 ? 2.0 : -2.0, 0, 0);
-  SimulatorOptions so;
-  so.dt = dt;
-  so.threads = threads;
-  Simulator sim(model, s, make_integrator("xpbd"), so);
-  BodyContactParams params;
-  params.friction = params.static_friction = 0;
-  params.restitution = 0;
-  sim.set_body_contact(params);
-  return sim;
-}
-
 // The symmetric head-on collision stays symmetric at 1/240 and 1/60 s: no sideways velocity, no
 // spin, no net momentum (Gauss-Seidel's order left +-0.10 m/s sideways and |L| = 13 kg m^2/s);
 // and at 1/60 s a run is the same bits for 1 and 2 threads. (At 1/60 s a particle meets
@@ -487,7 +464,7 @@ Simulator mirrored_collision(Real dt, int threads) {
 TEST(Xpbd, MirroredCollisionStaysSymmetric) {
   for (const Real dt : {1.0 / 240, 1.0 / 60}) {
     SCOPED_TRACE(dt);
-    Simulator sim = mirrored_collision(dt, 1);
+    Simulator sim = testing::head_on_cubes("xpbd", dt);
     const Model& model = sim.model();
     long touching = 0;
     Real sideways = 0, spin = 0, momentum = 0;
@@ -521,7 +498,8 @@ TEST(Xpbd, MirroredCollisionStaysSymmetric) {
         }
     EXPECT_LT(asymmetry, 1e-12);
   }
-  Simulator one = mirrored_collision(1.0 / 60, 1), two = mirrored_collision(1.0 / 60, 2);
+  Simulator one = testing::head_on_cubes("xpbd", 1.0 / 60, 0, 1),
+            two = testing::head_on_cubes("xpbd", 1.0 / 60, 0, 2);
   ASSERT_TRUE(one.run_until(0.3).ok());
   ASSERT_TRUE(two.run_until(0.3).ok());
   EXPECT_EQ(one.state().x, two.state().x);

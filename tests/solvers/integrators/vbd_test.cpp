@@ -372,27 +372,6 @@ TEST(Vbd, StretchedCubeStaysSymmetric) {
   }
 }
 
-// Two n = 4 cubes, mirror images of each other across x = 0 (0.1 m apart), thrown head on at
-// 2 m/s each without gravity; the contact between them is the Simulator's after each step
-// (frictionless, inelastic).
-Simulator vbd_head_on(Real dt, int threads) {
-  Model model;
-  const CubeSpec a = testing::small_cube(4, 0.3, Vec3(-0.35, 0, 0));
-  const CubeSpec b = testing::small_cube(4, 0.3, Vec3(0.05, 0, 0));
-  model.add_body("left", a.shape().build(a.material(), "a."));
-  model.add_body("right", b.shape().build(b.material(), "b."));
-  model.gravity.setZero();
-  State s = rest_state(model);
-  for (int i = 0; i < model.num_particles(); ++i)
-    particle(s.v, i) = Vec3(i < 64 ? 2.0 : -2.0, 0, 0);
-  Simulator sim = vbd_sim(model, s, dt, {}, threads);
-  BodyContactParams params;
-  params.friction = params.static_friction = 0;
-  params.restitution = 0;
-  sim.set_body_contact(params);
-  return sim;
-}
-
 // The symmetric head-on collision stays symmetric at 1/240 and 1/60 s: particle (i, j, k) of the
 // left cube is the mirror image of (3 - i, j, k) of the right one, positions and velocities to
 // 1e-12; no sideways velocity, no spin, no net momentum. The colouring's classes span both
@@ -401,7 +380,7 @@ Simulator vbd_head_on(Real dt, int threads) {
 TEST(Vbd, MirroredCollisionStaysSymmetric) {
   for (const Real dt : {1.0 / 240, 1.0 / 60}) {
     SCOPED_TRACE(dt);
-    Simulator sim = vbd_head_on(dt, 1);
+    Simulator sim = testing::head_on_cubes("vbd", dt);
     const Model& model = sim.model();
     long touching = 0;
     Real spin = 0, momentum = 0, asymmetry = 0;
@@ -409,16 +388,7 @@ TEST(Vbd, MirroredCollisionStaysSymmetric) {
       touching += sm.body_contact().pairs().empty() ? 0 : 1;
       spin = std::max(spin, angular_momentum(model, sm.state()).norm());
       momentum = std::max(momentum, linear_momentum(model, sm.state()).norm());
-      for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-          for (int k = 0; k < 4; ++k) {
-            const int l = (i * 4 + j) * 4 + k, r = 64 + ((3 - i) * 4 + j) * 4 + k;
-            const Vec3 xl = particle(sm.state().x, l), xr = particle(sm.state().x, r);
-            const Vec3 vl = particle(sm.state().v, l), vr = particle(sm.state().v, r);
-            asymmetry = std::max({asymmetry, std::abs(xl.x() + xr.x()), std::abs(xl.y() - xr.y()),
-                                  std::abs(xl.z() - xr.z()), std::abs(vl.x() + vr.x()),
-                                  std::abs(vl.y() - vr.y()), std::abs(vl.z() - vr.z())});
-          }
+      asymmetry = std::max(asymmetry, testing::head_on_asymmetry(sm.state()));
     });
     sim.add_observer(probe);
     ASSERT_TRUE(sim.run_until(0.5).ok());
@@ -428,7 +398,8 @@ TEST(Vbd, MirroredCollisionStaysSymmetric) {
     EXPECT_LT(momentum, 1e-12 * scale);
     EXPECT_LT(asymmetry, 1e-12);
   }
-  Simulator one = vbd_head_on(1.0 / 60, 1), two = vbd_head_on(1.0 / 60, 2);
+  Simulator one = testing::head_on_cubes("vbd", 1.0 / 60, 0, 1),
+            two = testing::head_on_cubes("vbd", 1.0 / 60, 0, 2);
   ASSERT_TRUE(one.run_until(0.3).ok());
   ASSERT_TRUE(two.run_until(0.3).ok());
   EXPECT_EQ(one.state().x, two.state().x);
