@@ -1,7 +1,7 @@
 #pragma once
 // The anchor springs' (diagonal) Jacobians in the matrices of the implicit integrators.
-#include <jelly/core/force.hpp>
 #include <jelly/core/detail/jacobian.hpp>
+#include <jelly/core/force.hpp>
 
 namespace jelly {
 

@@ -9,9 +9,9 @@
 // matrix (docs/implicit.md, "Matrix-free CG").
 #include <vector>
 
-#include <jelly/core/force.hpp>
 #include <jelly/core/detail/parallel.hpp>
 #include <jelly/core/detail/spring_bands.hpp>
+#include <jelly/core/force.hpp>
 #include <jelly/core/model.hpp>
 
 namespace jelly {

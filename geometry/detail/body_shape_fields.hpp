@@ -5,9 +5,9 @@
 // pose's, a material's) once.
 #include <jelly/core/detail/field_table.hpp>
 #include <jelly/geometry/body_spec.hpp>
+#include <jelly/geometry/cube.hpp>
 #include <jelly/geometry/detail/box.hpp>
 #include <jelly/geometry/detail/cloth.hpp>
-#include <jelly/geometry/cube.hpp>
 #include <jelly/geometry/detail/tetmesh.hpp>
 #include <jelly/geometry/detail/voxelized.hpp>
 

@@ -12,8 +12,8 @@
 #include <filesystem>
 #include <map>
 
-#include <jelly/core/errors.hpp>
 #include <jelly/core/detail/json.hpp>
+#include <jelly/core/errors.hpp>
 #include <jelly/geometry/detail/tet_mesh_io.hpp>
 #include <jelly/io/detail/field_reference.hpp>
 #include <jelly/io/scene.hpp>

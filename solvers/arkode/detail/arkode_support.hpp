@@ -12,8 +12,8 @@
 #include <sundials/sundials_linearsolver.h>
 #include <sundials/sundials_matrix.h>
 
-#include <jelly/solvers/integrators/integrator_options.hpp>
 #include <jelly/solvers/integrators/integrator.hpp>
+#include <jelly/solvers/integrators/integrator_options.hpp>
 
 namespace jelly::arkode {
 
