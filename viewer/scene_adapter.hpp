@@ -14,7 +14,6 @@
 #include <jelly/geometry/triangle_mesh.hpp>
 #include <jelly/io/recording.hpp>
 #include <jelly/terrain/terrain.hpp>
-#include <jelly/terrain/terrain.hpp>
 
 namespace jelly::viewer {
 
