@@ -92,6 +92,9 @@ void bind_fit(py::module_& m) {
                     "Why the numeric path was taken (empty on the adjoint path).")
       .def_readonly("adjoint_passes", &FitResult::adjoint_passes,
                     "Window replays differentiated by the adjoint.")
+      .def_readonly("adjoint_integrator", &FitResult::adjoint_integrator,
+                    "The integrator whose adjoint gave the gradients (the recording's; empty on "
+                    "the numeric path).")
       .def_readonly("wall_seconds", &FitResult::wall_seconds, "Wall time of the whole call (s).")
       .def_readonly("covariance_seconds", &FitResult::covariance_seconds,
                     "Of which the covariance (s).")

@@ -430,6 +430,18 @@ TEST(Cli, FitRecoversTheCoefficientsOfARecording) {
   EXPECT_THAT(r.out, HasSubstr("ks = "));
 }
 
+// A projective_dynamics recording (a pinned cloth, no terrain): the fit takes PD's own adjoint
+// and its report names it.
+TEST(Cli, FitNamesTheProjectiveDynamicsAdjoint) {
+  const std::string file = temp_path(".h5");
+  Result r = jelly("run '" + scene("hanging_cloth.json") +
+                   "' --set integrator.name=projective_dynamics --duration 0.3 -o '" + file + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = jelly("fit '" + file + "' --no-covariance");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("derivatives: adjoint (exact gradients of projective_dynamics"));
+}
+
 // An implicit_euler recording: jelly fit takes the adjoint path by default, says so, and
 // recovers the coefficients; --gradients numeric takes the other path and says why.
 TEST(Cli, FitTakesTheAdjointPathForImplicitEuler) {
