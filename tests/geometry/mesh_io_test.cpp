@@ -234,6 +234,12 @@ TEST(MeshIo, TextMeshFilesWithControlCharactersAreRefusedBeforeAssimp) {
   EXPECT_EQ(read_mesh(write_text(dir.file("ok.obj"), tetrahedron), field).mesh.num_triangles(), 4);
   EXPECT_THAT(error("bell.obj", "v 0 0 0\x07\n" + tetrahedron), HasSubstr("byte 7 is 0x07"));
   EXPECT_THAT(error("ascii.stl", std::string("solid t\n\0", 9)), HasSubstr("a text STL file"));
+  // An ASCII PLY file: a NUL byte in a vertex line made assimp abort on an assertion.
+  EXPECT_THAT(error("nul.ply", std::string("ply\nformat ascii 1.0\nelement vertex 1\n"
+                                           "property float x\nproperty float y\n"
+                                           "property float z\nend_header\n1 \0 0 0\n",
+                                           108)),
+              HasSubstr("a text PLY file (byte 102 is 0x00"));
   // Binary, named "solid ...": 84 + 50 n bytes.
   const TriangleMesh box = box_mesh(Vec3::Ones());
   write_mesh(dir.file("box.stl"), box);
