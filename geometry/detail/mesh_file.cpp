@@ -212,8 +212,15 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
   // An ASCII body is text: a NUL byte in a vertex line made assimp's reader lose its count of the
   // faces and abort on an assertion (jelly_mesh_fuzzer; the input is in tests/fuzz/corpus/mesh).
   if (ascii) require_no_control_characters(text, field, value, "PLY");
+  // An ASCII element is one line, as assimp reads it: its words never cross a line break, and
+  // its line holds nothing after them (a line read one way by this walk and another by assimp
+  // made assimp take a number for a count and allocate 24 GB; jelly_mesh_fuzzer).
+  const auto blank = [&](std::size_t at) {
+    return at < text.size() && text[at] != '\n' &&
+           std::isspace(static_cast<unsigned char>(text[at]));
+  };
   const auto next_word = [&](std::string_view* word) {
-    while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
+    while (blank(pos)) ++pos;
     const std::size_t start = pos;
     while (pos < text.size() && !std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
     *word = std::string_view(text).substr(start, pos - start);
@@ -225,6 +232,9 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
   };
   for (const Element& e : elements) {
     for (long long i = 0; i < e.count; ++i) {
+      if (ascii) {  // the element's line (blank lines between elements pass)
+        while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
+      }
       for (const Property& p : e.properties) {
         long long items = 1;
         if (p.count_size > 0) {
@@ -270,6 +280,13 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
         } else {
           if (static_cast<unsigned long long>(items) * p.size > text.size() - pos) truncated(e, i);
           pos += static_cast<std::size_t>(items) * p.size;
+        }
+      }
+      if (ascii) {
+        while (blank(pos)) ++pos;
+        if (pos < text.size() && text[pos] != '\n') {
+          malformed("element " + e.name + " " + std::to_string(i) +
+                    " has more on its line than its properties");
         }
       }
     }

@@ -26,7 +26,8 @@ void require_text_mesh(const std::string& path, const std::string& field, const 
 // what they say before reading the items), and for anything the walk cannot follow: no "ply"
 // first line or "end_header" line, another header line, format or version, a list length that
 // is no whole number, a body that ends early, a control character in an ASCII file (as
-// require_text_mesh). Only a file walked to its end goes to assimp.
+// require_text_mesh), an ASCII element not on a line of its own. Only a file walked to its end goes
+// to assimp.
 void require_ply_counts_fit(const std::string& path, const std::string& field,
                             const std::string& value);
 
