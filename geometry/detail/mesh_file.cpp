@@ -214,7 +214,7 @@ void require_ply_counts_fit(const std::string& path, const std::string& field,
   if (ascii) require_no_control_characters(text, field, value, "PLY");
   // An ASCII element is one line, as assimp reads it: its words never cross a line break, and
   // its line holds nothing after them (a line read one way by this walk and another by assimp
-  // made assimp take a number for a count and allocate 24 GB; jelly_mesh_fuzzer).
+  // made assimp take a number for a count and allocate its size; jelly_mesh_fuzzer).
   const auto blank = [&](std::size_t at) {
     return at < text.size() && text[at] != '\n' &&
            std::isspace(static_cast<unsigned char>(text[at]));

@@ -217,7 +217,7 @@ TEST(MeshIo, PlyFilesTheWalkCannotFollowAreRefusedBeforeAssimp) {
   EXPECT_THAT(error("edge_face.ply", tetrahedron_ply("2 1 2")),
               HasSubstr("element face 3 has a list of 2 vertices"));
   // An ASCII element is one line, as assimp reads it (a list read across lines by the walk and
-  // along one by assimp made assimp allocate 24 GB: jelly_mesh_fuzzer).
+  // along one by assimp made assimp allocate what a number said: jelly_mesh_fuzzer).
   EXPECT_THAT(error("two_lines.ply", tetrahedron_ply("3 1\n2 3")),
               HasSubstr("it ends inside element face 3 of 4"));
   EXPECT_THAT(error("extra.ply", tetrahedron_ply("3 1 2 3 4")),
